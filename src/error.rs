@@ -1,0 +1,49 @@
+//! The crate's one error type: every refused input gets a variant saying which.
+
+use core::fmt;
+
+/// Why a scene or a sample was refused. Input that is merely outside the
+/// theory's comfort zone is not refused; it is flagged in the result's
+/// [`Validity`](crate::reference::Validity).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Error {
+    /// Radius R1 not finite and positive, or R2 not positive (R2 may be +infinity: a plane).
+    Radius,
+    /// Shear modulus G not finite and positive.
+    ShearModulus,
+    /// Poisson's ratio not in [0, 0.5).
+    PoissonRatio,
+    /// Friction coefficient mu not finite and positive.
+    Friction,
+    /// Roller contact length not finite and positive.
+    Length,
+    /// Load P is NaN, infinite or negative.
+    Load,
+    /// Misalignment angle phi is NaN or infinite, or maps to an auxiliary angle
+    /// theta above pi/2 (eq 4), where m(theta), n(theta) are not defined.
+    Angle,
+    /// The elliptic solution was asked for a plane (R2 = infinity): its contact is a
+    /// strip for every phi (section 8); use the line-contact model.
+    PlaneHasNoEllipse,
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Error::Radius => "radius must be finite and positive (R2 may be inf)",
+            Error::ShearModulus => "shear modulus G must be finite and positive",
+            Error::PoissonRatio => "Poisson's ratio nu must be in [0, 0.5)",
+            Error::Friction => "friction coefficient mu must be finite and positive",
+            Error::Length => "contact length must be finite and positive",
+            Error::Load => "load P must be finite and >= 0",
+            Error::Angle => "misalignment phi must be finite with theta <= pi/2",
+            Error::PlaneHasNoEllipse => {
+                "a plane (R2 = inf) has no contact ellipse: use line contact"
+            }
+        })
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for Error {}

@@ -1,0 +1,33 @@
+//! `misalign`: microslip, critical misalignment angle and axial force of two
+//! misaligned rolling cylinders, after "The rolling contact of misaligned elastic
+//! cylinders" (Hertz ellipse, Kalker's line integrals), for condition-monitoring
+//! firmware.
+//!
+//! ```
+//! use misalign::{reference, Scene};
+//!
+//! // Two steel rollers of 50 mm radius, mu = 0.3.
+//! let scene = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3)?;
+//! // 1 kN load, 0.5 mrad misalignment.
+//! let e = reference::elliptic(&scene, 1e3, 5e-4)?;
+//! assert!(e.slip_ratio > 0.0 && e.axial_force > 0.0 && e.axial_force < 0.3 * 1e3);
+//! let phi0 = e.critical_angle.expect("a critical angle exists at this load");
+//! assert_eq!(e.regime == reference::Regime::Gross, 5e-4 >= phi0);
+//! # Ok::<(), misalign::Error>(())
+//! ```
+//!
+//! Layers: [`scene`] (one installation, validated), [`reference`] (the whole paper
+//! in f64). See ARCHITECTURE.md for which module owns what.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+#[cfg(feature = "std")]
+extern crate std;
+
+mod error;
+pub mod reference;
+pub mod scene;
+
+pub use error::Error;
+pub use scene::{Scene, ThetaRelation};

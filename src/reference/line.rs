@@ -1,0 +1,66 @@
+//! Line contact (paper section 8): a cylinder on a plane, or two long rollers with
+//! the effective radius of eq (31). Loads are per unit length (N/m).
+
+use core::f64::consts::PI;
+
+/// Half-width of the contact strip `b = sqrt(4 P (1 - nu) R / (pi G))` (eq 22), m.
+pub fn half_width(load: f64, nu: f64, g_modulus: f64, radius: f64) -> f64 {
+    libm::sqrt(4.0 * load * (1.0 - nu) * radius / (PI * g_modulus))
+}
+
+/// Peak pressure `p0 = 2 P / (pi b) = sqrt(P G / (pi (1 - nu) R))`, Pa (0 at P = 0).
+pub fn peak_pressure(load: f64, nu: f64, g_modulus: f64, radius: f64) -> f64 {
+    libm::sqrt(load * g_modulus / (PI * (1.0 - nu) * radius))
+}
+
+/// Non-dimensional load `P* = P / ((1 - nu) G R)` (eq 24).
+pub fn nondimensional_load(load: f64, nu: f64, g_modulus: f64, radius: f64) -> f64 {
+    load / ((1.0 - nu) * g_modulus * radius)
+}
+
+/// Critical non-dimensional load `P0* = pi phi^2 / (4 mu^2)` (eq 25).
+pub fn critical_nondimensional_load(phi: f64, mu: f64) -> f64 {
+    let x = phi / mu;
+    PI * x * x / 4.0
+}
+
+/// Slip ratio `d/b = (P0*/P*)^(1/2) = (|phi| / (2 mu)) sqrt(pi (1 - nu) G R / P)`
+/// (eq 23). 0 when phi = 0; +inf when P = 0 and phi != 0.
+pub fn slip_ratio(load: f64, nu: f64, g_modulus: f64, radius: f64, mu: f64, phi: f64) -> f64 {
+    let phi = libm::fabs(phi);
+    if phi == 0.0 {
+        return 0.0;
+    }
+    phi / (2.0 * mu) * libm::sqrt(PI * (1.0 - nu) * g_modulus * radius / load)
+}
+
+/// `F / (mu P) = 2 s - s^2` for `s < 1` (eq 27), 1 at and above (eq 29).
+pub fn axial_force_ratio(s: f64) -> f64 {
+    if s >= 1.0 {
+        1.0
+    } else {
+        libm::fmax(s, 0.0) * (2.0 - s)
+    }
+}
+
+/// Critical angle `phi0 = 2 mu sqrt(P / (pi G (1 - nu) R))` (eq 28), rad.
+pub fn critical_angle(load: f64, nu: f64, g_modulus: f64, radius: f64, mu: f64) -> f64 {
+    2.0 * mu * libm::sqrt(load / (PI * g_modulus * (1.0 - nu) * radius))
+}
+
+/// Axial traction `X(y)` (Pa) of eq (26) across the strip of half-width b, peak
+/// pressure `p0 = 2P/(pi b)`, friction `mu`, slip distance `d`, with the sign of phi.
+pub fn traction(mu: f64, p0: f64, b: f64, d: f64, sign: f64, y: f64) -> f64 {
+    let v = 1.0 - (y / b) * (y / b);
+    if v <= 0.0 {
+        return 0.0;
+    }
+    let mut t = libm::sqrt(v);
+    if b > d {
+        let u = (y - d) / (b - d);
+        if u * u < 1.0 {
+            t -= (1.0 - d / b) * libm::sqrt(1.0 - u * u); // eq (26b)
+        }
+    }
+    libm::copysign(mu * p0 * t, sign)
+}

@@ -1,0 +1,414 @@
+//! The f64 reference: every equation of the paper, to a few ulps, `no_std` (libm).
+//! It is the ground truth the f32 and fixed-point cores are tested against and the
+//! source of their tables. Sub-modules follow the paper: [`normal`] (section 5),
+//! [`tangential`] (sections 6-7), [`line`] (section 8); this module holds the
+//! per-sample results and the model choice of section 9.
+
+mod carlson;
+pub mod line;
+pub mod normal;
+mod solve;
+pub mod tangential;
+
+pub use carlson::carlson_rd;
+pub use normal::EllipseShape;
+pub use tangential::Regime;
+
+use crate::{Error, Scene, ThetaRelation};
+use core::f64::consts::{FRAC_PI_2, PI};
+
+/// Above this |phi| (rad) the small-angle form of eq (4) and the slender-ellipse
+/// expansion of section 4 are stretched (sin phi differs from phi by 0.17 %).
+pub const ANGLE_LIMIT: f64 = 0.1;
+/// Above this `p0 / G` the contact is far beyond the stresses the paper discusses
+/// (its example has 0.005; the reference data stop at 0.05).
+pub const PRESSURE_LIMIT: f64 = 0.05;
+
+/// Which solution produced a result.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactModel {
+    /// The contact ellipse, sections 5-7.
+    Elliptic,
+    /// The contact strip, section 8 (load per unit length).
+    Line,
+}
+
+impl ContactModel {
+    /// `"elliptic"` or `"line"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ContactModel::Elliptic => "elliptic",
+            ContactModel::Line => "line",
+        }
+    }
+}
+
+/// Where the theory's assumptions are stretched. The numbers are still the paper's
+/// equations evaluated exactly; these flags say how far to trust the physics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Validity {
+    /// |phi| above [`ANGLE_LIMIT`], or a critical angle above it.
+    pub large_angle: bool,
+    /// `p0 / G` above [`PRESSURE_LIMIT`].
+    pub high_pressure: bool,
+    /// The ellipse (2a) is longer than the rollers' contact length.
+    pub longer_than_rollers: bool,
+}
+
+impl Validity {
+    /// True when no flag is raised.
+    pub fn is_valid(&self) -> bool {
+        !(self.large_angle || self.high_pressure || self.longer_than_rollers)
+    }
+}
+
+/// Results of the elliptic solution (sections 5-7) for one sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Elliptic {
+    /// Misalignment phi (rad), signed, as given.
+    pub phi: f64,
+    /// Load P (N).
+    pub load: f64,
+    /// theta, k', m, n at this phi (eqs 4-6).
+    pub shape: EllipseShape,
+    /// Semi-axis along the rollers a = m L (m); +inf at phi = 0.
+    pub a: f64,
+    /// Semi-axis in the rolling direction b = n L (m).
+    pub b: f64,
+    /// Peak pressure p0 = 3P/(2 pi a b) (Pa), eq (7).
+    pub p0: f64,
+    /// Non-dimensional load P* (eq 17).
+    pub pstar: f64,
+    /// Critical non-dimensional load P0* (eq 18).
+    pub p0star: f64,
+    /// Slip ratio d/b (eqs 15, 16, 19).
+    pub slip_ratio: f64,
+    /// Distance d of the stick zone's centre from the x axis (m), eq (14), capped at b
+    /// (in gross slip the whole width b slips).
+    pub d: f64,
+    /// Partial or gross slip.
+    pub regime: Regime,
+    /// Axial force F (N) with the sign of phi, eq (21).
+    pub axial_force: f64,
+    /// Critical angle phi0 (rad) at this load, where d/b = 1 (eqs 18, 30); `None`
+    /// when no theta <= pi/2 reaches d/b = 1.
+    pub critical_angle: Option<f64>,
+    /// Auxiliary angle at the critical angle, theta0 (rad).
+    pub critical_theta: Option<f64>,
+    /// Critical load (N) at this phi: the load at which d/b = 1 (eqs 17-19).
+    pub critical_load: f64,
+    /// Where the theory is stretched.
+    pub validity: Validity,
+}
+
+/// Results of the line-contact solution (section 8) for one sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Line {
+    /// Misalignment phi (rad), signed, as given.
+    pub phi: f64,
+    /// Load per unit length P (N/m).
+    pub load: f64,
+    /// Radius of eqs (22)-(28): R1 on a plane, R = R1 R2/(R1 + R2) for rollers (eq 31).
+    pub radius: f64,
+    /// Half-width of the strip b (m), eq (22).
+    pub b: f64,
+    /// Peak pressure p0 = 2P/(pi b) (Pa).
+    pub p0: f64,
+    /// Non-dimensional load P* (eq 24).
+    pub pstar: f64,
+    /// Critical non-dimensional load P0* (eq 25).
+    pub p0star: f64,
+    /// Slip ratio d/b (eq 23).
+    pub slip_ratio: f64,
+    /// Width of the microslip strip d = (d/b) b (m), capped at b in gross slip.
+    pub d: f64,
+    /// Partial or gross slip.
+    pub regime: Regime,
+    /// Axial force per unit length F (N/m) with the sign of phi, eqs (27), (29).
+    pub axial_force: f64,
+    /// Critical angle phi0 (rad), eq (28).
+    pub critical_angle: f64,
+    /// Critical load per unit length (N/m) at this phi.
+    pub critical_load: f64,
+    /// Where the theory is stretched.
+    pub validity: Validity,
+}
+
+/// A result of either model, as chosen by [`estimate`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Estimate {
+    /// The ellipse fits on the rollers (or no length was given).
+    Elliptic(Elliptic),
+    /// The ellipse would be longer than the rollers: line contact with P / length.
+    Line(Line),
+}
+
+impl Estimate {
+    /// Which model produced it.
+    pub fn model(&self) -> ContactModel {
+        match self {
+            Estimate::Elliptic(_) => ContactModel::Elliptic,
+            Estimate::Line(_) => ContactModel::Line,
+        }
+    }
+    /// Slip ratio d/b.
+    pub fn slip_ratio(&self) -> f64 {
+        match self {
+            Estimate::Elliptic(e) => e.slip_ratio,
+            Estimate::Line(l) => l.slip_ratio,
+        }
+    }
+    /// Regime.
+    pub fn regime(&self) -> Regime {
+        Regime::of(self.slip_ratio())
+    }
+    /// Total axial force F (N): per unit length times the length for line contact.
+    pub fn axial_force(&self, scene: &Scene) -> f64 {
+        match self {
+            Estimate::Elliptic(e) => e.axial_force,
+            Estimate::Line(l) => l.axial_force * scene.length().unwrap_or(1.0),
+        }
+    }
+    /// Critical angle phi0 (rad), if any.
+    pub fn critical_angle(&self) -> Option<f64> {
+        match self {
+            Estimate::Elliptic(e) => e.critical_angle,
+            Estimate::Line(l) => Some(l.critical_angle),
+        }
+    }
+    /// Validity flags.
+    pub fn validity(&self) -> Validity {
+        match self {
+            Estimate::Elliptic(e) => e.validity,
+            Estimate::Line(l) => l.validity,
+        }
+    }
+}
+
+fn check_sample(load: f64, phi: f64) -> Result<(), Error> {
+    if !(load.is_finite() && load >= 0.0) {
+        return Err(Error::Load);
+    }
+    if !phi.is_finite() {
+        return Err(Error::Angle);
+    }
+    Ok(())
+}
+
+/// `L^3 / P = 3 (1 - nu) R1 R2 / (2 G (R1 + R2))` (eqs 2-3 with the erratum).
+pub fn hertz_volume(scene: &Scene) -> f64 {
+    3.0 * (1.0 - scene.poisson_ratio()) * scene.effective_radius() / (2.0 * scene.shear_modulus())
+}
+
+/// The phi (rad, >= 0) that gives auxiliary angle `theta` under the scene's relation.
+fn phi_of_theta(scene: &Scene, theta: f64) -> f64 {
+    let c = scene.radius_factor();
+    match scene.theta_relation() {
+        ThetaRelation::SmallAngle => theta / c,
+        ThetaRelation::Exact => libm::asin(libm::fmin(libm::sin(theta) / c, 1.0)),
+    }
+}
+
+/// Critical angle at `load`: the phi >= 0 with d/b = 1 (eq 15 = 1, i.e. eq 30
+/// `phi0 = 2 mu p0 / G` with p0 at phi0). Returns `(phi0, theta0)`, or `None` when
+/// d/b stays below 1 up to theta = pi/2 (or, for the exact relation, phi = pi/2).
+pub fn critical_angle(scene: &Scene, load: f64) -> Option<(f64, f64)> {
+    if load == 0.0 {
+        return Some((0.0, 0.0));
+    }
+    let v = libm::cbrt(hertz_volume(scene));
+    // d/b = 1  <=>  m n |phi| = 3 mu P^(1/3) / (pi G V^(2/3)).
+    let target = 3.0 * scene.friction() * libm::cbrt(load) / (PI * scene.shear_modulus() * v * v);
+    let theta_max = match scene.theta_relation() {
+        ThetaRelation::SmallAngle => FRAC_PI_2,
+        ThetaRelation::Exact => libm::asin(scene.radius_factor()),
+    };
+    let kprime_max = normal::ellipse_shape(theta_max)?.kprime;
+    let guess = normal::theta_for_g(libm::fmin(target * scene.radius_factor(), FRAC_PI_2))
+        .map_or(kprime_max, |s| libm::fmax(s.kprime, f64::MIN_POSITIVE));
+    let kprime = solve::increasing_root(
+        |k| {
+            let s = normal::shape_from_kprime(k);
+            s.mn() * phi_of_theta(scene, s.theta) - target
+        },
+        libm::fmin(guess, kprime_max),
+        0.0,
+        kprime_max,
+    )?;
+    let theta0 = libm::fmin(normal::shape_from_kprime(kprime).theta, theta_max);
+    Some((phi_of_theta(scene, theta0), theta0))
+}
+
+/// The elliptic solution (sections 5-7) for load `load` (N) and misalignment `phi`
+/// (rad, signed). Zero angle gives the strip limit (a = inf, p0 = 0, d/b = 0, F = 0);
+/// zero load gives a = b = p0 = F = 0, d/b = inf (gross slip), phi0 = 0.
+///
+/// # Errors
+/// [`Error::Load`], [`Error::Angle`] for undefined input, [`Error::PlaneHasNoEllipse`]
+/// for a plane.
+pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
+    check_sample(load, phi)?;
+    if scene.is_plane() {
+        return Err(Error::PlaneHasNoEllipse);
+    }
+    let theta = scene.auxiliary_angle(phi);
+    let shape = normal::ellipse_shape(theta).ok_or(Error::Angle)?;
+    let (g_mod, nu, mu) = (
+        scene.shear_modulus(),
+        scene.poisson_ratio(),
+        scene.friction(),
+    );
+    let vol = hertz_volume(scene);
+    let (a, b) = normal::semi_axes(&shape, vol, load);
+    let p0 = normal::peak_pressure(&shape, vol, load);
+    let s = if load == 0.0 && phi != 0.0 {
+        f64::INFINITY
+    } else {
+        tangential::slip_ratio(g_mod, mu, shape.mn(), vol, load, phi)
+    };
+    let (r1, r2) = (scene.r1(), scene.r2());
+    let pstar = tangential::nondimensional_load(load, nu, g_mod, r1, r2);
+    let p0star = tangential::critical_nondimensional_load(shape.g(), mu);
+    // P at which d/b = 1 for this phi: P0* scaled back by eq (17).
+    let critical_load =
+        p0star * (1.0 - nu) * (1.0 - nu) * g_mod * (r1 + r2) * libm::sqrt(r1 * r2) / 2.0;
+    let axial_force = libm::copysign(mu * load * tangential::axial_force_ratio(s), phi);
+    let critical = critical_angle(scene, load);
+    let validity = Validity {
+        large_angle: libm::fabs(phi) > ANGLE_LIMIT || critical.is_none_or(|(p, _)| p > ANGLE_LIMIT),
+        high_pressure: p0 / g_mod > PRESSURE_LIMIT,
+        longer_than_rollers: scene.length().is_some_and(|l| 2.0 * a > l),
+    };
+    Ok(Elliptic {
+        phi,
+        load,
+        shape,
+        a,
+        b,
+        p0,
+        pstar,
+        p0star,
+        slip_ratio: s,
+        d: libm::fmin(s, 1.0) * b,
+        regime: Regime::of(s),
+        axial_force,
+        critical_angle: critical.map(|c| c.0),
+        critical_theta: critical.map(|c| c.1),
+        critical_load,
+        validity,
+    })
+}
+
+impl Elliptic {
+    /// Hertz pressure p(x, y) (Pa), eq (7).
+    pub fn pressure(&self, x: f64, y: f64) -> f64 {
+        normal::pressure(self.p0, self.a, self.b, x, y)
+    }
+    /// Axial traction X(x, y) (Pa), eqs (11), (13), (14); the friction comes from `scene`.
+    pub fn traction(&self, scene: &Scene, x: f64, y: f64) -> f64 {
+        tangential::elliptic_traction(
+            scene.friction(),
+            self.p0,
+            self.a,
+            self.b,
+            self.d,
+            self.phi,
+            x,
+            y,
+        )
+    }
+    /// The stick zone `(y_min, y_max)` at axial position x (m), if any.
+    pub fn stick_zone(&self, x: f64) -> Option<(f64, f64)> {
+        tangential::elliptic_stick_zone(self.a, self.b, self.d, x)
+    }
+    /// Component `F phi / 2` (N) of the axial force opposing the rolling of each cylinder (section 7).
+    pub fn rolling_resistance(&self) -> f64 {
+        0.5 * self.axial_force * self.phi
+    }
+    /// Power `F phi V` (W) dissipated by microslip at rolling speed `speed` (m/s), section 7.
+    pub fn dissipated_power(&self, speed: f64) -> f64 {
+        self.axial_force * self.phi * speed
+    }
+}
+
+/// The line-contact solution (section 8) for load per unit length `load` (N/m) and
+/// misalignment `phi` (rad), with R1 for a plane and eq (31) for two rollers.
+/// Zero angle: d/b = 0, F = 0. Zero load: b = p0 = F = phi0 = 0, d/b = inf.
+///
+/// # Errors
+/// [`Error::Load`], [`Error::Angle`] for undefined input.
+pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
+    check_sample(load, phi)?;
+    let (g_mod, nu, mu) = (
+        scene.shear_modulus(),
+        scene.poisson_ratio(),
+        scene.friction(),
+    );
+    let radius = scene.effective_radius();
+    let b = line::half_width(load, nu, g_mod, radius);
+    let p0 = line::peak_pressure(load, nu, g_mod, radius);
+    let s = if load == 0.0 && phi != 0.0 {
+        f64::INFINITY
+    } else {
+        line::slip_ratio(load, nu, g_mod, radius, mu, phi)
+    };
+    let p0star = line::critical_nondimensional_load(phi, mu);
+    let critical_angle = line::critical_angle(load, nu, g_mod, radius, mu);
+    Ok(Line {
+        phi,
+        load,
+        radius,
+        b,
+        p0,
+        pstar: line::nondimensional_load(load, nu, g_mod, radius),
+        p0star,
+        slip_ratio: s,
+        d: libm::fmin(s, 1.0) * b,
+        regime: Regime::of(s),
+        axial_force: libm::copysign(mu * load * line::axial_force_ratio(s), phi),
+        critical_angle,
+        critical_load: p0star * (1.0 - nu) * g_mod * radius,
+        validity: Validity {
+            large_angle: libm::fabs(phi) > ANGLE_LIMIT || critical_angle > ANGLE_LIMIT,
+            high_pressure: p0 / g_mod > PRESSURE_LIMIT,
+            longer_than_rollers: false,
+        },
+    })
+}
+
+impl Line {
+    /// Axial traction X(y) (Pa) across the strip, eq (26); friction from `scene`.
+    pub fn traction(&self, scene: &Scene, y: f64) -> f64 {
+        line::traction(scene.friction(), self.p0, self.b, self.d, self.phi, y)
+    }
+    /// Stick zone `(y_min, y_max) = (2d - b, b)`, or `None` in gross slip.
+    pub fn stick_zone(&self) -> Option<(f64, f64)> {
+        if self.b > self.d {
+            Some((2.0 * self.d - self.b, self.b))
+        } else {
+            None
+        }
+    }
+}
+
+/// The paper's model choice (section 9): the elliptic solution, unless the scene has a
+/// contact length and the ellipse is longer than it (or body 2 is a plane), in which
+/// case the line solution with the load per unit length `P / length`.
+///
+/// # Errors
+/// As [`elliptic`] and [`line`]; [`Error::PlaneHasNoEllipse`] for a plane without length.
+pub fn estimate(scene: &Scene, load: f64, phi: f64) -> Result<Estimate, Error> {
+    check_sample(load, phi)?;
+    match scene.length() {
+        None => elliptic(scene, load, phi).map(Estimate::Elliptic),
+        Some(length) => {
+            if !scene.is_plane() {
+                let e = elliptic(scene, load, phi)?;
+                if !e.validity.longer_than_rollers {
+                    return Ok(Estimate::Elliptic(e));
+                }
+            }
+            line(scene, load / length, phi).map(Estimate::Line)
+        }
+    }
+}

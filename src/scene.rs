@@ -1,0 +1,151 @@
+//! One installation: the two rollers' radii, their contact length, the material and
+//! the friction. Built once and validated; samples (load, angle) come per reading.
+
+use crate::Error;
+
+/// How the auxiliary angle theta follows from the misalignment phi.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ThetaRelation {
+    /// The paper's eq (4): `theta = 2 |phi| sqrt(R1 R2) / (R1 + R2)`. Default; the
+    /// reference data use it.
+    #[default]
+    SmallAngle,
+    /// The exact crossed-cylinder relation
+    /// `sin(theta) = 2 sqrt(R1 R2) sin|phi| / (R1 + R2)`; it equals eq (4) for
+    /// R1 = R2 and differs by `(1 - c^2) phi^2 / 6` otherwise.
+    Exact,
+}
+
+/// A validated installation, in SI units. Same elastic material for both bodies,
+/// as the paper assumes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scene {
+    r1: f64,
+    r2: f64,
+    length: Option<f64>,
+    shear_modulus: f64,
+    poisson_ratio: f64,
+    friction: f64,
+    theta_relation: ThetaRelation,
+}
+
+impl Scene {
+    /// A scene of two rollers of radii `r1`, `r2` (m; `r2 = f64::INFINITY` is a plane),
+    /// shear modulus `shear_modulus` G (Pa), Poisson's ratio `poisson_ratio` nu and
+    /// friction coefficient `friction` mu.
+    ///
+    /// # Errors
+    /// A typed [`Error`] for non-finite or non-positive radii or modulus, nu outside
+    /// [0, 0.5), or mu not finite and positive.
+    pub fn new(
+        r1: f64,
+        r2: f64,
+        shear_modulus: f64,
+        poisson_ratio: f64,
+        friction: f64,
+    ) -> Result<Self, Error> {
+        if !(r1.is_finite() && r1 > 0.0) || r2.is_nan() || r2 <= 0.0 {
+            return Err(Error::Radius);
+        }
+        if !(shear_modulus.is_finite() && shear_modulus > 0.0) {
+            return Err(Error::ShearModulus);
+        }
+        if !(0.0..0.5).contains(&poisson_ratio) {
+            return Err(Error::PoissonRatio);
+        }
+        if !(friction.is_finite() && friction > 0.0) {
+            return Err(Error::Friction);
+        }
+        Ok(Self {
+            r1,
+            r2,
+            length: None,
+            shear_modulus,
+            poisson_ratio,
+            friction,
+            theta_relation: ThetaRelation::SmallAngle,
+        })
+    }
+
+    /// The same scene with the rollers' contact length (m), which lets the model
+    /// choice of section 9 switch to line contact when the ellipse is longer.
+    ///
+    /// # Errors
+    /// [`Error::Length`] unless `length` is finite and positive.
+    pub fn with_length(mut self, length: f64) -> Result<Self, Error> {
+        if !(length.is_finite() && length > 0.0) {
+            return Err(Error::Length);
+        }
+        self.length = Some(length);
+        Ok(self)
+    }
+
+    /// The same scene with another theta(phi) relation.
+    pub fn with_theta_relation(mut self, relation: ThetaRelation) -> Self {
+        self.theta_relation = relation;
+        self
+    }
+
+    /// Radius R1 (m).
+    pub fn r1(&self) -> f64 {
+        self.r1
+    }
+    /// Radius R2 (m); infinite for a plane.
+    pub fn r2(&self) -> f64 {
+        self.r2
+    }
+    /// Contact length of the rollers (m), if given.
+    pub fn length(&self) -> Option<f64> {
+        self.length
+    }
+    /// Shear modulus G (Pa).
+    pub fn shear_modulus(&self) -> f64 {
+        self.shear_modulus
+    }
+    /// Poisson's ratio nu.
+    pub fn poisson_ratio(&self) -> f64 {
+        self.poisson_ratio
+    }
+    /// Friction coefficient mu.
+    pub fn friction(&self) -> f64 {
+        self.friction
+    }
+    /// The theta(phi) relation in use.
+    pub fn theta_relation(&self) -> ThetaRelation {
+        self.theta_relation
+    }
+    /// True when body 2 is a plane (R2 = infinity).
+    pub fn is_plane(&self) -> bool {
+        self.r2.is_infinite()
+    }
+
+    /// Effective radius `R = R1 R2 / (R1 + R2)` (eq 31); R1 for a plane.
+    pub fn effective_radius(&self) -> f64 {
+        if self.is_plane() {
+            self.r1
+        } else {
+            self.r1 * self.r2 / (self.r1 + self.r2)
+        }
+    }
+
+    /// `c = 2 sqrt(R1 R2) / (R1 + R2)` of eq (4), so that `theta = c phi`; 0 for a plane.
+    pub fn radius_factor(&self) -> f64 {
+        if self.is_plane() {
+            0.0
+        } else {
+            // 2 sqrt(R1 R2)/(R1+R2) = 2 sqrt(r)/(1+r), r = R2/R1, without overflow.
+            let r = self.r2 / self.r1;
+            2.0 * libm::sqrt(r) / (1.0 + r)
+        }
+    }
+
+    /// The auxiliary angle theta (rad) for a misalignment `phi` (rad), by the scene's
+    /// [`ThetaRelation`]; depends on |phi| only.
+    pub fn auxiliary_angle(&self, phi: f64) -> f64 {
+        let c = self.radius_factor();
+        match self.theta_relation {
+            ThetaRelation::SmallAngle => c * libm::fabs(phi),
+            ThetaRelation::Exact => libm::asin(c * libm::sin(libm::fabs(phi))),
+        }
+    }
+}
