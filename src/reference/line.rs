@@ -48,9 +48,9 @@ pub fn critical_angle(load: f64, nu: f64, g_modulus: f64, radius: f64, mu: f64) 
     2.0 * mu * libm::sqrt(load / (PI * g_modulus * (1.0 - nu) * radius))
 }
 
-/// Axial traction `X(y)` (Pa) of eq (26) across the strip of half-width b, peak
-/// pressure `p0 = 2P/(pi b)`, friction `mu`, slip distance `d`, with the sign of phi.
-pub fn traction(mu: f64, p0: f64, b: f64, d: f64, sign: f64, y: f64) -> f64 {
+/// Axial traction `X(y)` (Pa) of eq (26) across the strip of half-width b, with
+/// `scale = mu p0 = 2 mu P/(pi b)` signed like phi and slip distance `d`.
+pub fn traction(scale: f64, b: f64, d: f64, y: f64) -> f64 {
     let v = 1.0 - (y / b) * (y / b);
     if v <= 0.0 {
         return 0.0;
@@ -62,5 +62,5 @@ pub fn traction(mu: f64, p0: f64, b: f64, d: f64, sign: f64, y: f64) -> f64 {
             t -= (1.0 - d / b) * libm::sqrt(1.0 - u * u); // eq (26b)
         }
     }
-    libm::copysign(mu * p0 * t, sign)
+    scale * t
 }

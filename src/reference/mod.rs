@@ -307,12 +307,10 @@ impl Elliptic {
     /// Axial traction X(x, y) (Pa), eqs (11), (13), (14); the friction comes from `scene`.
     pub fn traction(&self, scene: &Scene, x: f64, y: f64) -> f64 {
         tangential::elliptic_traction(
-            scene.friction(),
-            self.p0,
+            libm::copysign(scene.friction() * self.p0, self.phi),
             self.a,
             self.b,
             self.d,
-            self.phi,
             x,
             y,
         )
@@ -379,7 +377,12 @@ pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
 impl Line {
     /// Axial traction X(y) (Pa) across the strip, eq (26); friction from `scene`.
     pub fn traction(&self, scene: &Scene, y: f64) -> f64 {
-        line::traction(scene.friction(), self.p0, self.b, self.d, self.phi, y)
+        line::traction(
+            libm::copysign(scene.friction() * self.p0, self.phi),
+            self.b,
+            self.d,
+            y,
+        )
     }
     /// Stick zone `(y_min, y_max) = (2d - b, b)`, or `None` in gross slip.
     pub fn stick_zone(&self) -> Option<(f64, f64)> {

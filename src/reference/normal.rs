@@ -134,7 +134,7 @@ pub fn ellipse_shape(theta: f64) -> Option<EllipseShape> {
 /// The theta in [0, pi/2] at which `g(theta) = m n theta` equals `g`, or `None`
 /// when `g > pi/2 = g(pi/2)` (no such theta) or `g` is NaN or negative.
 pub fn theta_for_g(g: f64) -> Option<EllipseShape> {
-    if g.is_nan() || g < 0.0 || g > FRAC_PI_2 {
+    if !(0.0..=FRAC_PI_2).contains(&g) {
         return None;
     }
     if g == 0.0 {

@@ -40,7 +40,7 @@ pub(crate) fn increasing_root(
     while f_lo > 0.0 {
         hi = lo;
         f_hi = f_lo;
-        lo = 0.5 * lo;
+        lo *= 0.5;
         if lo <= lo_limit || evaluations > MAX_EVALUATIONS {
             return None;
         }

@@ -87,20 +87,10 @@ pub fn critical_nondimensional_load(g: f64, mu: f64) -> f64 {
 }
 
 /// Axial traction `X(x, y)` (Pa) of eqs (11), (13), (14) on an ellipse of semi-axes
-/// a (along the rollers, x) and b (rolling direction, y), peak pressure `p0`, friction
-/// `mu`, slip distance `d = (d/b) b` and the sign of phi. The stick zone is
-/// `(y - d)^2 < (c - d)^2` with `c(x) = b sqrt(1 - x^2/a^2)` (eq 10); 0 outside the
-/// contact.
-pub fn elliptic_traction(
-    mu: f64,
-    p0: f64,
-    a: f64,
-    b: f64,
-    d: f64,
-    sign: f64,
-    x: f64,
-    y: f64,
-) -> f64 {
+/// a (along the rollers, x) and b (rolling direction, y), with `scale = mu p0` signed
+/// like phi and slip distance `d = (d/b) b`. The stick zone is `(y - d)^2 < (c - d)^2`
+/// with `c(x) = b sqrt(1 - x^2/a^2)` (eq 10); 0 outside the contact.
+pub fn elliptic_traction(scale: f64, a: f64, b: f64, d: f64, x: f64, y: f64) -> f64 {
     let ex = 1.0 - (x / a) * (x / a);
     let inside = ex - (y / b) * (y / b);
     if ex <= 0.0 || inside <= 0.0 {
@@ -114,7 +104,7 @@ pub fn elliptic_traction(
             t -= (c - d) / b * libm::sqrt(1.0 - u * u); // eq (11b) with A = (c - d)/b (eq 13)
         }
     }
-    libm::copysign(mu * p0 * t, sign)
+    scale * t
 }
 
 /// The stick zone across the rolling direction at axial position x: `y` from
