@@ -26,6 +26,12 @@ pub enum Error {
     /// The elliptic solution was asked for a plane (R2 = infinity): its contact is a
     /// strip for every phi (section 8); use the line-contact model.
     PlaneHasNoEllipse,
+    /// The f32 and fixed-point cores implement eq (4); the exact theta relation is in
+    /// the reference only.
+    Unsupported,
+    /// A value outside what a prepared scene accepts: a scene constant that does not
+    /// fit the core's number format, or an input outside the declared range.
+    OutOfRange,
 }
 
 impl fmt::Display for Error {
@@ -41,6 +47,10 @@ impl fmt::Display for Error {
             Error::PlaneHasNoEllipse => {
                 "a plane (R2 = inf) has no contact ellipse: use line contact"
             }
+            Error::Unsupported => {
+                "the cores implement eq (4) only; use the reference for the exact relation"
+            }
+            Error::OutOfRange => "value outside the range the prepared scene accepts",
         })
     }
 }

@@ -23,12 +23,17 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
-#[cfg(feature = "std")]
+#[cfg(any(test, feature = "std"))]
+#[cfg_attr(test, macro_use)]
 extern crate std;
 
 mod error;
+pub mod float;
+pub mod kernels;
 pub mod reference;
 pub mod scene;
+#[rustfmt::skip]
+pub mod tables;
 
 pub use error::Error;
 pub use scene::{Scene, ThetaRelation};

@@ -1,5 +1,76 @@
 //! Chores for people and CI alike: `cargo xtask <task>`.
-fn main() {
-    eprintln!("usage: cargo xtask <task>");
-    std::process::exit(2);
+
+mod fit;
+mod tables;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+const USAGE: &str = "\
+usage: cargo xtask <task>
+
+tasks:
+    tables [--check] [--explore]   generate src/tables.rs from the f64 reference
+                                   (--check: fail if the committed file differs;
+                                   --explore: print error and size of table shapes)
+";
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let flag = |f: &str| args.iter().any(|a| a == f);
+    match args.first().map(String::as_str) {
+        Some("tables") if flag("--explore-octaves") => {
+            tables::explore_octaves(0, 6);
+            ExitCode::SUCCESS
+        }
+        Some("tables") if flag("--explore-force") => {
+            tables::explore_force();
+            ExitCode::SUCCESS
+        }
+        Some("tables") if flag("--explore") => {
+            tables::explore();
+            ExitCode::SUCCESS
+        }
+        Some("tables") => {
+            let path = root().join("src/tables.rs");
+            let text = tables::source();
+            if flag("--check") {
+                let committed = std::fs::read_to_string(&path).unwrap_or_default();
+                if committed != text {
+                    eprintln!(
+                        "{} differs from the reference: run `cargo xtask tables`",
+                        path.display()
+                    );
+                    return ExitCode::FAILURE;
+                }
+                println!("{} matches the reference", path.display());
+            } else {
+                std::fs::write(&path, text).expect("write src/tables.rs");
+                println!("wrote {}", path.display());
+            }
+            ExitCode::SUCCESS
+        }
+        _ => {
+            eprint!("{USAGE}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The committed tables are exactly what the reference generates today: any
+    /// change to the reference or the fit that moves a coefficient fails here.
+    #[test]
+    fn committed_tables_match_the_reference() {
+        let committed = std::fs::read_to_string(super::root().join("src/tables.rs")).unwrap();
+        assert!(
+            committed == super::tables::source(),
+            "src/tables.rs drifted from the reference: run `cargo xtask tables`"
+        );
+    }
 }

@@ -1,0 +1,253 @@
+//! The elliptic contact (paper sections 5-7) in f32.
+
+use super::{DEFAULT_RISK_SLIP_RATIO, Estimate, check};
+use crate::kernels::axial_force::axial_force_ratio;
+use crate::kernels::cbrt::{cbrt, inv_cbrt};
+use crate::kernels::octave::OctaveTable;
+use crate::kernels::small_theta;
+use crate::reference::hertz_volume;
+use crate::{Error, Scene, ThetaRelation, tables};
+use core::f32::consts::{FRAC_PI_2, PI};
+
+/// Below this theta (and g below `SMALL_G`) the small-theta asymptotics are exact in
+/// f32 and take over from the tables.
+const SMALL_THETA: f32 = 9.094_947e-13; // 2^-40
+const SMALL_G: f32 = 7.450_581e-9; // 2^-27
+
+/// The tables one elliptic scene reads per sample: g(theta) (eqs 5, 6, 16) and its
+/// inverse (eq 18). [`Tables::FULL`] covers theta from 0 to pi/2; a firmware whose
+/// scene declares a narrower range of misalignment can pass narrower ones (built at
+/// compile time with [`crate::kernels::octave::narrow_rows`]) and link only those rows.
+#[derive(Debug, Clone, Copy)]
+pub struct Tables<'a> {
+    /// g(theta) = m n theta.
+    pub g: OctaveTable<'a, 7>,
+    /// theta(g), the inverse of g.
+    pub theta_of_g: OctaveTable<'a, 7>,
+}
+
+impl Tables<'static> {
+    /// The generated tables over the whole range, theta from 0 to pi/2.
+    pub const FULL: Tables<'static> = Tables {
+        g: tables::G_OF_THETA,
+        theta_of_g: tables::THETA_OF_G,
+    };
+}
+
+/// A prepared elliptic-contact scene: the per-sample constants of eqs (4), (16), (18).
+#[derive(Debug, Clone, Copy)]
+pub struct EllipticScene<'t> {
+    /// `c = 2 sqrt(R1 R2) / (R1 + R2)` (eq 4): theta = c |phi|.
+    radius_factor: f32,
+    /// `1 / c`.
+    inv_radius_factor: f32,
+    /// `A = pi G V^(2/3) / (3 mu c)`: d/b = A g(theta) P^(-1/3) (eq 16), V = L^3/P.
+    slip_gain: f32,
+    /// `1 / A`: at d/b = 1, g(theta0) = P^(1/3) / A (eq 18).
+    critical_gain: f32,
+    /// Friction coefficient mu.
+    friction: f32,
+    /// `V^(1/3)`: L = V^(1/3) P^(1/3) (eqs 2, 3).
+    hertz_gain: f32,
+    /// d/b at and above which the risk flag is raised.
+    risk_slip_ratio: f32,
+    tables: Tables<'t>,
+}
+
+impl EllipticScene<'static> {
+    /// Prepares `scene` with the full tables.
+    ///
+    /// # Errors
+    /// [`Error::PlaneHasNoEllipse`] for a plane, [`Error::Unsupported`] for the exact
+    /// theta relation (the cores implement eq 4), [`Error::OutOfRange`] if a constant
+    /// does not fit in f32.
+    pub fn new(scene: &Scene) -> Result<Self, Error> {
+        Self::with_tables(scene, Tables::FULL)
+    }
+}
+
+impl<'t> EllipticScene<'t> {
+    /// Prepares `scene` with the given tables (see [`Tables`]).
+    ///
+    /// # Errors
+    /// As [`EllipticScene::new`].
+    pub fn with_tables(scene: &Scene, tables: Tables<'t>) -> Result<Self, Error> {
+        if scene.is_plane() {
+            return Err(Error::PlaneHasNoEllipse);
+        }
+        if scene.theta_relation() != ThetaRelation::SmallAngle {
+            return Err(Error::Unsupported);
+        }
+        let c = scene.radius_factor();
+        let v = libm::cbrt(hertz_volume(scene));
+        let slip_gain =
+            core::f64::consts::PI * scene.shear_modulus() * v * v / (3.0 * scene.friction() * c);
+        let constants = [c, 1.0 / c, slip_gain, 1.0 / slip_gain, scene.friction(), v];
+        let mut f = [0.0f32; 6];
+        for (out, x) in f.iter_mut().zip(constants) {
+            *out = x as f32;
+            if !(out.is_normal() && *out > 0.0) {
+                return Err(Error::OutOfRange);
+            }
+        }
+        Ok(EllipticScene {
+            radius_factor: f[0],
+            inv_radius_factor: f[1],
+            slip_gain: f[2],
+            critical_gain: f[3],
+            friction: f[4],
+            hertz_gain: f[5],
+            risk_slip_ratio: DEFAULT_RISK_SLIP_RATIO,
+            tables,
+        })
+    }
+
+    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`].
+    pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Self {
+        self.risk_slip_ratio = slip_ratio;
+        self
+    }
+
+    /// The estimate for load `load` (N) and misalignment `phi` (rad, signed).
+    /// Zero angle: d/b = 0, F = 0. Zero load: d/b = +inf (gross slip), F = 0, phi0 = 0.
+    ///
+    /// # Errors
+    /// [`Error::Load`] for a NaN, infinite or negative load; [`Error::Angle`] for a
+    /// non-finite angle or theta above pi/2; [`Error::OutOfRange`] for a theta below
+    /// narrowed tables.
+    #[inline]
+    pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
+        check(load, phi)?;
+        let abs_phi = phi.abs();
+        let theta = self.radius_factor * abs_phi;
+        if theta > FRAC_PI_2 {
+            return Err(Error::Angle);
+        }
+        if load == 0.0 {
+            let s = if theta == 0.0 { 0.0 } else { f32::INFINITY };
+            return Ok(Estimate::new(
+                s,
+                0.0,
+                Some(0.0),
+                abs_phi,
+                self.risk_slip_ratio,
+            ));
+        }
+        let r = inv_cbrt(load); // P^(-1/3)
+        let g = self.g_of_theta(theta)?;
+        let s = self.slip_gain * g * r; // eq (16)
+        let force = (self.friction * load * axial_force_ratio(s)).copysign(phi); // eq (21)
+        let g0 = self.critical_gain * (load * r * r); // eq (18) at d/b = 1
+        let critical = self.theta_of_g(g0)?.map(|t| t * self.inv_radius_factor);
+        Ok(Estimate::new(
+            s,
+            force,
+            critical,
+            abs_phi,
+            self.risk_slip_ratio,
+        ))
+    }
+
+    #[inline(always)]
+    fn g_of_theta(&self, theta: f32) -> Result<f32, Error> {
+        match self.tables.g.eval(theta) {
+            Some(g) => Ok(g),
+            None => self.g_outside(theta),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn g_outside(&self, theta: f32) -> Result<f32, Error> {
+        if theta == 0.0 {
+            Ok(0.0)
+        } else if theta < self.tables.g.lower() && self.tables.g.lower() <= SMALL_THETA {
+            Ok(small_theta::g_small(theta))
+        } else {
+            Err(Error::OutOfRange)
+        }
+    }
+
+    /// theta0 with g(theta0) = g; `Ok(None)` above g(pi/2) = pi/2 (no critical angle).
+    #[inline(always)]
+    fn theta_of_g(&self, g: f32) -> Result<Option<f32>, Error> {
+        if g > FRAC_PI_2 {
+            return Ok(None);
+        }
+        match self.tables.theta_of_g.eval(g) {
+            Some(t) => Ok(Some(t)),
+            None => self.theta_outside(g).map(Some),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn theta_outside(&self, g: f32) -> Result<f32, Error> {
+        if g == 0.0 {
+            Ok(0.0)
+        } else if g < self.tables.theta_of_g.lower() && self.tables.theta_of_g.lower() <= SMALL_G {
+            Ok(small_theta::theta_small(g))
+        } else {
+            Err(Error::OutOfRange)
+        }
+    }
+
+    /// The contact ellipse on request: m, n (eqs 5-6), a, b (eqs 2-3), p0 (eq 7).
+    ///
+    /// # Errors
+    /// As [`EllipticScene::estimate`].
+    pub fn details(&self, load: f32, phi: f32) -> Result<Details, Error> {
+        check(load, phi)?;
+        let theta = self.radius_factor * phi.abs();
+        if theta > FRAC_PI_2 {
+            return Err(Error::Angle);
+        }
+        if theta == 0.0 {
+            // The strip limit: an infinitely long ellipse of zero width.
+            return Ok(Details {
+                theta,
+                m: f32::INFINITY,
+                n: 0.0,
+                a: f32::INFINITY,
+                b: 0.0,
+                p0: 0.0,
+            });
+        }
+        let g = self.g_of_theta(theta)?;
+        let inv_m = match tables::INV_M_OF_THETA.eval(theta) {
+            Some(x) => x,
+            None if theta < SMALL_THETA => small_theta::inv_m_small(theta),
+            None => return Err(Error::OutOfRange),
+        };
+        let m = 1.0 / inv_m;
+        let n = g * inv_m / theta;
+        let l = self.hertz_gain * cbrt(load); // L, eqs (2)-(3)
+        // p0 = 3 P / (2 pi a b) = 3 P^(1/3) / (2 pi m n V^(2/3)); 0 at P = 0.
+        let p0 = 3.0 * cbrt(load) / (2.0 * PI * m * n * self.hertz_gain * self.hertz_gain);
+        Ok(Details {
+            theta,
+            m,
+            n,
+            a: m * l,
+            b: n * l,
+            p0,
+        })
+    }
+}
+
+/// The contact ellipse of one sample, on request ([`EllipticScene::details`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Details {
+    /// Auxiliary angle theta (rad), eq (4).
+    pub theta: f32,
+    /// m (eqs 5-6); +inf at phi = 0.
+    pub m: f32,
+    /// n (eqs 5-6).
+    pub n: f32,
+    /// Semi-axis along the rollers a = m L (m); +inf at phi = 0.
+    pub a: f32,
+    /// Semi-axis in the rolling direction b = n L (m).
+    pub b: f32,
+    /// Peak pressure p0 (Pa), eq (7).
+    pub p0: f32,
+}

@@ -1,0 +1,329 @@
+//! `cargo xtask tables`: the f32 core's tables, fitted to the project's own f64
+//! reference and written as Rust source (`src/tables.rs`).
+//!
+//! Every table here is an "octave table": the input x > 0 is split by its f32 bits into
+//! segments (2^M per octave of x), and on each segment the function is one polynomial of
+//! degree D in the segment's local variable t in [0, 1), the x bits below the segment
+//! index. The firmware finds the segment with a shift and evaluates by Horner: no
+//! logarithm, no search.
+
+use crate::fit::{chebyshev_fit, horner_f32};
+use misalign::reference::{normal, tangential};
+use std::f64::consts::FRAC_PI_2;
+use std::fmt::Write;
+
+/// One octave table to generate.
+#[derive(Clone, Copy)]
+pub struct OctaveSpec {
+    /// Name of the `pub static` in the generated source.
+    pub name: &'static str,
+    /// What it holds, for the doc comment.
+    pub doc: &'static str,
+    /// Unbiased f32 exponent of the first octave: x from 2^first.
+    pub first_exponent: i32,
+    /// Number of octaves: x below 2^(first + octaves).
+    pub octaves: i32,
+    /// log2 of the segments per octave (M).
+    pub segments_log2: u32,
+    /// Polynomial degree D.
+    pub degree: usize,
+    /// x above this is outside the domain (fit only up to it).
+    pub domain_max: f64,
+    /// The function, in f64.
+    pub f: fn(f64) -> f64,
+}
+
+/// g(theta) = m n theta (eqs 5, 6, 16): alone it gives the slip ratio.
+pub fn g_of_theta(theta: f64) -> f64 {
+    normal::ellipse_shape(theta)
+        .expect("theta in the domain")
+        .g()
+}
+/// 1/m(theta) (eqs 5, 6), a = m L: like g a positive power of theta (2/3), which a
+/// polynomial per octave fits 20 times better than m's negative power.
+pub fn inv_m_of_theta(theta: f64) -> f64 {
+    1.0 / normal::ellipse_shape(theta).expect("theta in the domain").m
+}
+/// theta(g), the inverse of g: gives the critical angle.
+pub fn theta_of_g(g: f64) -> f64 {
+    normal::theta_for_g(g).expect("g in the domain").theta
+}
+
+/// The tables the library ships, with the shape chosen by `cargo xtask tables --explore`.
+pub fn specs() -> [OctaveSpec; 3] {
+    [
+        OctaveSpec {
+            name: "G_OF_THETA",
+            doc: "g(theta) = m n theta (eqs 5, 6), theta from 2^-40 to pi/2.",
+            first_exponent: -40,
+            octaves: 41,
+            segments_log2: 0,
+            degree: 6,
+            domain_max: FRAC_PI_2,
+            f: g_of_theta,
+        },
+        OctaveSpec {
+            name: "INV_M_OF_THETA",
+            doc: "1/m(theta) (eqs 5, 6), theta from 2^-40 to pi/2; n = g / (m theta).",
+            first_exponent: -40,
+            octaves: 41,
+            segments_log2: 0,
+            degree: 6,
+            domain_max: FRAC_PI_2,
+            f: inv_m_of_theta,
+        },
+        OctaveSpec {
+            name: "THETA_OF_G",
+            doc: "theta(g), the inverse of g(theta), g from 2^-27 to pi/2.",
+            first_exponent: -27,
+            octaves: 28,
+            segments_log2: 0,
+            degree: 6,
+            domain_max: FRAC_PI_2,
+            f: theta_of_g,
+        },
+    ]
+}
+
+/// x at local coordinate t of segment `seg` (counted from the table's first segment).
+pub fn x_of(spec: &OctaveSpec, seg: usize, t: f64) -> f64 {
+    let per = 1usize << spec.segments_log2;
+    let e = spec.first_exponent + (seg / per) as i32;
+    let j = (seg % per) as f64;
+    2f64.powi(e) * (1.0 + (j + t) / per as f64)
+}
+
+/// Number of segments.
+pub fn segments(spec: &OctaveSpec) -> usize {
+    (spec.octaves as usize) << spec.segments_log2
+}
+
+/// The fitted f32 coefficients, segment by segment.
+pub fn fit(spec: &OctaveSpec) -> Vec<Vec<f32>> {
+    (0..segments(spec))
+        .map(|seg| {
+            let (x0, x1) = (x_of(spec, seg, 0.0), x_of(spec, seg, 1.0));
+            let span = if x1 > spec.domain_max {
+                (spec.domain_max - x0) / (x1 - x0)
+            } else {
+                1.0
+            };
+            // Local variable u = t - 1/2 in [-1/2, 1/2): smaller powers, less rounding.
+            chebyshev_fit(
+                |u| (spec.f)(x_of(spec, seg, u + 0.5)),
+                -0.5,
+                span - 0.5,
+                spec.degree,
+            )
+            .iter()
+            .map(|&c| c as f32)
+            .collect()
+        })
+        .collect()
+}
+
+/// Evaluates a fitted table at f32 x exactly as the library does; `None` outside.
+pub fn eval(spec: &OctaveSpec, coeffs: &[Vec<f32>], x: f32) -> Option<f32> {
+    let shift = 23 - spec.segments_log2;
+    let base = ((spec.first_exponent + 127) as u32) << spec.segments_log2;
+    let index = (x.to_bits() >> shift).checked_sub(base)? as usize;
+    let t = (x.to_bits() & ((1 << shift) - 1)) as f32 * (1.0 / (1u32 << shift) as f32);
+    coeffs.get(index).map(|c| horner_f32(c, t - 0.5))
+}
+
+/// Worst relative error of the f32 table against the f64 function over `samples`
+/// f32 points per segment, and where.
+pub fn measure(spec: &OctaveSpec, coeffs: &[Vec<f32>], samples: usize) -> (f64, f64) {
+    let mut worst = (0.0, 0.0);
+    for seg in 0..segments(spec) {
+        for k in 0..samples {
+            let x = x_of(spec, seg, (k as f64 + 0.5) / samples as f64) as f32;
+            if x as f64 > spec.domain_max {
+                continue;
+            }
+            let got = eval(spec, coeffs, x).expect("inside the table") as f64;
+            let want = (spec.f)(x as f64);
+            let e = (got / want - 1.0).abs();
+            if e > worst.0 {
+                worst = (e, x as f64);
+            }
+        }
+    }
+    worst
+}
+
+/// Degrees of the two pieces of the axial-force kernel (chosen by `--explore`).
+pub const AXIAL_FORCE_DEGREES: (usize, usize) = (6, 5);
+
+/// `F/(mu P) / s` as a polynomial in s on [0, 1/2] (eq 21 is analytic there), and
+/// `(1 - F/(mu P)) / u^5` as a polynomial in `u = sqrt(1 - s)` on [0, sqrt(1/2)]
+/// (eq 21's `(1 - s)^(5/2)` branch point factored out; what is left is analytic).
+pub fn fit_axial_force(low: usize, high: usize) -> (Vec<f32>, Vec<f32>) {
+    let ratio = |s: f64| {
+        if s == 0.0 {
+            0.75 * std::f64::consts::PI
+        } else {
+            tangential::axial_force_ratio(s) / s
+        }
+    };
+    let lo = chebyshev_fit(ratio, 0.0, 0.5, low);
+    let tail = |u: f64| {
+        if u == 0.0 {
+            0.8 * std::f64::consts::SQRT_2 // the limit (4 sqrt 2 / 5)
+        } else {
+            (1.0 - tangential::axial_force_ratio((1.0 - u) * (1.0 + u))) / u.powi(5)
+        }
+    };
+    let hi = chebyshev_fit(tail, 0.0, 0.5f64.sqrt(), high);
+    let f32s = |v: Vec<f64>| v.iter().map(|&c| c as f32).collect();
+    (f32s(lo), f32s(hi))
+}
+
+fn write_coeffs(out: &mut String, coeffs: &[Vec<f32>]) {
+    for c in coeffs {
+        out.push_str("    [");
+        for (i, x) in c.iter().enumerate() {
+            if i > 0 {
+                out.push_str(", ");
+            }
+            // {:?} prints the shortest text that reads back to the same f32.
+            write!(out, "{x:?}").unwrap();
+        }
+        out.push_str("],\n");
+    }
+}
+
+/// The whole generated source file.
+pub fn source() -> String {
+    let mut out = String::new();
+    out.push_str(
+        "//! Tables of the f32 core, generated from the f64 reference by `cargo xtask tables`.\n\
+         //! Do not edit: a test regenerates this file and fails on any drift.\n\n\
+         use crate::kernels::octave::OctaveTable;\n\n",
+    );
+    for spec in specs() {
+        assert_eq!(
+            spec.segments_log2, 0,
+            "the library reads one segment per octave"
+        );
+        let coeffs = fit(&spec);
+        let (n, d) = (coeffs.len(), spec.degree + 1);
+        let (worst, _) = measure(&spec, &coeffs, 64);
+        writeln!(
+            out,
+            "/// Coefficients of [`{}`], one row per octave.",
+            spec.name
+        )
+        .unwrap();
+        writeln!(out, "pub const {}_ROWS: [[f32; {d}]; {n}] = [", spec.name).unwrap();
+        write_coeffs(&mut out, &coeffs);
+        out.push_str("];\n\n");
+        writeln!(out, "/// {}", spec.doc).unwrap();
+        writeln!(
+            out,
+            "/// Degree {} per octave from 2^{}; worst relative error {worst:.1e} at the generator's check.",
+            spec.degree, spec.first_exponent
+        )
+        .unwrap();
+        writeln!(
+            out,
+            "pub const {}: OctaveTable<'static, {d}> = OctaveTable {{",
+            spec.name
+        )
+        .unwrap();
+        writeln!(out, "    first_exponent: {},", spec.first_exponent).unwrap();
+        writeln!(out, "    coeffs: &{}_ROWS,", spec.name).unwrap();
+        out.push_str("};\n\n");
+    }
+    let (lo, hi) = fit_axial_force(AXIAL_FORCE_DEGREES.0, AXIAL_FORCE_DEGREES.1);
+    let pieces = [
+        (
+            "AXIAL_FORCE_LOW",
+            "`F/(mu P) / s` in s for s < 1/2 (eq 21), lowest power first.",
+            lo,
+        ),
+        (
+            "AXIAL_FORCE_HIGH",
+            "`(1 - F/(mu P)) / u^5` in `u = sqrt(1 - s)` for s >= 1/2 (eq 21), lowest power first.",
+            hi,
+        ),
+    ];
+    for (name, doc, c) in pieces {
+        writeln!(out, "/// {doc}").unwrap();
+        writeln!(out, "pub static {name}: [f32; {}] = [", c.len()).unwrap();
+        for x in &c {
+            writeln!(out, "    {x:?},").unwrap();
+        }
+        out.push_str("];\n\n");
+    }
+    out.pop();
+    out
+}
+
+/// `--explore`: worst error and size of each table shape considered.
+pub fn explore() {
+    println!("table,segments_per_octave,degree,bytes,max_rel_error,at");
+    for spec in specs() {
+        for m in 0..=1 {
+            for d in 3..=7 {
+                let s = OctaveSpec {
+                    segments_log2: m,
+                    degree: d,
+                    ..spec
+                };
+                let c = fit(&s);
+                let (e, at) = measure(&s, &c, 400);
+                let bytes = c.len() * (d + 1) * 4;
+                println!("{},{},{},{},{:.3e},{:.3e}", s.name, 1 << m, d, bytes, e, at);
+            }
+        }
+    }
+}
+
+/// `--explore-octaves`: worst error per octave for one shape.
+pub fn explore_octaves(m: u32, d: usize) {
+    for spec in specs() {
+        let s = OctaveSpec {
+            segments_log2: m,
+            degree: d,
+            ..spec
+        };
+        let c = fit(&s);
+        print!("{}:", s.name);
+        for o in 0..s.octaves {
+            let sub = OctaveSpec {
+                first_exponent: s.first_exponent + o,
+                octaves: 1,
+                ..s
+            };
+            let per = 1usize << m;
+            let cc = &c[o as usize * per..(o as usize + 1) * per];
+            let (e, _) = measure(&sub, cc, 200);
+            print!(" {}:{:.1e}", s.first_exponent + o, e);
+        }
+        println!();
+    }
+}
+
+/// `--explore-force`: worst error of the axial-force kernel's pieces by degree,
+/// evaluated in f32 as the library does (u from the exact f64 square root).
+pub fn explore_force() {
+    let f = |s: f64| tangential::axial_force_ratio(s);
+    for d in 3..=9 {
+        let (lo, hi) = fit_axial_force(d, d);
+        let (mut e_lo, mut e_hi) = (0.0f64, 0.0f64);
+        for k in 1..200_000 {
+            let s = (k as f64 / 200_000.0) as f32;
+            if s < 0.5 {
+                let got = s * horner_f32(&lo, s);
+                e_lo = e_lo.max((got as f64 / f(s as f64) - 1.0).abs());
+            } else {
+                let v = 1.0 - s;
+                let u = (v as f64).sqrt() as f32;
+                let got = 1.0 - v * v * u * horner_f32(&hi, u);
+                e_hi = e_hi.max((got as f64 / f(s as f64) - 1.0).abs());
+            }
+        }
+        println!("degree {d}: low {e_lo:.2e} high {e_hi:.2e}");
+    }
+}
