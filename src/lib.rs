@@ -28,6 +28,7 @@
 extern crate std;
 
 mod error;
+pub mod fixed;
 pub mod float;
 pub mod kernels;
 pub mod reference;

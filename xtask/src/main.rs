@@ -1,6 +1,7 @@
 //! Chores for people and CI alike: `cargo xtask <task>`.
 
 mod fit;
+mod fixed_tables;
 mod tables;
 
 use std::path::PathBuf;
@@ -10,9 +11,10 @@ const USAGE: &str = "\
 usage: cargo xtask <task>
 
 tasks:
-    tables [--check] [--explore]   generate src/tables.rs from the f64 reference
-                                   (--check: fail if the committed file differs;
-                                   --explore: print error and size of table shapes)
+    tables [--check]               generate src/tables.rs from the f64 reference
+                                   (--check: fail if the committed file differs)
+    tables --explore | --explore-force | --explore-fixed | --derivatives
+                                   error and size of the table shapes considered
 ";
 
 fn root() -> PathBuf {
@@ -29,6 +31,14 @@ fn main() -> ExitCode {
         }
         Some("tables") if flag("--explore-force") => {
             tables::explore_force();
+            ExitCode::SUCCESS
+        }
+        Some("tables") if flag("--derivatives") => {
+            fixed_tables::derivatives();
+            ExitCode::SUCCESS
+        }
+        Some("tables") if flag("--explore-fixed") => {
+            fixed_tables::explore();
             ExitCode::SUCCESS
         }
         Some("tables") if flag("--explore") => {

@@ -199,6 +199,7 @@ pub fn source() -> String {
     out.push_str(
         "//! Tables of the f32 core, generated from the f64 reference by `cargo xtask tables`.\n\
          //! Do not edit: a test regenerates this file and fails on any drift.\n\n\
+         use crate::fixed::uniform::UniformTable;\n\
          use crate::kernels::octave::OctaveTable;\n\n",
     );
     for spec in specs() {
@@ -256,6 +257,7 @@ pub fn source() -> String {
         }
         out.push_str("];\n\n");
     }
+    crate::fixed_tables::source(&mut out);
     out.pop();
     out
 }

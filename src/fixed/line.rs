@@ -1,0 +1,129 @@
+//! Line contact (paper section 8) in fixed point: no table beyond log2 and exp2.
+
+use super::elliptic::zero_load;
+use super::logexp::{exp2_fixed, log2_u32};
+use super::{FixedEstimate, InputRange, Log2, constant, margin_counts};
+use crate::float::DEFAULT_RISK_SLIP_RATIO;
+use crate::reference::Regime;
+use crate::{Error, Scene};
+use core::f64::consts::{FRAC_PI_2, PI};
+
+/// A prepared line-contact scene for the fixed-point core. Loads are per unit length
+/// (N/m) without a scene length, total (N) with one, as for [`crate::float::LineScene`].
+#[derive(Debug, Clone, Copy)]
+pub struct FixedLineScene {
+    /// log2 of `sqrt(pi (1 - nu) G R l) / (2 mu)` x angle LSB / sqrt(load LSB) (eq 23).
+    log_slip: i32,
+    /// log2 of `2 mu / sqrt(pi G (1 - nu) R l)` x sqrt(load LSB) (eq 28).
+    log_critical: i32,
+    /// log2(angle LSB).
+    log_angle_lsb: i32,
+    /// log2(mu x load LSB).
+    log_force: i32,
+    /// log2 of the d/b risk threshold.
+    log_risk: i32,
+    range: InputRange,
+}
+
+impl FixedLineScene {
+    /// Prepares `scene` for load counts of `load_lsb` (N/m, or N with a length) and angle
+    /// counts of `angle_lsb` rad.
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] for LSBs that are not positive and finite or constants
+    /// beyond the Q8.24 range.
+    pub fn new(scene: &Scene, load_lsb: f64, angle_lsb: f64) -> Result<Self, Error> {
+        if !(load_lsb.is_finite() && load_lsb > 0.0 && angle_lsb.is_finite() && angle_lsb > 0.0) {
+            return Err(Error::OutOfRange);
+        }
+        let mu = scene.friction();
+        let stiffness = PI
+            * (1.0 - scene.poisson_ratio())
+            * scene.shear_modulus()
+            * scene.effective_radius()
+            * scene.length().unwrap_or(1.0);
+        let root = libm::sqrt(stiffness);
+        let root_lsb = libm::sqrt(load_lsb);
+        Ok(FixedLineScene {
+            log_slip: constant(root / (2.0 * mu) * angle_lsb / root_lsb)?,
+            log_critical: constant(2.0 * mu / root * root_lsb)?,
+            log_angle_lsb: constant(angle_lsb)?,
+            log_force: constant(mu * load_lsb)?,
+            log_risk: constant(DEFAULT_RISK_SLIP_RATIO as f64)?,
+            range: InputRange {
+                load_min: 1,
+                angle_max: libm::fmin(libm::floor(FRAC_PI_2 / angle_lsb), 2_147_483_648.0) as u32,
+            },
+        })
+    }
+
+    /// The same scene with another d/b threshold (> 0) for the risk flag.
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] for a threshold that is not positive and finite.
+    pub fn with_risk_slip_ratio(mut self, slip_ratio: f64) -> Result<Self, Error> {
+        self.log_risk = constant(slip_ratio)?;
+        Ok(self)
+    }
+
+    /// The inputs this scene accepts.
+    pub fn input_range(&self) -> InputRange {
+        self.range
+    }
+
+    /// The estimate for `load` counts and `angle` counts (signed).
+    ///
+    /// # Errors
+    /// [`Error::Angle`] above the scene's angle range.
+    #[inline]
+    pub fn estimate(&self, load: u32, angle: i32) -> Result<FixedEstimate, Error> {
+        let a = angle.unsigned_abs();
+        if a > self.range.angle_max {
+            return Err(Error::Angle);
+        }
+        if load == 0 {
+            return Ok(zero_load(a, self.log_risk));
+        }
+        let half_lp = log2_u32(load) >> 1;
+        let log_phi0 = self.log_critical + half_lp; // eq (28)
+        let critical = Some(Log2(log_phi0));
+        let margin = Some(margin_counts(
+            log_phi0.saturating_sub(self.log_angle_lsb),
+            a,
+        ));
+        if a == 0 {
+            return Ok(FixedEstimate {
+                slip_ratio: Log2::ZERO,
+                regime: Regime::Partial,
+                axial_force: Log2::ZERO,
+                axial_force_negative: false,
+                critical_angle: critical,
+                margin,
+                microslip_risk: false,
+            });
+        }
+        let ls = self
+            .log_slip
+            .saturating_add(log2_u32(a))
+            .saturating_sub(half_lp); // eq (23)
+        // F / (mu P) = s (2 - s) below s = 1 (eq 27), 1 above (eq 29).
+        let (regime, log_ratio) = if ls < 0 {
+            let s = exp2_fixed(ls, 24); // Q0.24
+            (
+                Regime::Partial,
+                ls.saturating_add(log2_u32((2 << 24) - s) - (24 << 24)),
+            )
+        } else {
+            (Regime::Gross, 0)
+        };
+        Ok(FixedEstimate {
+            slip_ratio: Log2(ls),
+            regime,
+            axial_force: Log2(self.log_force.saturating_add(log2_u32(load) + log_ratio)),
+            axial_force_negative: angle < 0,
+            critical_angle: critical,
+            margin,
+            microslip_risk: ls >= self.log_risk,
+        })
+    }
+}

@@ -1,0 +1,119 @@
+//! Base-2 logarithm of an integer and exponential of a Q8.24 logarithm, for the
+//! fixed-point core's logarithmic number system: products, quotients and cube roots
+//! become additions, shifts and a division by 3.
+
+use super::uniform::ONE;
+use crate::tables::{EXP2_FRACTION, LOG2_MANTISSA};
+
+/// Maximum error of [`log2_u32`] in log2 units (the relative error of the number it
+/// stands for is 0.69 times this), over every u32: the table part is measured over
+/// all 2^24 fractions it can see, plus 8.6e-8 for the bits below them (test below).
+pub const LOG2_MAX_ERROR: f64 = 3.3e-7;
+
+/// Maximum relative error of [`exp2_fixed`] before the final truncation to an integer,
+/// over all 2^24 Q8.24 fractions (test below).
+pub const EXP2_MAX_REL_ERROR: f64 = 2.6e-7;
+
+/// `log2(x)` in Q8.24 for `x >= 1` (`x = 0` gives `i32::MIN`, standing for -inf).
+#[inline(always)]
+pub fn log2_u32(x: u32) -> i32 {
+    if x == 0 {
+        return i32::MIN;
+    }
+    let lz = x.leading_zeros();
+    // The bits below the leading one, as a Q0.32 fraction, then Q8.24.
+    let fraction = ((x << lz) << 1) >> 8;
+    // The table covers [0, 1): the default is never taken.
+    let mantissa = LOG2_MANTISSA.eval(fraction as i32).unwrap_or_default();
+    ((31 - lz as i32) << 24) + mantissa
+}
+
+/// `x / 3` for non-negative x, exactly, by shifts (a Cortex-M0 has no divider).
+#[inline(always)]
+pub fn div3(x: i32) -> i32 {
+    let x = x as u32;
+    // Hacker's Delight divu3: q ~ x * 0.010101...b, then one correction.
+    let mut q = (x >> 2) + (x >> 4);
+    q += q >> 4;
+    q += q >> 8;
+    q += q >> 16;
+    let r = x - q * 3;
+    (q + ((11 * r) >> 5)) as i32
+}
+
+/// `2^l` (l in Q8.24) as an unsigned fixed-point number with `frac_bits` fraction
+/// bits, truncated; saturates at `u32::MAX`, flushes to 0 below its resolution.
+#[inline(always)]
+pub fn exp2_fixed(l: i32, frac_bits: u32) -> u32 {
+    if l == i32::MIN {
+        return 0;
+    }
+    let k = l >> 24; // floor
+    let mantissa = match EXP2_FRACTION.eval(l & (ONE - 1)) {
+        Some(v) => v as u32, // 2^f in Q8.24, in [2^24, 2^25)
+        None => ONE as u32,  // unreachable: the table covers [0, 1)
+    };
+    let shift = k + frac_bits as i32 - 24;
+    if shift >= 7 {
+        u32::MAX
+    } else if shift >= 0 {
+        mantissa << shift
+    } else if shift > -26 {
+        mantissa >> -shift
+    } else {
+        0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log2_exhaustive_over_its_fractions_and_sampled_everywhere() {
+        // The table sees the 24 bits below the leading one: the octave [2^24, 2^25)
+        // holds every such fraction exactly. Larger x lose bits below those 24, which
+        // moves log2 by less than 2^-24 / ln 2 = 8.6e-8.
+        let err = |x: u32| (log2_u32(x) as f64 / ONE as f64 - (x as f64).log2()).abs();
+        let table = ((1u32 << 24)..(1u32 << 25)).map(err).fold(0.0, f64::max);
+        println!("log2_u32 worst table error {table:.3e}");
+        assert!(table + 8.6e-8 <= LOG2_MAX_ERROR, "{table:e}");
+        let sampled = (1u32..=u32::MAX)
+            .step_by(9973)
+            .chain([1, 2, 3, u32::MAX])
+            .map(err)
+            .fold(0.0, f64::max);
+        assert!(sampled <= LOG2_MAX_ERROR, "{sampled:e}");
+        assert_eq!(log2_u32(0), i32::MIN);
+        assert_eq!(log2_u32(1), 0);
+        assert_eq!(log2_u32(1 << 20), 20 << 24);
+    }
+
+    #[test]
+    fn div3_is_exact() {
+        for x in (0..i32::MAX)
+            .step_by(7919)
+            .chain([0, 1, 2, 3, 4, i32::MAX, i32::MAX - 1])
+        {
+            assert_eq!(div3(x), x / 3, "{x}");
+        }
+    }
+
+    #[test]
+    fn exp2_relative_error() {
+        let mut worst: f64 = 0.0;
+        for f in 0..ONE {
+            // 2^(5 + f) with 24 fraction bits keeps 29 significant bits.
+            let l = 5 * ONE + f;
+            let got = exp2_fixed(l, 24) as f64 / ONE as f64;
+            let want = (l as f64 / ONE as f64).exp2();
+            worst = worst.max((got / want - 1.0).abs());
+        }
+        println!("exp2_fixed worst relative error {worst:.3e}");
+        assert!(worst <= EXP2_MAX_REL_ERROR, "{worst:e}");
+        assert_eq!(exp2_fixed(40 * ONE, 0), u32::MAX);
+        assert_eq!(exp2_fixed(-40 * ONE, 0), 0);
+        assert_eq!(exp2_fixed(i32::MIN, 10), 0);
+        assert_eq!(exp2_fixed(3 * ONE, 0), 8);
+    }
+}
