@@ -34,8 +34,12 @@ fn parse(text: &str) -> Vec<Row> {
 }
 
 fn reproduce(file: &str, contact: &str, columns: &[&str]) {
+    reproduce_with("reference", file, contact, columns, 1e-12);
+}
+
+fn reproduce_with(model: &str, file: &str, contact: &str, columns: &[&str], bound: f64) {
     let input = std::fs::read(reference_dir().join(file)).unwrap();
-    let (code, out, err) = run(&["--model", "reference", "--contact", contact], &input);
+    let (code, out, err) = run(&["--model", model, "--contact", contact], &input);
     assert_eq!(code, 0, "{err}");
     let want = read_rows(file);
     let got = parse(&out);
@@ -43,12 +47,16 @@ fn reproduce(file: &str, contact: &str, columns: &[&str]) {
     let mut worst = Worst::default();
     for (i, (g, w)) in got.iter().zip(&want).enumerate() {
         assert_eq!(g["error"], "", "row {i}");
-        assert_eq!(g["regime"], w["regime"], "row {i}");
+        // Only the reference is exact at d/b = 1; the cores may differ within their
+        // error of it (issue 3: 1e-6 for f32; the same window for fixed).
+        if model == "reference" || (num(w, "s") - 1.0).abs() > 1e-6 {
+            assert_eq!(g["regime"], w["regime"], "row {i}");
+        }
         for c in columns {
             worst.add(c, i, num(g, c), num(w, c));
         }
     }
-    worst.assert_below(1e-12);
+    worst.assert_below(bound);
 }
 
 #[test]
@@ -70,6 +78,18 @@ fn reproduces_vectors_line() {
         "line",
         &["R", "b", "p0", "s", "F", "phi0", "Pstar", "P0star", "d"],
     );
+}
+
+/// The cores through the same tool: issue 3's targets (f32 2e-6, fixed 1e-4); the
+/// regime may differ from the reference only near d/b = 1, which the data avoid.
+#[test]
+fn cores_reproduce_the_reference_files() {
+    let elliptic = ["theta", "m", "n", "a", "b", "p0", "s", "F", "phi0"];
+    let line = ["s", "F", "phi0"];
+    reproduce_with("f32", "vectors_scene.csv", "elliptic", &elliptic, 2e-6);
+    reproduce_with("f32", "vectors_line.csv", "line", &line, 2e-6);
+    reproduce_with("fixed", "vectors_scene.csv", "elliptic", &elliptic, 1e-4);
+    reproduce_with("fixed", "vectors_line.csv", "line", &line, 1e-4);
 }
 
 #[test]

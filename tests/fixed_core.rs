@@ -7,7 +7,7 @@
 mod common;
 use common::{Row, Worst, num, read_rows};
 use misalign::Scene;
-use misalign::fixed::{FixedEllipticScene, FixedEstimate, FixedLineScene};
+use misalign::fixed::{FixedEllipticScene, FixedEstimate, FixedLineScene, exact_lsb};
 
 const BOUND: f64 = 1e-4;
 
@@ -22,15 +22,11 @@ fn scene(row: &Row) -> Scene {
     .unwrap()
 }
 
-/// An LSB with `x = counts x LSB` exactly for an integer count of at most 1234567891
-/// (no power of two, so that log2 of the counts is not exact), and the LSB at least
-/// `floor`; returns (LSB, counts).
+/// Counts and LSB that represent x exactly with up to 1234567891 counts (no power of
+/// two, so that log2 of the counts is not exact), the LSB at least `floor`.
 fn lsb(x: f64, floor: f64) -> (f64, f64) {
-    if x == 0.0 {
-        return (floor.max(1e-9), 0.0);
-    }
-    let counts = (x.abs() / floor).floor().clamp(1.0, 1_234_567_891.0);
-    (x.abs() / counts, counts.copysign(x))
+    let (lsb, counts) = exact_lsb(x, 1_234_567_891, floor);
+    (lsb, (counts as f64).copysign(x))
 }
 
 fn signed_force(e: &FixedEstimate) -> f64 {
@@ -44,8 +40,7 @@ fn elliptic_against_vectors_scene() {
     for (i, row) in read_rows("vectors_scene.csv").iter().enumerate() {
         let s = scene(row);
         let (p, phi) = (num(row, "P"), num(row, "phi"));
-        // The tables start at theta = 2^-40: one angle count must not be finer.
-        let (angle_lsb, angle) = lsb(phi, (-40f64).exp2() / s.radius_factor() * 1.0001);
+        let (angle_lsb, angle) = lsb(phi, FixedEllipticScene::min_angle_lsb(&s));
         let (load_lsb, load) = lsb(p, 0.0);
         let prepared = FixedEllipticScene::new(&s, load_lsb, angle_lsb).unwrap();
         let e = prepared.estimate(load as u32, angle as i32).unwrap();
@@ -59,6 +54,17 @@ fn elliptic_against_vectors_scene() {
         );
         if (num(row, "s") - 1.0).abs() > 1e-4 {
             assert_eq!(e.regime.as_str(), row["regime"], "row {i}");
+        }
+        let d = prepared.details(load as u32, angle as i32).unwrap();
+        for (name, got) in [
+            ("theta", d.theta),
+            ("m", d.m),
+            ("n", d.n),
+            ("a", d.a),
+            ("b", d.b),
+            ("p0", d.p0),
+        ] {
+            worst.add(name, i, got.to_f64(), num(row, name));
         }
     }
     worst.assert_below(BOUND);

@@ -1,6 +1,8 @@
 //! The estimator's logic, shared by `examples/estimate/main.rs` and the tests.
 
-use misalign::reference::{self, Validity};
+use misalign::fixed::{FixedEllipticScene, FixedLineScene, Log2, exact_lsb};
+use misalign::float::{EllipticScene, LineScene};
+use misalign::reference::{self, Regime, Validity};
 use misalign::{Error, Scene};
 use std::io::{Read, Write};
 
@@ -8,10 +10,14 @@ pub const HELP: &str = "\
 estimate: misalignment, microslip and axial force for each row of a CSV file
 
 USAGE:
-    cargo run --release --example estimate -- [--model reference] [--contact elliptic|line] < in.csv > out.csv
+    cargo run --release --example estimate -- [--model reference|f32|fixed] [--contact elliptic|line] < in.csv > out.csv
 
 OPTIONS:
     --model reference     the f64 reference of the whole paper (default)
+    --model f32           the f32 core that runs on a Cortex-M4F (tables, kernels)
+    --model fixed         the fixed-point core for a Cortex-M0/M3; each row's P and phi
+                          become integer counts of an LSB that holds them exactly
+                          (up to 2^30 counts; angles no finer than the tables allow)
     --contact elliptic    the contact ellipse, sections 5-7 (default); P in N
     --contact line        line contact, section 8; P in N/m, R2 = inf for a plane
     -h, --help            this text
@@ -25,6 +31,8 @@ OUTPUT (stdout): one row per input row, in order.
     elliptic: theta,m,n,a,b,p0,s,F,phi0,regime,error,kprime,Pstar,P0star,theta0,d,model,flags
     line:     R,b,p0,s,F,phi0,regime,error,Pstar,P0star,d,model,flags
     s is the slip ratio d/b; regime is partial (s < 1) or gross; F has the sign of phi.
+    The cores leave empty what they do not compute (Pstar, P0star, theta0, flags other
+    than no_critical_angle).
     Numbers are in shortest round-trip form. A row that cannot be computed has empty
     values and a message in `error`; the batch goes on. phi0 is empty when no
     theta <= pi/2 reaches s = 1 (flag no_critical_angle). flags lists, separated by
@@ -49,8 +57,25 @@ pub enum Contact {
     Line,
 }
 
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub enum Model {
+    Reference,
+    F32,
+    Fixed,
+}
+
 /// Shortest text that reads back to the same f64.
 pub fn number(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() || (1e-3..1e7).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// Shortest text that reads back to the same f32.
+pub fn number32(x: f32) -> String {
     let a = x.abs();
     if x == 0.0 || !x.is_finite() || (1e-3..1e7).contains(&a) {
         format!("{x}")
@@ -123,6 +148,160 @@ fn elliptic_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, Strin
     ])
 }
 
+fn no_critical(phi0: &str) -> String {
+    if phi0.is_empty() {
+        "no_critical_angle".into()
+    } else {
+        String::new()
+    }
+}
+
+fn f32_elliptic_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
+    let prepared = EllipticScene::new(scene).map_err(|e| e.to_string())?;
+    let (p, a) = (load as f32, phi as f32);
+    let e = prepared.estimate(p, a).map_err(|e| e.to_string())?;
+    let d = prepared.details(p, a).map_err(|e| e.to_string())?;
+    let phi0 = e.critical_angle.map(number32).unwrap_or_default();
+    let width = if e.slip_ratio < 1.0 {
+        e.slip_ratio * d.b
+    } else {
+        d.b
+    };
+    Ok(vec![
+        number32(d.theta),
+        number32(d.m),
+        number32(d.n),
+        number32(d.a),
+        number32(d.b),
+        number32(d.p0),
+        number32(e.slip_ratio),
+        number32(e.axial_force),
+        phi0.clone(),
+        e.regime.as_str().into(),
+        String::new(),
+        number32(d.n / d.m),
+        String::new(),
+        String::new(),
+        String::new(),
+        number32(width),
+        "elliptic".into(),
+        no_critical(&phi0),
+    ])
+}
+
+fn f32_line_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
+    let prepared = LineScene::new(scene).map_err(|e| e.to_string())?;
+    let e = prepared
+        .estimate(load as f32, phi as f32)
+        .map_err(|e| e.to_string())?;
+    Ok(vec![
+        number(scene.effective_radius()),
+        String::new(),
+        String::new(),
+        number32(e.slip_ratio),
+        number32(e.axial_force),
+        e.critical_angle.map(number32).unwrap_or_default(),
+        e.regime.as_str().into(),
+        String::new(),
+        String::new(),
+        String::new(),
+        String::new(),
+        "line".into(),
+        String::new(),
+    ])
+}
+
+/// Counts for the fixed-point core: 2^30 of an LSB that holds the value exactly.
+fn counts(x: f64, min_lsb: f64) -> (f64, u32) {
+    exact_lsb(x, 1 << 30, min_lsb)
+}
+
+fn signed(x: Log2, negative: bool) -> String {
+    number(if negative { -x.to_f64() } else { x.to_f64() })
+}
+
+fn fixed_elliptic_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
+    if !(load.is_finite() && load >= 0.0) {
+        return Err(Error::Load.to_string());
+    }
+    if !phi.is_finite() || scene.is_plane() {
+        return Err(if scene.is_plane() {
+            Error::PlaneHasNoEllipse
+        } else {
+            Error::Angle
+        }
+        .to_string());
+    }
+    let (load_lsb, p) = counts(load, 0.0);
+    let (angle_lsb, a) = counts(phi, FixedEllipticScene::min_angle_lsb(scene));
+    let angle = if phi < 0.0 { -(a as i64) } else { a as i64 };
+    let angle = i32::try_from(angle).map_err(|_| Error::Angle.to_string())?;
+    let prepared =
+        FixedEllipticScene::new(scene, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
+    let e = prepared.estimate(p, angle).map_err(|e| e.to_string())?;
+    let d = prepared.details(p, angle).map_err(|e| e.to_string())?;
+    let phi0 = e
+        .critical_angle
+        .map(|x| number(x.to_f64()))
+        .unwrap_or_default();
+    let width = if e.regime == Regime::Partial {
+        e.slip_ratio.to_f64() * d.b.to_f64()
+    } else {
+        d.b.to_f64()
+    };
+    Ok(vec![
+        number(d.theta.to_f64()),
+        number(d.m.to_f64()),
+        number(d.n.to_f64()),
+        number(d.a.to_f64()),
+        number(d.b.to_f64()),
+        number(d.p0.to_f64()),
+        number(e.slip_ratio.to_f64()),
+        signed(e.axial_force, e.axial_force_negative),
+        phi0.clone(),
+        e.regime.as_str().into(),
+        String::new(),
+        number(d.n.to_f64() / d.m.to_f64()),
+        String::new(),
+        String::new(),
+        String::new(),
+        number(width),
+        "elliptic".into(),
+        no_critical(&phi0),
+    ])
+}
+
+fn fixed_line_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
+    if !(load.is_finite() && load >= 0.0) {
+        return Err(Error::Load.to_string());
+    }
+    if !phi.is_finite() {
+        return Err(Error::Angle.to_string());
+    }
+    let (load_lsb, p) = counts(load, 0.0);
+    let (angle_lsb, a) = counts(phi, 0.0);
+    let angle = if phi < 0.0 { -(a as i32) } else { a as i32 };
+    let prepared = FixedLineScene::new(scene, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
+    let e = prepared.estimate(p, angle).map_err(|e| e.to_string())?;
+    Ok(vec![
+        number(scene.effective_radius()),
+        String::new(),
+        String::new(),
+        number(e.slip_ratio.to_f64()),
+        signed(e.axial_force, e.axial_force_negative),
+        e.critical_angle
+            .map(|x| number(x.to_f64()))
+            .unwrap_or_default(),
+        e.regime.as_str().into(),
+        String::new(),
+        String::new(),
+        String::new(),
+        String::new(),
+        "line".into(),
+        String::new(),
+    ])
+}
+
 fn line_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
     let l = reference::line(scene, load, phi).map_err(|e| e.to_string())?;
     Ok(vec![
@@ -146,6 +325,7 @@ fn line_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
 /// returns the process exit code.
 pub fn run(args: &[String], input: impl Read, output: impl Write, err: &mut dyn Write) -> i32 {
     let mut contact = Contact::Elliptic;
+    let mut model = Model::Reference;
     let mut i = 0;
     while i < args.len() {
         let value = args.get(i + 1).map(String::as_str);
@@ -155,7 +335,9 @@ pub fn run(args: &[String], input: impl Read, output: impl Write, err: &mut dyn 
                 let _ = output.write_all(HELP.as_bytes());
                 return 0;
             }
-            ("--model", Some("reference")) => i += 1,
+            ("--model", Some("reference")) => (model, i) = (Model::Reference, i + 1),
+            ("--model", Some("f32")) => (model, i) = (Model::F32, i + 1),
+            ("--model", Some("fixed")) => (model, i) = (Model::Fixed, i + 1),
             ("--contact", Some("elliptic")) => (contact, i) = (Contact::Elliptic, i + 1),
             ("--contact", Some("line")) => (contact, i) = (Contact::Line, i + 1),
             (other, v) => {
@@ -219,9 +401,13 @@ pub fn run(args: &[String], input: impl Read, output: impl Write, err: &mut dyn 
         };
         let values = columns.map(|c| record.get(c));
         let result = scene_and_sample(&values, length_column.and_then(|c| record.get(c))).and_then(
-            |(scene, load, phi)| match contact {
-                Contact::Elliptic => elliptic_row(&scene, load, phi),
-                Contact::Line => line_row(&scene, load, phi),
+            |(scene, load, phi)| match (model, contact) {
+                (Model::Reference, Contact::Elliptic) => elliptic_row(&scene, load, phi),
+                (Model::Reference, Contact::Line) => line_row(&scene, load, phi),
+                (Model::F32, Contact::Elliptic) => f32_elliptic_row(&scene, load, phi),
+                (Model::F32, Contact::Line) => f32_line_row(&scene, load, phi),
+                (Model::Fixed, Contact::Elliptic) => fixed_elliptic_row(&scene, load, phi),
+                (Model::Fixed, Contact::Line) => fixed_line_row(&scene, load, phi),
             },
         );
         let fields = result.unwrap_or_else(|message| {

@@ -5,7 +5,9 @@ use super::uniform::{ONE, UniformTable};
 use super::{FixedEstimate, InputRange, LOG2_HALF_PI, Log2, constant, margin_counts};
 use crate::float::DEFAULT_RISK_SLIP_RATIO;
 use crate::reference::{Regime, hertz_volume};
-use crate::tables::{LOG_FORCE_OVER_S, LOG_G_HIGH, LOG_G_LOW, LOG_THETA_HIGH, LOG_THETA_LOW};
+use crate::tables::{
+    LOG_FORCE_OVER_S, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW, LOG_THETA_HIGH, LOG_THETA_LOW,
+};
 use crate::{Error, Scene, ThetaRelation};
 use core::f64::consts::{FRAC_PI_2, PI};
 
@@ -24,6 +26,10 @@ pub struct FixedEllipticScene {
     log_force: i32,
     /// log2 of the d/b risk threshold.
     log_risk: i32,
+    /// log2(V^(1/3) x load LSB^(1/3)): log2 L = this + log2(counts)/3 (eqs 2, 3).
+    log_hertz: i32,
+    /// log2(3 x load LSB / (2 pi)): log2 p0 = this + log2(counts) - log2 a - log2 b (eq 7).
+    log_pressure: i32,
     range: InputRange,
 }
 
@@ -68,6 +74,8 @@ impl FixedEllipticScene {
             log_radius_factor: constant(c)?,
             log_force: constant(scene.friction() * load_lsb)?,
             log_risk: constant(DEFAULT_RISK_SLIP_RATIO as f64)?,
+            log_hertz: constant(v * cbrt_lsb)?,
+            log_pressure: constant(3.0 * load_lsb / (2.0 * PI))?,
             range: InputRange {
                 load_min: if load_min > u32::MAX as f64 {
                     u32::MAX
@@ -78,6 +86,12 @@ impl FixedEllipticScene {
                     as u32,
             },
         })
+    }
+
+    /// The finest angle LSB (rad) this scene accepts: one count must give theta >= 2^-40,
+    /// where the tables start.
+    pub fn min_angle_lsb(scene: &Scene) -> f64 {
+        libm::exp2(LOG_G_LOW.start as f64 / ONE as f64) / scene.radius_factor() * (1.0 + 1e-12)
     }
 
     /// The same scene with another d/b threshold (> 0) for the risk flag.
@@ -158,6 +172,80 @@ impl FixedEllipticScene {
             microslip_risk: ls >= self.log_risk,
         })
     }
+}
+
+impl FixedEllipticScene {
+    /// The contact ellipse on request: theta, m, n (eqs 4-6), a, b (eqs 2-3), p0 (eq 7),
+    /// all as [`Log2`]. At zero angle m = a = infinity, n = b = p0 = 0; at zero load
+    /// a = b = p0 = 0.
+    ///
+    /// # Errors
+    /// As [`FixedEllipticScene::estimate`].
+    pub fn details(&self, load: u32, angle: i32) -> Result<FixedDetails, Error> {
+        let a = angle.unsigned_abs();
+        if a > self.range.angle_max {
+            return Err(Error::Angle);
+        }
+        if load != 0 && load < self.range.load_min {
+            return Err(Error::OutOfRange);
+        }
+        if a == 0 {
+            let (inf, zero) = (Log2::INFINITY, Log2::ZERO);
+            return Ok(FixedDetails {
+                theta: zero,
+                m: inf,
+                n: zero,
+                a: inf,
+                b: zero,
+                p0: zero,
+            });
+        }
+        let y = self.log_theta_lsb + log2_u32(a);
+        let log_g = lookup(LOG_G_LOW, LOG_G_HIGH, y)?;
+        let log_m = lookup(LOG_M_LOW, LOG_M_HIGH, y)?;
+        let log_n = log_g - log_m - y; // n = g / (m theta)
+        let (log_a, log_b, log_p0) = if load == 0 {
+            (i32::MIN, i32::MIN, i32::MIN)
+        } else {
+            let lp = log2_u32(load);
+            let log_l = self.log_hertz + div3(lp);
+            let (la, lb) = (log_m + log_l, log_n + log_l);
+            (
+                la,
+                lb,
+                self.log_pressure
+                    .saturating_add(lp)
+                    .saturating_sub(la)
+                    .saturating_sub(lb),
+            )
+        };
+        Ok(FixedDetails {
+            theta: Log2(y),
+            m: Log2(log_m),
+            n: Log2(log_n),
+            a: Log2(log_a),
+            b: Log2(log_b),
+            p0: Log2(log_p0),
+        })
+    }
+}
+
+/// The contact ellipse of one sample in the fixed-point core, as base-2 logarithms:
+/// theta (rad), m, n, a and b (m), p0 (Pa).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FixedDetails {
+    /// Auxiliary angle theta (rad), eq (4).
+    pub theta: Log2,
+    /// m (eqs 5-6).
+    pub m: Log2,
+    /// n (eqs 5-6).
+    pub n: Log2,
+    /// Semi-axis along the rollers a (m).
+    pub a: Log2,
+    /// Semi-axis in the rolling direction b (m).
+    pub b: Log2,
+    /// Peak pressure p0 (Pa).
+    pub p0: Log2,
 }
 
 /// A log-log table in two pieces, coarse below the high piece's start.

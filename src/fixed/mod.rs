@@ -17,7 +17,7 @@ pub mod uniform;
 mod elliptic;
 mod line;
 
-pub use elliptic::FixedEllipticScene;
+pub use elliptic::{FixedDetails, FixedEllipticScene};
 pub use line::FixedLineScene;
 
 use crate::Error;
@@ -99,6 +99,19 @@ pub struct FixedEstimate {
     pub margin: Option<i32>,
     /// d/b at or above the scene's risk threshold.
     pub microslip_risk: bool,
+}
+
+/// An LSB for which `x = counts x LSB` holds exactly (to f64 rounding) with an integer
+/// `counts <= max_counts`, and `LSB >= min_lsb`: for hosts that feed recorded values to
+/// the fixed-point core (the CSV estimator, tests). Returns `(LSB, counts)`; x = 0 gives
+/// counts 0 and the LSB `max(min_lsb, 1e-9)`.
+pub fn exact_lsb(x: f64, max_counts: u32, min_lsb: f64) -> (f64, u32) {
+    let x = libm::fabs(x);
+    if x == 0.0 || !x.is_finite() {
+        return (libm::fmax(min_lsb, 1e-9), 0);
+    }
+    let counts = libm::fmin(libm::fmax(libm::floor(x / min_lsb), 1.0), max_counts as f64);
+    (x / counts, counts as u32)
 }
 
 /// log2(pi/2) in Q8.24: g and theta above it have no table (eq 18 has no solution).

@@ -42,6 +42,10 @@ fn g_of_log_theta(y: f64) -> f64 {
     shape_at_theta(y.exp2()).g().log2()
 }
 
+fn m_of_log_theta(y: f64) -> f64 {
+    shape_at_theta(y.exp2()).m.log2()
+}
+
 fn log_theta_of_log_g(z: f64) -> f64 {
     let g = z.exp2();
     if g <= FRAC_PI_2 {
@@ -76,7 +80,7 @@ pub const SPLIT_G: f64 = -4.0;
 pub const SPLIT_THETA: f64 = -6.0;
 
 /// Spacing exponents, chosen by `cargo xtask tables --explore-fixed`.
-pub fn specs() -> [UniformSpec; 7] {
+pub fn specs() -> [UniformSpec; 9] {
     let top = FRAC_PI_2.log2();
     [
         UniformSpec {
@@ -126,6 +130,22 @@ pub fn specs() -> [UniformSpec; 7] {
             end: top,
             spacing_log2: 5,
             f: log_theta_of_log_g,
+        },
+        UniformSpec {
+            name: "LOG_M_LOW",
+            doc: "log2 m(theta) against y = log2 theta, y from -40 to -4 (eqs 5, 6): details only.",
+            start: -40.0,
+            end: SPLIT_G,
+            spacing_log2: 2,
+            f: m_of_log_theta,
+        },
+        UniformSpec {
+            name: "LOG_M_HIGH",
+            doc: "log2 m(theta) against y = log2 theta, y from -4 to log2(pi/2) (eqs 5, 6): details only.",
+            start: SPLIT_G,
+            end: top,
+            spacing_log2: 5,
+            f: m_of_log_theta,
         },
         UniformSpec {
             name: "LOG_FORCE_OVER_S",
