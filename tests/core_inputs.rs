@@ -99,7 +99,16 @@ fn f32_extreme_but_valid_input_gives_no_nan() {
     let e = EllipticScene::new(&scene()).unwrap();
     let l = LineScene::new(&scene()).unwrap();
     let loads = [1e-45, f32::MIN_POSITIVE, 1e-3, 1.0, 1e8, f32::MAX];
-    let angles = [1e-45, 1e-30, 1e-12, 1e-6, 0.01, 1.0, 1.5707963, -1e-6];
+    let angles = [
+        1e-45,
+        1e-30,
+        1e-12,
+        1e-6,
+        0.01,
+        1.0,
+        core::f32::consts::FRAC_PI_2,
+        -1e-6,
+    ];
     for &p in &loads {
         for &phi in &angles {
             for est in [e.estimate(p, phi).unwrap(), l.estimate(p, phi).unwrap()] {
