@@ -37,4 +37,9 @@ pub mod scene;
 pub mod tables;
 
 pub use error::Error;
+
+/// The README's examples run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
 pub use scene::{Scene, ThetaRelation};
