@@ -119,24 +119,28 @@ impl Scene {
         self.r2.is_infinite()
     }
 
-    /// Effective radius `R = R1 R2 / (R1 + R2)` (eq 31); R1 for a plane.
+    /// Effective radius `R = R1 R2 / (R1 + R2)` (eq 31); R1 for a plane. Formed as
+    /// `small / (1 + small/large)`, which neither overflows nor underflows.
     pub fn effective_radius(&self) -> f64 {
-        if self.is_plane() {
-            self.r1
+        let (small, large) = if self.r1 <= self.r2 {
+            (self.r1, self.r2)
         } else {
-            self.r1 * self.r2 / (self.r1 + self.r2)
-        }
+            (self.r2, self.r1)
+        };
+        small / (1.0 + small / large)
     }
 
     /// `c = 2 sqrt(R1 R2) / (R1 + R2)` of eq (4), so that `theta = c phi`; 0 for a plane.
+    /// Formed as `2 q / (1 + q^2)`, `q = sqrt(R_small / R_large) <= 1`, which stays
+    /// finite and exact to a few ulps for any pair of radii.
     pub fn radius_factor(&self) -> f64 {
-        if self.is_plane() {
-            0.0
+        let (small, large) = if self.r1 <= self.r2 {
+            (self.r1, self.r2)
         } else {
-            // 2 sqrt(R1 R2)/(R1+R2) = 2 sqrt(r)/(1+r), r = R2/R1, without overflow.
-            let r = self.r2 / self.r1;
-            2.0 * libm::sqrt(r) / (1.0 + r)
-        }
+            (self.r2, self.r1)
+        };
+        let q = libm::sqrt(small / large);
+        2.0 * q / (1.0 + q * q)
     }
 
     /// The auxiliary angle theta (rad) for a misalignment `phi` (rad), by the scene's

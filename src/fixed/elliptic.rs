@@ -4,7 +4,7 @@ use super::logexp::{div3, exp2_fixed, log2_u32};
 use super::uniform::{ONE, UniformTable};
 use super::{FixedEstimate, InputRange, LOG2_HALF_PI, Log2, constant, margin_counts};
 use crate::float::DEFAULT_RISK_SLIP_RATIO;
-use crate::reference::{Regime, hertz_volume};
+use crate::reference::{Regime, hertz_scale};
 use crate::tables::{
     LOG_FORCE_OVER_S, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW, LOG_THETA_HIGH, LOG_THETA_LOW,
 };
@@ -52,7 +52,7 @@ impl FixedEllipticScene {
             return Err(Error::OutOfRange);
         }
         let c = scene.radius_factor();
-        let v = libm::cbrt(hertz_volume(scene));
+        let v = hertz_scale(scene);
         let slip_gain = PI * scene.shear_modulus() * v * v / (3.0 * scene.friction() * c);
         let cbrt_lsb = libm::cbrt(load_lsb);
         let log_theta_lsb = constant(c * angle_lsb)?;

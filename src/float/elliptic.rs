@@ -5,7 +5,7 @@ use crate::kernels::axial_force::axial_force_ratio;
 use crate::kernels::cbrt::{cbrt, inv_cbrt};
 use crate::kernels::octave::OctaveTable;
 use crate::kernels::small_theta;
-use crate::reference::hertz_volume;
+use crate::reference::hertz_scale;
 use crate::{Error, Scene, ThetaRelation, tables};
 use core::f32::consts::{FRAC_PI_2, PI};
 
@@ -79,7 +79,7 @@ impl<'t> EllipticScene<'t> {
             return Err(Error::Unsupported);
         }
         let c = scene.radius_factor();
-        let v = libm::cbrt(hertz_volume(scene));
+        let v = hertz_scale(scene);
         let slip_gain =
             core::f64::consts::PI * scene.shear_modulus() * v * v / (3.0 * scene.friction() * c);
         let constants = [c, 1.0 / c, slip_gain, 1.0 / slip_gain, scene.friction(), v];

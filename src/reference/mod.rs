@@ -200,6 +200,13 @@ pub fn hertz_volume(scene: &Scene) -> f64 {
     3.0 * (1.0 - scene.poisson_ratio()) * scene.effective_radius() / (2.0 * scene.shear_modulus())
 }
 
+/// The Hertz scale `v = (L^3/P)^(1/3)`, so that `L = v P^(1/3)` (eqs 2-3 with the
+/// erratum), formed factor by factor so that no extreme but valid scene underflows.
+pub fn hertz_scale(scene: &Scene) -> f64 {
+    libm::cbrt(1.5 * (1.0 - scene.poisson_ratio()) / scene.shear_modulus())
+        * libm::cbrt(scene.effective_radius())
+}
+
 /// The phi (rad, >= 0) that gives auxiliary angle `theta` under the scene's relation.
 fn phi_of_theta(scene: &Scene, theta: f64) -> f64 {
     let c = scene.radius_factor();
@@ -216,12 +223,18 @@ pub fn critical_angle(scene: &Scene, load: f64) -> Option<(f64, f64)> {
     if load == 0.0 {
         return Some((0.0, 0.0));
     }
-    let v = libm::cbrt(hertz_volume(scene));
-    // d/b = 1  <=>  m n |phi| = 3 mu P^(1/3) / (pi G V^(2/3)).
+    let v = hertz_scale(scene);
+    // d/b = 1  <=>  m n |phi| = 3 mu P^(1/3) / (pi G v^2).
     let target = 3.0 * scene.friction() * libm::cbrt(load) / (PI * scene.shear_modulus() * v * v);
+    let c = scene.radius_factor();
+    if c * target < normal::small_theta_g_limit() {
+        // theta0 < 1e-100: the asymptotics, where sin phi = phi exactly (both relations).
+        let theta0 = normal::small_theta_for_g(c * target);
+        return Some((theta0 / c, theta0));
+    }
     let theta_max = match scene.theta_relation() {
         ThetaRelation::SmallAngle => FRAC_PI_2,
-        ThetaRelation::Exact => libm::asin(scene.radius_factor()),
+        ThetaRelation::Exact => libm::asin(c),
     };
     let kprime_max = normal::ellipse_shape(theta_max)?.kprime;
     let guess = normal::theta_for_g(libm::fmin(target * scene.radius_factor(), FRAC_PI_2))
@@ -258,20 +271,21 @@ pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
         scene.poisson_ratio(),
         scene.friction(),
     );
-    let vol = hertz_volume(scene);
-    let (a, b) = normal::semi_axes(&shape, vol, load);
-    let p0 = normal::peak_pressure(&shape, vol, load);
+    let v = hertz_scale(scene);
+    let (a, b) = normal::semi_axes(&shape, v, load);
+    let p0 = normal::peak_pressure(&shape, v, load);
     let s = if load == 0.0 && phi != 0.0 {
         f64::INFINITY
     } else {
-        tangential::slip_ratio(g_mod, mu, shape.mn(), vol, load, phi)
+        tangential::slip_ratio(g_mod, mu, shape.mn(), v, load, phi)
     };
     let (r1, r2) = (scene.r1(), scene.r2());
     let pstar = tangential::nondimensional_load(load, nu, g_mod, r1, r2);
     let p0star = tangential::critical_nondimensional_load(shape.g(), mu);
     // P at which d/b = 1 for this phi: P0* scaled back by eq (17).
     let critical_load =
-        p0star * (1.0 - nu) * (1.0 - nu) * g_mod * (r1 + r2) * libm::sqrt(r1 * r2) / 2.0;
+        p0star * (1.0 - nu) * (1.0 - nu) * g_mod * (r1 + r2) * libm::sqrt(r1) * libm::sqrt(r2)
+            / 2.0;
     let axial_force = libm::copysign(mu * load * tangential::axial_force_ratio(s), phi);
     let critical = critical_angle(scene, load);
     let validity = Validity {

@@ -71,10 +71,12 @@ pub fn shape_from_kprime(kprime: f64) -> EllipseShape {
 }
 
 /// `Lam = ln(4/k') - 1` at small theta, the root of `Lam = ln(8 sqrt(Lam)/theta) - 1`.
+/// Written with `ln 8 - ln theta`, so that subnormal theta does not overflow `8/theta`.
 fn small_theta_lambda(theta: f64) -> f64 {
-    let mut lam = libm::log(8.0 / theta);
+    let ln8_over_theta = core::f64::consts::LN_2 * 3.0 - libm::log(theta);
+    let mut lam = ln8_over_theta;
     for _ in 0..64 {
-        let next = libm::log(8.0 * libm::sqrt(lam) / theta) - 1.0;
+        let next = ln8_over_theta + 0.5 * libm::log(lam) - 1.0;
         if libm::fabs(next - lam) <= 1e-16 * lam {
             return next;
         }
@@ -85,15 +87,42 @@ fn small_theta_lambda(theta: f64) -> f64 {
 
 /// Small-theta asymptotics of the reference README: `k' ~ theta/(2 sqrt Lam)`,
 /// `m ~ (8 Lam/(pi theta^2))^(1/3)`, `n ~ (theta/(pi sqrt Lam))^(1/3)`.
+/// Powers of theta are taken as powers of `cbrt(theta)`, so that theta down to the
+/// smallest subnormal gives finite m (about 1e216) and non-zero n.
 pub fn small_theta_shape(theta: f64) -> EllipseShape {
     let lam = small_theta_lambda(theta);
     let root_lam = libm::sqrt(lam);
+    let cbrt_theta = libm::cbrt(theta);
     EllipseShape {
         theta,
         kprime: theta / (2.0 * root_lam),
-        m: libm::cbrt(8.0 * lam / (PI * theta * theta)),
-        n: libm::cbrt(theta / (PI * root_lam)),
+        m: libm::cbrt(8.0 * lam / PI) / (cbrt_theta * cbrt_theta),
+        n: libm::cbrt(1.0 / (PI * root_lam)) * cbrt_theta,
     }
+}
+
+/// The theta with `g(theta) = g` by the small-theta asymptotics, for g below
+/// [`small_theta_g_limit`]: `theta = (g / ((8/pi^2)^(1/3) Lam^(1/6)))^(3/2)`, with Lam
+/// (which depends on theta only through its logarithm) by fixed-point iteration.
+pub fn small_theta_for_g(g: f64) -> f64 {
+    let scale = libm::cbrt(8.0 / (PI * PI));
+    let mut theta = libm::pow(g / scale, 1.5);
+    for _ in 0..64 {
+        let next = libm::pow(
+            g / (scale * libm::pow(small_theta_lambda(theta), 1.0 / 6.0)),
+            1.5,
+        );
+        if libm::fabs(next - theta) <= 1e-16 * theta {
+            return next;
+        }
+        theta = next;
+    }
+    theta
+}
+
+/// g at the theta below which the asymptotics replace the exact path (1e-100).
+pub fn small_theta_g_limit() -> f64 {
+    small_theta_shape(ASYMPTOTIC_BELOW).g()
 }
 
 /// m(theta), n(theta) and `k'` for theta in [0, pi/2], eqs (5)-(6), to a few ulps.
@@ -140,6 +169,9 @@ pub fn theta_for_g(g: f64) -> Option<EllipseShape> {
     if g == 0.0 {
         return ellipse_shape(0.0);
     }
+    if g < small_theta_g_limit() {
+        return Some(small_theta_shape(small_theta_for_g(g)));
+    }
     // Small theta: g ~ theta^(2/3) (8/pi^2)^(1/3) Lam^(1/6); start from Lam ~ 10.
     let theta_guess = libm::pow(g / (0.932 * 1.47), 1.5);
     let guess = libm::fmin(small_theta_shape(libm::fmin(theta_guess, 0.1)).kprime, 1.0);
@@ -150,18 +182,18 @@ pub fn theta_for_g(g: f64) -> Option<EllipseShape> {
     ellipse_shape(libm::fmin(shape.theta, FRAC_PI_2))
 }
 
-/// Semi-axes `(a, b)` (m) and the Hertz length `L` for load `load` (N) given the
-/// scene's `hertz_volume = L^3/P = 3 (1 - nu) R / (2 G)`, `R = R1 R2/(R1 + R2)`.
-pub fn semi_axes(shape: &EllipseShape, hertz_volume: f64, load: f64) -> (f64, f64) {
-    let l = libm::cbrt(hertz_volume * load);
+/// Semi-axes `(a, b)` (m) for load `load` (N) given the scene's Hertz scale
+/// `v = (L^3/P)^(1/3)`, `L^3/P = 3 (1 - nu) R / (2 G)`, `R = R1 R2/(R1 + R2)`.
+pub fn semi_axes(shape: &EllipseShape, hertz_scale: f64, load: f64) -> (f64, f64) {
+    let l = hertz_scale * libm::cbrt(load);
     let a = if l == 0.0 { 0.0 } else { shape.m * l };
     (a, shape.n * l)
 }
 
 /// Peak pressure `p0 = p(0, 0) = 3 P / (2 pi a b)` (eq 7), written as
-/// `3 P^(1/3) / (2 pi m n (L^3/P)^(2/3))` so that P = 0 gives 0 and theta = 0 gives 0.
-pub fn peak_pressure(shape: &EllipseShape, hertz_volume: f64, load: f64) -> f64 {
-    let v = libm::cbrt(hertz_volume);
+/// `3 P^(1/3) / (2 pi m n v^2)` so that P = 0 gives 0 and theta = 0 gives 0.
+pub fn peak_pressure(shape: &EllipseShape, hertz_scale: f64, load: f64) -> f64 {
+    let v = hertz_scale;
     3.0 * libm::cbrt(load) / (2.0 * PI * shape.mn() * v * v)
 }
 

@@ -32,15 +32,15 @@ impl Regime {
 }
 
 /// Slip ratio `d/b = pi G a b |phi| / (3 mu P)` (eq 15), written with the scene's
-/// `L^3/P = hertz_volume` as `pi G m n V^(2/3) |phi| / (3 mu P^(1/3))`.
+/// Hertz scale `v = (L^3/P)^(1/3)` as `pi G m n v^2 |phi| / (3 mu P^(1/3))`.
 /// Defined limits: 0 when phi = 0 (no misalignment, no slip), +inf when P = 0 and
 /// phi != 0 (an unloaded contact slips).
-pub fn slip_ratio(g_modulus: f64, mu: f64, mn: f64, hertz_volume: f64, load: f64, phi: f64) -> f64 {
+pub fn slip_ratio(g_modulus: f64, mu: f64, mn: f64, hertz_scale: f64, load: f64, phi: f64) -> f64 {
     let phi = libm::fabs(phi);
     if phi == 0.0 {
         return 0.0;
     }
-    let v = libm::cbrt(hertz_volume);
+    let v = hertz_scale;
     PI * g_modulus * mn * v * v * phi / (3.0 * mu * libm::cbrt(load))
 }
 
@@ -76,7 +76,7 @@ pub fn axial_force_ratio_slope(s: f64) -> f64 {
 /// Non-dimensional load `P* = 2 P / ((1 - nu)^2 G (R1 + R2) sqrt(R1 R2))` (eq 17).
 pub fn nondimensional_load(load: f64, nu: f64, g_modulus: f64, r1: f64, r2: f64) -> f64 {
     let one_nu = 1.0 - nu;
-    2.0 * load / (one_nu * one_nu * g_modulus * (r1 + r2) * libm::sqrt(r1 * r2))
+    2.0 * load / (one_nu * one_nu * g_modulus * (r1 + r2) * libm::sqrt(r1) * libm::sqrt(r2))
 }
 
 /// Critical non-dimensional load `P0* = (pi m n theta)^3 / (48 mu^3)` (eq 18),
