@@ -208,8 +208,8 @@ impl FixedEllipticScene {
             (i32::MIN, i32::MIN, i32::MIN)
         } else {
             let lp = log2_u32(load);
-            let log_l = self.log_hertz + div3(lp);
-            let (la, lb) = (log_m + log_l, log_n + log_l);
+            let log_l = self.log_hertz.saturating_add(div3(lp));
+            let (la, lb) = (log_m.saturating_add(log_l), log_n.saturating_add(log_l));
             (
                 la,
                 lb,

@@ -60,7 +60,7 @@ impl EllipticScene<'static> {
     /// # Errors
     /// [`Error::PlaneHasNoEllipse`] for a plane, [`Error::Unsupported`] for the exact
     /// theta relation (the cores implement eq 4), [`Error::OutOfRange`] if a constant
-    /// does not fit in f32.
+    /// does not fit in f32 or the radii differ by more than 1e24 (c < 2^-40).
     pub fn new(scene: &Scene) -> Result<Self, Error> {
         Self::with_tables(scene, Tables::FULL)
     }
@@ -79,6 +79,11 @@ impl<'t> EllipticScene<'t> {
             return Err(Error::Unsupported);
         }
         let c = scene.radius_factor();
+        // Below this the radii differ by more than 1e24: theta never leaves the
+        // asymptotic range and theta0 would underflow f32 while phi0 does not.
+        if c < SMALL_THETA as f64 {
+            return Err(Error::OutOfRange);
+        }
         let v = hertz_scale(scene);
         let slip_gain =
             core::f64::consts::PI * scene.shear_modulus() * v * v / (3.0 * scene.friction() * c);
@@ -136,7 +141,7 @@ impl<'t> EllipticScene<'t> {
         let r = inv_cbrt(load); // P^(-1/3)
         let g = self.g_of_theta(theta)?;
         let s = self.slip_gain * g * r; // eq (16)
-        let force = (self.friction * load * axial_force_ratio(s)).copysign(phi); // eq (21)
+        let force = (self.friction * (load * axial_force_ratio(s))).copysign(phi); // eq (21), F <= mu P
         let g0 = self.critical_gain * (load * r * r); // eq (18) at d/b = 1
         let critical = self.theta_of_g(g0)?.map(|t| t * self.inv_radius_factor);
         Ok(Estimate::new(
@@ -220,10 +225,14 @@ impl<'t> EllipticScene<'t> {
             None => return Err(Error::OutOfRange),
         };
         let m = 1.0 / inv_m;
-        let n = g * inv_m / theta;
+        let n = g / theta * inv_m; // in this order: g inv_m underflows at tiny theta
         let l = self.hertz_gain * cbrt(load); // L, eqs (2)-(3)
         // p0 = 3 P / (2 pi a b) = 3 P^(1/3) / (2 pi m n V^(2/3)); 0 at P = 0.
-        let p0 = 3.0 * cbrt(load) / (2.0 * PI * m * n * self.hertz_gain * self.hertz_gain);
+        let p0 = if load == 0.0 {
+            0.0
+        } else {
+            3.0 * cbrt(load) / (2.0 * PI * m * n * self.hertz_gain * self.hertz_gain)
+        };
         Ok(Details {
             theta,
             m,

@@ -81,14 +81,10 @@ impl LineScene {
                 self.risk_slip_ratio,
             ));
         }
-        let y = if load < f32::MIN_POSITIVE {
-            inv_sqrt(load * 16_777_216.0) * 4096.0 // subnormal: scale by 2^24
-        } else {
-            inv_sqrt(load)
-        };
+        let y = inv_sqrt(load); // P^(-1/2), subnormal loads included
         let s = self.slip_gain * abs_phi * y; // eq (23)
         let ratio = if s < 1.0 { s * (2.0 - s) } else { 1.0 }; // eqs (27), (29)
-        let force = (self.friction * load * ratio).copysign(phi);
+        let force = (self.friction * (load * ratio)).copysign(phi);
         let critical = self.critical_gain * (load * y); // eq (28)
         Ok(Estimate::new(
             s,

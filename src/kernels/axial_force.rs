@@ -8,7 +8,7 @@
 //!   follows; with that branch point factored out what is left is analytic, and
 //!   `1 - s` is exact there.
 
-use super::sqrt::inv_sqrt;
+use super::sqrt::inv_sqrt_normal;
 use crate::tables::{AXIAL_FORCE_HIGH, AXIAL_FORCE_LOW};
 
 /// Maximum relative error of [`axial_force_ratio`] against eq (21) in f64, over all
@@ -30,7 +30,7 @@ pub fn axial_force_ratio(s: f32) -> f32 {
         s * horner(&AXIAL_FORCE_LOW, s)
     } else {
         let v = 1.0 - s; // exact (Sterbenz)
-        let u = v * inv_sqrt(v);
+        let u = v * inv_sqrt_normal(v); // v >= 2^-24
         1.0 - v * v * u * horner(&AXIAL_FORCE_HIGH, u)
     }
 }

@@ -11,15 +11,19 @@ pub const INV_CBRT_MAX_REL_ERROR: f32 = 1.0e-7;
 /// First guess: the bits of x^(-1/3) are about `K - bits(x)/3` (3.4 % off at most).
 const MAGIC: u32 = 0x54a2_32a0;
 
+/// Inputs below this are scaled by 2^24 first, so that `x/3` stays normal and the
+/// kernel stays exact under scaling by 8.
+const SCALE_BELOW: f32 = 7.523_164e-37; // 2^-120
+
 /// `x^(-1/3)` for positive finite `x` (including subnormals); +inf for 0. Other
 /// inputs (negative, NaN, inf) give an unspecified finite or NaN value: callers check.
 #[inline(always)]
 pub fn inv_cbrt(x: f32) -> f32 {
-    if x < f32::MIN_POSITIVE {
+    if x < SCALE_BELOW {
         if x == 0.0 {
             return f32::INFINITY;
         }
-        // Subnormal: scale by 2^24 (exact), then x^(-1/3) gains a factor 2^8.
+        // Scale by 2^24 (exact), then x^(-1/3) gains a factor 2^8.
         return inv_cbrt_normal(x * 16_777_216.0) * 256.0;
     }
     inv_cbrt_normal(x)

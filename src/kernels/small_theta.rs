@@ -50,6 +50,10 @@ pub fn inv_m_small(theta: f32) -> f32 {
 
 /// The theta with `g(theta) = g`, for `0 < g < 2^-27`.
 pub fn theta_small(g: f32) -> f32 {
+    // theta ~ (g/2)^(3/2) underflows f32 below this; the iteration would meet log(0).
+    if g < 7.888_609e-31 {
+        return 0.0; // 2^-100
+    }
     // theta = q^(3/2), q = g / (G_SCALE Lam^(1/6)); Lam depends on theta only by its log.
     let mut theta = 0.0;
     let mut ln_theta = 1.5 * libm::logf(g / (G_SCALE * 1.7));

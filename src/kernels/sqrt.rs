@@ -3,17 +3,33 @@
 //! `micromath`'s is fast but about 5 % off. Used by the axial-force kernel
 //! (`u = sqrt(1 - d/b)`) and by line contact (eqs 23, 28).
 
-/// Maximum relative error of [`inv_sqrt`] over all positive normal f32 (exhaustive
-/// test over [1, 4), which covers every normal input: the kernel is exact under
-/// scaling by 4).
+/// Maximum relative error of [`inv_sqrt`] over all positive finite f32 (exhaustive
+/// test over [1, 4), which covers every input: the kernel is exact under scaling by 4
+/// down to 2^-120, and scales smaller inputs up by 2^24 first).
 pub const INV_SQRT_MAX_REL_ERROR: f32 = 1.0e-7;
 
 /// First guess: the bits of x^(-1/2) are about `K - bits(x)/2` (3.4 % off at most).
 const MAGIC: u32 = 0x5f37_6430;
 
-/// `x^(-1/2)` for positive normal `x`. Callers keep x normal and positive.
+/// Inputs below this are scaled by 2^24 first, so that `x/2` stays normal and the
+/// kernel stays exact under scaling by 4.
+const SCALE_BELOW: f32 = 7.523_164e-37; // 2^-120
+
+/// `x^(-1/2)` for positive finite `x`, subnormals included (+inf for 0).
 #[inline(always)]
 pub fn inv_sqrt(x: f32) -> f32 {
+    if x < SCALE_BELOW {
+        if x == 0.0 {
+            return f32::INFINITY;
+        }
+        return inv_sqrt_normal(x * 16_777_216.0) * 4096.0;
+    }
+    inv_sqrt_normal(x)
+}
+
+/// `x^(-1/2)` for `x >= 2^-120`: the per-sample path where the caller knows its range.
+#[inline(always)]
+pub(crate) fn inv_sqrt_normal(x: f32) -> f32 {
     let mut y = f32::from_bits(MAGIC.wrapping_sub(x.to_bits() >> 1));
     let half = 0.5 * x;
     // Newton: y <- y (3/2 - (x/2) y^2), formed as ((x/2) y) y to stay normal.
@@ -23,7 +39,7 @@ pub fn inv_sqrt(x: f32) -> f32 {
     y + y * (0.5 - (half * y) * y)
 }
 
-/// `sqrt(x)` for non-negative normal x or 0, as `x x^(-1/2)`.
+/// `sqrt(x)` for non-negative finite x, as `x x^(-1/2)`.
 #[inline(always)]
 pub fn sqrt(x: f32) -> f32 {
     if x == 0.0 { 0.0 } else { x * inv_sqrt(x) }

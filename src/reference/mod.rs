@@ -5,6 +5,7 @@
 //! per-sample results and the model choice of section 9.
 
 mod carlson;
+mod chain;
 pub mod line;
 pub mod normal;
 mod solve;
@@ -203,8 +204,13 @@ pub fn hertz_volume(scene: &Scene) -> f64 {
 /// The Hertz scale `v = (L^3/P)^(1/3)`, so that `L = v P^(1/3)` (eqs 2-3 with the
 /// erratum), formed factor by factor so that no extreme but valid scene underflows.
 pub fn hertz_scale(scene: &Scene) -> f64 {
-    libm::cbrt(1.5 * (1.0 - scene.poisson_ratio()) / scene.shear_modulus())
-        * libm::cbrt(scene.effective_radius())
+    chain::chain(
+        &[
+            libm::cbrt(1.5 * (1.0 - scene.poisson_ratio())),
+            libm::cbrt(scene.effective_radius()),
+        ],
+        &[libm::cbrt(scene.shear_modulus())],
+    )
 }
 
 /// The phi (rad, >= 0) that gives auxiliary angle `theta` under the scene's relation.
@@ -225,8 +231,14 @@ pub fn critical_angle(scene: &Scene, load: f64) -> Option<(f64, f64)> {
     }
     let v = hertz_scale(scene);
     // d/b = 1  <=>  m n |phi| = 3 mu P^(1/3) / (pi G v^2).
-    let target = 3.0 * scene.friction() * libm::cbrt(load) / (PI * scene.shear_modulus() * v * v);
+    let target = chain::chain(
+        &[3.0, scene.friction(), libm::cbrt(load)],
+        &[PI, scene.shear_modulus(), v, v],
+    );
     let c = scene.radius_factor();
+    if c == 0.0 {
+        return None; // a strip: no contact ellipse, no elliptic critical angle
+    }
     if c * target < normal::small_theta_g_limit() {
         // theta0 < 1e-100: the asymptotics, where sin phi = phi exactly (both relations).
         let theta0 = normal::small_theta_for_g(c * target);
@@ -261,7 +273,8 @@ pub fn critical_angle(scene: &Scene, load: f64) -> Option<(f64, f64)> {
 /// for a plane.
 pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
     check_sample(load, phi)?;
-    if scene.is_plane() {
+    // c = 0: a plane, or radii so unequal that c underflows; the contact is a strip.
+    if scene.is_plane() || scene.radius_factor() == 0.0 {
         return Err(Error::PlaneHasNoEllipse);
     }
     let theta = scene.auxiliary_angle(phi);
@@ -283,10 +296,19 @@ pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
     let pstar = tangential::nondimensional_load(load, nu, g_mod, r1, r2);
     let p0star = tangential::critical_nondimensional_load(shape.g(), mu);
     // P at which d/b = 1 for this phi: P0* scaled back by eq (17).
-    let critical_load =
-        p0star * (1.0 - nu) * (1.0 - nu) * g_mod * (r1 + r2) * libm::sqrt(r1) * libm::sqrt(r2)
-            / 2.0;
-    let axial_force = libm::copysign(mu * load * tangential::axial_force_ratio(s), phi);
+    let critical_load = chain::chain(
+        &[
+            p0star,
+            1.0 - nu,
+            1.0 - nu,
+            g_mod,
+            r1 + r2,
+            libm::sqrt(r1),
+            libm::sqrt(r2),
+        ],
+        &[2.0],
+    );
+    let axial_force = libm::copysign(mu * (load * tangential::axial_force_ratio(s)), phi);
     let critical = critical_angle(scene, load);
     let validity = Validity {
         large_angle: libm::fabs(phi) > ANGLE_LIMIT || critical.is_none_or(|(p, _)| p > ANGLE_LIMIT),
@@ -348,9 +370,12 @@ impl Elliptic {
 /// Zero angle: d/b = 0, F = 0. Zero load: b = p0 = F = phi0 = 0, d/b = inf.
 ///
 /// # Errors
-/// [`Error::Load`], [`Error::Angle`] for undefined input.
+/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| above pi/2.
 pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
     check_sample(load, phi)?;
+    if libm::fabs(phi) > FRAC_PI_2 {
+        return Err(Error::Angle); // the angle between two axes is at most pi/2
+    }
     let (g_mod, nu, mu) = (
         scene.shear_modulus(),
         scene.poisson_ratio(),
@@ -377,9 +402,9 @@ pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
         slip_ratio: s,
         d: libm::fmin(s, 1.0) * b,
         regime: Regime::of(s),
-        axial_force: libm::copysign(mu * load * line::axial_force_ratio(s), phi),
+        axial_force: libm::copysign(mu * (load * line::axial_force_ratio(s)), phi),
         critical_angle,
-        critical_load: p0star * (1.0 - nu) * g_mod * radius,
+        critical_load: chain::chain(&[p0star, 1.0 - nu, g_mod, radius], &[]),
         validity: Validity {
             large_angle: libm::fabs(phi) > ANGLE_LIMIT || critical_angle > ANGLE_LIMIT,
             high_pressure: p0 / g_mod > PRESSURE_LIMIT,

@@ -1,6 +1,7 @@
 //! The normal problem (paper section 5): the Hertz contact ellipse, eqs (2)-(7).
 
 use super::carlson::carlson_rd;
+use super::chain::chain;
 use super::solve::increasing_root;
 use core::f64::consts::{FRAC_PI_2, PI};
 
@@ -185,16 +186,20 @@ pub fn theta_for_g(g: f64) -> Option<EllipseShape> {
 /// Semi-axes `(a, b)` (m) for load `load` (N) given the scene's Hertz scale
 /// `v = (L^3/P)^(1/3)`, `L^3/P = 3 (1 - nu) R / (2 G)`, `R = R1 R2/(R1 + R2)`.
 pub fn semi_axes(shape: &EllipseShape, hertz_scale: f64, load: f64) -> (f64, f64) {
-    let l = hertz_scale * libm::cbrt(load);
-    let a = if l == 0.0 { 0.0 } else { shape.m * l };
-    (a, shape.n * l)
+    let cbrt_load = libm::cbrt(load);
+    let a = if cbrt_load == 0.0 {
+        0.0
+    } else {
+        chain(&[shape.m, hertz_scale, cbrt_load], &[])
+    };
+    (a, chain(&[shape.n, hertz_scale, cbrt_load], &[]))
 }
 
 /// Peak pressure `p0 = p(0, 0) = 3 P / (2 pi a b)` (eq 7), written as
 /// `3 P^(1/3) / (2 pi m n v^2)` so that P = 0 gives 0 and theta = 0 gives 0.
 pub fn peak_pressure(shape: &EllipseShape, hertz_scale: f64, load: f64) -> f64 {
     let v = hertz_scale;
-    3.0 * libm::cbrt(load) / (2.0 * PI * shape.mn() * v * v)
+    chain(&[3.0, libm::cbrt(load)], &[2.0, PI, shape.mn(), v, v])
 }
 
 /// Hertz pressure `p(x, y)` (Pa) of eq (7) inside the ellipse, 0 outside.

@@ -1,6 +1,7 @@
 //! The tangential problem (paper sections 6-7): traction, stick and slip zones,
 //! slip ratio, critical load and axial force, eqs (8)-(21) and (30).
 
+use super::chain::chain;
 use core::f64::consts::PI;
 
 /// Whether part of the contact still sticks.
@@ -41,7 +42,10 @@ pub fn slip_ratio(g_modulus: f64, mu: f64, mn: f64, hertz_scale: f64, load: f64,
         return 0.0;
     }
     let v = hertz_scale;
-    PI * g_modulus * mn * v * v * phi / (3.0 * mu * libm::cbrt(load))
+    chain(
+        &[PI, g_modulus, mn, v, v, phi],
+        &[3.0, mu, libm::cbrt(load)],
+    )
 }
 
 /// `F / (mu P)` as a function of `s = d/b`: eq (21) for `s < 1`, 1 for `s >= 1`
@@ -76,14 +80,23 @@ pub fn axial_force_ratio_slope(s: f64) -> f64 {
 /// Non-dimensional load `P* = 2 P / ((1 - nu)^2 G (R1 + R2) sqrt(R1 R2))` (eq 17).
 pub fn nondimensional_load(load: f64, nu: f64, g_modulus: f64, r1: f64, r2: f64) -> f64 {
     let one_nu = 1.0 - nu;
-    2.0 * load / (one_nu * one_nu * g_modulus * (r1 + r2) * libm::sqrt(r1) * libm::sqrt(r2))
+    chain(
+        &[2.0, load],
+        &[
+            one_nu,
+            one_nu,
+            g_modulus,
+            r1 + r2,
+            libm::sqrt(r1),
+            libm::sqrt(r2),
+        ],
+    )
 }
 
 /// Critical non-dimensional load `P0* = (pi m n theta)^3 / (48 mu^3)` (eq 18),
 /// given `g = m n theta`.
 pub fn critical_nondimensional_load(g: f64, mu: f64) -> f64 {
-    let x = PI * g / mu;
-    x * x * x / 48.0
+    chain(&[PI, g, PI, g, PI, g], &[48.0, mu, mu, mu])
 }
 
 /// Axial traction `X(x, y)` (Pa) of eqs (11), (13), (14) on an ellipse of semi-axes
