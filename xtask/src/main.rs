@@ -1,7 +1,10 @@
 //! Chores for people and CI alike: `cargo xtask <task>`.
 
+mod figures;
 mod fit;
 mod fixed_tables;
+mod fuzz;
+mod sweep;
 mod tables;
 
 use std::path::PathBuf;
@@ -13,8 +16,14 @@ usage: cargo xtask <task>
 tasks:
     tables [--check]               generate src/tables.rs from the f64 reference
                                    (--check: fail if the committed file differs)
+    fuzz [--seconds N]             every fuzz target for N seconds (default 60; nightly)
+    sweep [--quick] [--readme]     every f32 kernel over every input of its domain against
+                                   the reference (--quick strides; --readme writes the table)
     tables --explore | --explore-force | --explore-fixed | --derivatives
                                    error and size of the table shapes considered
+    figures [--check]              write the paper's Figs 1-4 (and the speed against
+                                   error from docs/bench.csv, if any) as SVG to docs/
+                                   (--check: fail if a committed SVG differs)
 ";
 
 fn root() -> PathBuf {
@@ -31,6 +40,33 @@ fn main() -> ExitCode {
         }
         Some("tables") if flag("--explore-force") => {
             tables::explore_force();
+            ExitCode::SUCCESS
+        }
+        Some("fuzz") => {
+            let seconds = args
+                .iter()
+                .position(|a| a == "--seconds")
+                .and_then(|i| args.get(i + 1))
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(60);
+            match fuzz::run(&root(), seconds) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("xtask fuzz: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Some("sweep") => {
+            let quick = flag("--quick");
+            let start = std::time::Instant::now();
+            let rows = sweep::run(quick);
+            let table = sweep::markdown(&rows, quick);
+            print!("{table}");
+            eprintln!("swept in {:.0} s", start.elapsed().as_secs_f64());
+            if flag("--readme") {
+                sweep::write_readme(&root().join("README.md"), &table).expect("write README.md");
+            }
             ExitCode::SUCCESS
         }
         Some("tables") if flag("--derivatives") => {
@@ -64,6 +100,7 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
+        Some("figures") => figures::run(&root().join("docs"), flag("--check")),
         _ => {
             eprint!("{USAGE}");
             ExitCode::from(2)

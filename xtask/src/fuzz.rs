@@ -1,0 +1,54 @@
+//! `cargo xtask fuzz [--seconds N]`: every fuzz target under fuzz/ (libFuzzer through
+//! cargo-fuzz, which needs a nightly toolchain) for a bounded time each. A crash stops
+//! with a non-zero status and leaves the input under fuzz/artifacts/: turn it into a
+//! test in tests/fuzz_regressions.rs.
+
+use std::path::Path;
+use std::process::Command;
+
+/// The targets, as named in fuzz/Cargo.toml.
+pub const TARGETS: [&str; 4] = ["estimator_csv", "reference", "float_core", "fixed_core"];
+
+fn have(cmd: &mut Command) -> bool {
+    cmd.output().map(|o| o.status.success()).unwrap_or(false)
+}
+
+/// Runs the targets; Err with a message on a crash or a missing tool.
+pub fn run(root: &Path, seconds: u32) -> Result<(), String> {
+    if !have(Command::new("cargo").args(["+nightly", "--version"])) {
+        return Err(
+            "cargo-fuzz needs a nightly toolchain (`rustup toolchain install nightly`)".into(),
+        );
+    }
+    if !have(Command::new("cargo").args(["+nightly", "fuzz", "--version"])) {
+        eprintln!("installing cargo-fuzz (about 2.5 minutes)");
+        let ok = Command::new("cargo")
+            .args(["install", "cargo-fuzz", "--locked"])
+            .status()
+            .map(|s| s.success());
+        if !matches!(ok, Ok(true)) {
+            return Err("cargo install cargo-fuzz failed".into());
+        }
+    }
+    for target in TARGETS {
+        eprintln!("fuzzing {target} for {seconds} s");
+        let status = Command::new("cargo")
+            .current_dir(root)
+            .args([
+                "+nightly",
+                "fuzz",
+                "run",
+                target,
+                "--",
+                &format!("-max_total_time={seconds}"),
+            ])
+            .status()
+            .map_err(|e| e.to_string())?;
+        if !status.success() {
+            return Err(format!(
+                "fuzz target {target} failed: see fuzz/artifacts/{target}/"
+            ));
+        }
+    }
+    Ok(())
+}
