@@ -1,0 +1,26 @@
+//! The benchmark's scene and samples, shared by the host benchmark and the firmware
+//! benchmark images: a few hundred (P, phi) over the practical domain (theta ~ 1e-5 to
+//! 1e-2, loads from 50 N to 5 kN on printing-press rollers), the same on every run.
+#![allow(dead_code)]
+
+/// Largest load in the samples (N).
+pub const LOAD_MAX: f64 = 5000.0;
+
+/// The demo scene: two steel rollers of 50 mm radius, mu = 0.3.
+pub fn scene() -> misalign::Scene {
+    misalign::Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).expect("valid scene")
+}
+
+/// `n` samples, log-spaced in phi (1e-5 to 1e-2 rad) and in P (50 N to 5 kN), with
+/// alternating sign of phi; a fixed low-discrepancy walk, no random generator.
+pub fn practical(n: usize) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|i| {
+            let u = (i as f64 + 0.5) / n as f64;
+            let v = ((i as f64) * 0.618_033_988_749_894_9).fract();
+            let phi = 1e-5 * 1e3f64.powf(u);
+            let load = 50.0 * 100f64.powf(v);
+            (load, if i % 2 == 0 { phi } else { -phi })
+        })
+        .collect()
+}
