@@ -1,9 +1,12 @@
 //! Chores for people and CI alike: `cargo xtask <task>`.
 
+mod cross;
 mod figures;
+mod firmware;
 mod fit;
 mod fixed_tables;
 mod fuzz;
+mod nopanic;
 mod sweep;
 mod tables;
 
@@ -24,6 +27,11 @@ tasks:
     figures [--check]              write the paper's Figs 1-4 (and the speed against
                                    error from docs/bench.csv, if any) as SVG to docs/
                                    (--check: fail if a committed SVG differs)
+    firmware [--readme]            build every firmware image and on-target test, run them
+                                   in QEMU (Cortex-M4F, M7, M3, M0), print the size and
+                                   stack table (--readme: write it into README.md); fail
+                                   on any failure or over budget
+    nopanic                        prove the estimator has no panic path (panic-never)
 ";
 
 fn root() -> PathBuf {
@@ -101,6 +109,8 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Some("figures") => figures::run(&root().join("docs"), flag("--check")),
+        Some("firmware") => firmware::run(flag("--readme")),
+        Some("nopanic") => nopanic::run(),
         _ => {
             eprint!("{USAGE}");
             ExitCode::from(2)

@@ -1,0 +1,43 @@
+//! The harness of the minimal images (`cargo xtask firmware`'s size table) and of the
+//! no-panic images: inputs from flash through volatile reads (so that nothing is
+//! folded at compile time, as for a scene read from a configuration block and samples
+//! from a sensor), outputs through `black_box`, exit through semihosting. No
+//! logger: the images hold the estimator and as little else as possible.
+#![allow(dead_code)]
+
+/// The demo scene `(R1, R2, G, nu, mu)`, as a configuration block would hold it.
+static SCENE: [f64; 5] = [0.05, 0.05, 79.3e9, 0.3, 0.3];
+/// One sample `(load, phi)`.
+static SAMPLE: [f32; 2] = [1000.0, 2e-4];
+
+fn read<T: Copy>(x: &T) -> T {
+    // SAFETY: a reference is valid for a read.
+    unsafe { core::ptr::read_volatile(x) }
+}
+
+/// The scene parameters.
+pub fn scene() -> (f64, f64, f64, f64, f64) {
+    (
+        read(&SCENE[0]),
+        read(&SCENE[1]),
+        read(&SCENE[2]),
+        read(&SCENE[3]),
+        read(&SCENE[4]),
+    )
+}
+
+/// The sample `(load, phi)`.
+pub fn sample() -> (f32, f32) {
+    (read(&SAMPLE[0]), read(&SAMPLE[1]))
+}
+
+/// Keeps `x` alive, as if the answer went out in a report: the optimiser must compute
+/// it, in memory, without knowing what happens to it.
+pub fn emit<T>(x: T) {
+    core::hint::black_box(x);
+}
+
+/// Semihosting exit.
+pub fn exit(code: i32) -> ! {
+    semihosting::process::exit(code)
+}

@@ -1,0 +1,34 @@
+//! Minimal image with the elliptic estimator: prepares the scene once
+//! ([`EllipticScene::new`], f64) and estimates one sample. Its flash minus that of
+//! `minimal_elliptic_prepare` is the per-sample estimator (code and tables).
+#![cfg_attr(target_os = "none", no_std)]
+#![cfg_attr(target_os = "none", no_main)]
+
+#[cfg(target_os = "none")]
+mod common;
+#[cfg(target_os = "none")]
+mod panic;
+
+#[cfg(target_os = "none")]
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    use misalign::{Scene, float::EllipticScene};
+    let (r1, r2, g, nu, mu) = common::scene();
+    let Ok(scene) = Scene::new(r1, r2, g, nu, mu).and_then(|s| EllipticScene::new(&s)) else {
+        common::exit(2)
+    };
+    let (load, phi) = common::sample();
+    match scene.estimate(load, phi) {
+        Ok(e) => {
+            common::emit(e);
+            common::exit(0)
+        }
+        Err(_) => common::exit(1),
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("a firmware image: `cargo xtask firmware` builds it for Cortex-M");
+    std::process::exit(2);
+}

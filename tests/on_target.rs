@@ -1,0 +1,308 @@
+//! On-target tests of the f32 core: every public path of `misalign::float` run on the
+//! microcontroller (`cargo xtask firmware` runs them on the Cortex-M4F and the
+//! Cortex-M0 in QEMU; defmt-test harness, log over semihosting, exit status 0 when
+//! all pass, 101 on the first failure). The answers are held to the f64 reference
+//! evaluated on the same target, to the relative 2e-6 of `tests/float_core.rs`.
+//!
+//! ```sh
+//! cargo test --target thumbv7em-none-eabihf --features firmware --test on_target
+//! cargo test --target thumbv6m-none-eabi --features firmware --test on_target
+//! ```
+//!
+//! On the host it builds as a stub that says so.
+#![cfg_attr(target_os = "none", no_std)]
+#![cfg_attr(target_os = "none", no_main)]
+
+#[cfg(target_os = "none")]
+#[path = "../examples/support/mod.rs"]
+mod support;
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    println!("on_target: these tests run on a Cortex-M (cargo xtask firmware)");
+}
+
+/// What the tests share (defmt-test wants only tests in its module).
+#[cfg(target_os = "none")]
+mod check {
+    use misalign::Scene;
+    use misalign::reference::Regime;
+
+    pub const BOUND: f64 = 2e-6;
+
+    /// Loads (N, or N/m for line contact) and angles (rad) of the sweeps: both
+    /// regimes, both signs.
+    pub const LOADS: [f32; 5] = [50.0, 300.0, 1000.0, 4000.0, 2e4];
+    pub const LINE_LOADS: [f32; 4] = [3e3, 2e4, 2e5, 2e6];
+    pub const ANGLES: [f32; 7] = [-1.5e-3, -2e-5, 3e-6, 9e-5, 4e-4, 1e-3, 5e-3];
+
+    pub fn demo() -> Scene {
+        Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap()
+    }
+
+    /// A scene of unequal rollers, so that theta != phi.
+    pub fn unequal() -> Scene {
+        Scene::new(0.02, 0.35, 26e9, 0.34, 0.15).unwrap()
+    }
+
+    pub fn rel(got: f32, want: f64) -> f64 {
+        if got as f64 == want {
+            0.0
+        } else {
+            ((got as f64 - want) / want).abs()
+        }
+    }
+
+    pub fn close(what: &str, got: f32, want: f64) {
+        defmt::assert!(
+            rel(got, want) <= BOUND,
+            "{=str}: got {=f32} want {=f64} (relative error {=f64})",
+            what,
+            got,
+            want,
+            rel(got, want)
+        );
+    }
+
+    pub fn regime_agrees(got: Regime, s_ref: f64) {
+        if (s_ref - 1.0).abs() > 1e-6 {
+            defmt::assert!(got == Regime::of(s_ref), "regime at d/b = {=f64}", s_ref);
+        }
+    }
+}
+
+#[cfg(target_os = "none")]
+#[defmt_test::tests]
+mod tests {
+    use misalign::float::{EllipticScene, LineScene, Tables};
+    use misalign::kernels::octave::{OctaveTable, narrow_rows};
+    use misalign::reference::{self, Regime};
+    use misalign::{Error, Scene, ThetaRelation, tables};
+
+    use super::check::*;
+
+    #[test]
+    fn elliptic_estimate_matches_the_reference() {
+        for scene in [demo(), unequal()] {
+            let prepared = EllipticScene::new(&scene).unwrap();
+            for p in LOADS {
+                for phi in ANGLES {
+                    let e = prepared.estimate(p, phi).unwrap();
+                    let r = reference::elliptic(&scene, p as f64, phi as f64).unwrap();
+                    close("d/b", e.slip_ratio, r.slip_ratio);
+                    close("F", e.axial_force, r.axial_force);
+                    let phi0 = r.critical_angle.unwrap();
+                    close("phi0", e.critical_angle.unwrap(), phi0);
+                    // phi0 - |phi| cancels: hold it to the error of the larger term.
+                    let abs_phi = (phi as f64).abs();
+                    let margin = e.margin.unwrap() as f64 - (phi0 - abs_phi);
+                    defmt::assert!(
+                        margin.abs() <= BOUND * phi0.max(abs_phi),
+                        "margin off by {=f64}",
+                        margin
+                    );
+                    regime_agrees(e.regime, r.slip_ratio);
+                    if (r.slip_ratio - 0.8).abs() > 1e-6 {
+                        defmt::assert_eq!(e.microslip_risk, r.slip_ratio >= 0.8);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn elliptic_details_match_the_reference() {
+        for scene in [demo(), unequal()] {
+            let prepared = EllipticScene::new(&scene).unwrap();
+            for p in LOADS {
+                for phi in ANGLES {
+                    let d = prepared.details(p, phi).unwrap();
+                    let r = reference::elliptic(&scene, p as f64, phi as f64).unwrap();
+                    close("theta", d.theta, r.shape.theta);
+                    close("m", d.m, r.shape.m);
+                    close("n", d.n, r.shape.n);
+                    close("a", d.a, r.a);
+                    close("b", d.b, r.b);
+                    close("p0", d.p0, r.p0);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn line_estimate_matches_the_reference() {
+        for scene in [
+            demo(),
+            unequal(),
+            Scene::new(0.1, f64::INFINITY, 79.3e9, 0.3, 0.2).unwrap(),
+        ] {
+            let prepared = LineScene::new(&scene).unwrap();
+            for p in LINE_LOADS {
+                for phi in ANGLES {
+                    let e = prepared.estimate(p, phi).unwrap();
+                    let r = reference::line(&scene, p as f64, phi as f64).unwrap();
+                    close("d/b", e.slip_ratio, r.slip_ratio);
+                    close("F", e.axial_force, r.axial_force);
+                    close("phi0", e.critical_angle.unwrap(), r.critical_angle);
+                    regime_agrees(e.regime, r.slip_ratio);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn line_with_a_length_takes_the_total_load() {
+        let scene = demo().with_length(0.4).unwrap();
+        let e = LineScene::new(&scene).unwrap().estimate(8e4, 1e-3).unwrap();
+        let r = reference::line(&scene, 8e4 / 0.4, 1e-3).unwrap();
+        close("d/b", e.slip_ratio, r.slip_ratio);
+        close("F", e.axial_force, r.axial_force * 0.4);
+        close("phi0", e.critical_angle.unwrap(), r.critical_angle);
+    }
+
+    #[test]
+    fn zero_angle_and_zero_load() {
+        let elliptic = EllipticScene::new(&demo()).unwrap();
+        let line = LineScene::new(&demo()).unwrap();
+        for e in [
+            elliptic.estimate(1000.0, 0.0).unwrap(),
+            line.estimate(1e5, -0.0).unwrap(),
+        ] {
+            defmt::assert_eq!(e.slip_ratio, 0.0);
+            defmt::assert_eq!(e.axial_force, 0.0);
+            defmt::assert!(e.regime == Regime::Partial && !e.microslip_risk);
+            defmt::assert!(e.critical_angle.unwrap() > 0.0);
+            defmt::assert_eq!(e.margin, e.critical_angle);
+        }
+        for e in [
+            elliptic.estimate(0.0, 2e-4).unwrap(),
+            line.estimate(-0.0, -2e-4).unwrap(),
+        ] {
+            defmt::assert_eq!(e.slip_ratio, f32::INFINITY);
+            defmt::assert_eq!(e.axial_force, 0.0);
+            defmt::assert!(e.regime == Regime::Gross && e.microslip_risk);
+            defmt::assert_eq!(e.critical_angle, Some(0.0));
+            defmt::assert_eq!(e.margin, Some(-2e-4));
+        }
+        for e in [
+            elliptic.estimate(0.0, 0.0).unwrap(),
+            line.estimate(0.0, 0.0).unwrap(),
+        ] {
+            defmt::assert_eq!(e.slip_ratio, 0.0);
+            defmt::assert!(e.regime == Regime::Partial);
+        }
+        let d = elliptic.details(1000.0, 0.0).unwrap();
+        defmt::assert!(d.m == f32::INFINITY && d.a == f32::INFINITY);
+        defmt::assert!(d.n == 0.0 && d.b == 0.0 && d.p0 == 0.0 && d.theta == 0.0);
+        let d = elliptic.details(0.0, 1e-3).unwrap();
+        defmt::assert!(d.a == 0.0 && d.b == 0.0 && d.p0 == 0.0 && d.m > 1.0);
+    }
+
+    #[test]
+    fn bad_samples_are_refused() {
+        let elliptic = EllipticScene::new(&demo()).unwrap();
+        let line = LineScene::new(&demo()).unwrap();
+        for p in [f32::NAN, f32::INFINITY, -1.0, -1e-40, f32::NEG_INFINITY] {
+            defmt::assert!(elliptic.estimate(p, 1e-4) == Err(Error::Load));
+            defmt::assert!(elliptic.details(p, 1e-4).err() == Some(Error::Load));
+            defmt::assert!(line.estimate(p, 1e-4) == Err(Error::Load));
+        }
+        for phi in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1.6, -2.0] {
+            defmt::assert!(elliptic.estimate(1e3, phi) == Err(Error::Angle));
+            defmt::assert!(elliptic.details(1e3, phi).err() == Some(Error::Angle));
+            defmt::assert!(line.estimate(1e3, phi) == Err(Error::Angle));
+        }
+        // pi/2 itself is the edge of the tables, and accepted.
+        defmt::assert!(elliptic.estimate(1e3, core::f32::consts::FRAC_PI_2).is_ok());
+    }
+
+    #[test]
+    fn bad_scenes_are_refused() {
+        defmt::assert!(Scene::new(-1.0, 0.05, 79.3e9, 0.3, 0.3) == Err(Error::Radius));
+        defmt::assert!(Scene::new(0.05, 0.05, f64::NAN, 0.3, 0.3) == Err(Error::ShearModulus));
+        defmt::assert!(Scene::new(0.05, 0.05, 79.3e9, 0.5, 0.3) == Err(Error::PoissonRatio));
+        defmt::assert!(Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.0) == Err(Error::Friction));
+        defmt::assert!(demo().with_length(-1.0) == Err(Error::Length));
+        let plane = Scene::new(0.05, f64::INFINITY, 79.3e9, 0.3, 0.3).unwrap();
+        defmt::assert!(EllipticScene::new(&plane).err() == Some(Error::PlaneHasNoEllipse));
+        defmt::assert!(LineScene::new(&plane).is_ok());
+        let exact = demo().with_theta_relation(ThetaRelation::Exact);
+        defmt::assert!(EllipticScene::new(&exact).err() == Some(Error::Unsupported));
+        // A modulus so large that the slip gain overflows f32.
+        let stiff = Scene::new(0.05, 0.05, 1e300, 0.3, 0.3).unwrap();
+        defmt::assert!(EllipticScene::new(&stiff).err() == Some(Error::OutOfRange));
+        defmt::assert!(LineScene::new(&stiff).err() == Some(Error::OutOfRange));
+    }
+
+    #[test]
+    fn small_theta_subnormal_load_and_no_critical_angle() {
+        let scene = demo();
+        let prepared = EllipticScene::new(&scene).unwrap();
+        // Below the tables (theta < 2^-40): the small-theta asymptotics.
+        for phi in [1e-13f32, -3e-20, 1e-38] {
+            let e = prepared.estimate(1000.0, phi).unwrap();
+            let r = reference::elliptic(&scene, 1000.0, phi as f64).unwrap();
+            close("d/b (small theta)", e.slip_ratio, r.slip_ratio);
+            close("F (small theta)", e.axial_force, r.axial_force);
+            let d = prepared.details(1000.0, phi).unwrap();
+            close("m (small theta)", d.m, r.shape.m);
+            close("n (small theta)", d.n, r.shape.n);
+        }
+        // A load this high has no critical angle (theta0 would pass pi/2).
+        let e = prepared.estimate(1e14, 1e-3).unwrap();
+        defmt::assert!(e.critical_angle.is_none() && e.margin.is_none());
+        defmt::assert!(
+            reference::elliptic(&scene, 1e14, 1e-3)
+                .unwrap()
+                .critical_angle
+                .is_none()
+        );
+        // A subnormal load.
+        let line = LineScene::new(&scene).unwrap();
+        for p in [1e-40f32, 1e-44] {
+            let e = line.estimate(p, 1e-30).unwrap();
+            let r = reference::line(&scene, p as f64, 1e-30).unwrap();
+            close("d/b (subnormal load)", e.slip_ratio, r.slip_ratio);
+            let e = prepared.estimate(p, 1e-30).unwrap();
+            let r = reference::elliptic(&scene, p as f64, 1e-30).unwrap();
+            close("d/b (subnormal load, elliptic)", e.slip_ratio, r.slip_ratio);
+        }
+    }
+
+    #[test]
+    fn narrowed_tables_and_risk_threshold() {
+        // Rows from theta = 2^-20 up: below that the scene refuses the sample.
+        const SKIP: usize = 20;
+        const G_ROWS: usize = tables::G_OF_THETA_ROWS.len();
+        const T_ROWS: usize = tables::THETA_OF_G_ROWS.len();
+        static G: [[f32; 7]; G_ROWS - SKIP] = narrow_rows(&tables::G_OF_THETA_ROWS, SKIP);
+        static T: [[f32; 7]; T_ROWS] = narrow_rows(&tables::THETA_OF_G_ROWS, 0);
+        let narrow = Tables {
+            g: OctaveTable {
+                first_exponent: tables::G_OF_THETA.first_exponent + SKIP as i32,
+                coeffs: &G,
+            },
+            theta_of_g: OctaveTable {
+                first_exponent: tables::THETA_OF_G.first_exponent,
+                coeffs: &T,
+            },
+        };
+        let scene = demo();
+        let full = EllipticScene::new(&scene).unwrap();
+        let narrowed = EllipticScene::with_tables(&scene, narrow).unwrap();
+        defmt::assert!(narrowed.estimate(1000.0, 4e-4) == full.estimate(1000.0, 4e-4));
+        defmt::assert!(narrowed.estimate(1000.0, 1e-7) == Err(Error::OutOfRange));
+        defmt::assert!(narrowed.estimate(1000.0, 0.0) == full.estimate(1000.0, 0.0));
+        // The risk flag follows the scene's threshold.
+        let e = full.estimate(1000.0, 2e-4).unwrap(); // d/b = 0.63
+        defmt::assert!(!e.microslip_risk);
+        defmt::assert!(
+            full.with_risk_slip_ratio(0.5)
+                .estimate(1000.0, 2e-4)
+                .unwrap()
+                .microslip_risk
+        );
+        let line = LineScene::new(&scene).unwrap().with_risk_slip_ratio(0.1);
+        defmt::assert!(line.estimate(2e5, 5e-4).unwrap().microslip_risk); // d/b = 0.12
+    }
+}

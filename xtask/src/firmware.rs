@@ -1,0 +1,472 @@
+//! `cargo xtask firmware`: builds every firmware image and on-target test, runs them in
+//! QEMU, prints the size and stack table and holds the estimator to its budget.
+//!
+//! Measured, per core (profile `firmware`: release with fat LTO, one codegen unit):
+//!
+//! - image flash and RAM of the minimal images (`examples/minimal`): flash is
+//!   .vector_table + .text + .rodata + .data, RAM the statics (.data + .bss + .uninit)
+//!   as llvm-size counts them; the stack comes on top;
+//! - **estimator flash** (budgeted): `minimal_<model>` minus `minimal_<model>_prepare`,
+//!   two images that differ only in the per-sample `estimate` call: its code, the
+//!   kernels it inlines and calls (soft-float routines included where the core has no
+//!   FPU) and its tables;
+//! - preparation flash (reported): `minimal_<model>_prepare` minus `minimal_base`, the
+//!   one-off `Scene::new` + `*Scene::new` (f64, soft on every Cortex-M here);
+//! - **estimator stack** (budgeted): the deepest stack use of one per-sample call over
+//!   the firmware's trace, by stack painting on the target (`examples/firmware`);
+//! - instructions per sample (reported): SysTick under QEMU's `-icount`.
+
+use crate::cross::{self, Artifacts, Sections};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Per-sample estimator budget: flash (code + tables) and stack, in bytes. Applied to
+/// the cores marked `budget` below; lower them when the estimator beats them.
+pub const FLASH_BUDGET: u64 = 8 * 1024;
+pub const STACK_BUDGET: u64 = 512;
+
+struct Core {
+    name: &'static str,
+    target: &'static str,
+    machine: &'static str,
+    /// The number format of the estimator it runs.
+    number: &'static str,
+    /// Size table and budget for this core (the Cortex-M7 runs the Cortex-M4F's images).
+    sizes: bool,
+    budget: bool,
+}
+
+/// The cores: the f32 core with an FPU (Cortex-M4F, M7) and, until the fixed-point core
+/// lands, in soft float (Cortex-M3, M0) as the baseline; the budget holds for the FPU.
+const CORES: [Core; 4] = [
+    Core {
+        name: "Cortex-M4F",
+        target: "thumbv7em-none-eabihf",
+        machine: "mps2-an386",
+        number: "f32",
+        sizes: true,
+        budget: true,
+    },
+    Core {
+        name: "Cortex-M7",
+        target: "thumbv7em-none-eabihf",
+        machine: "mps2-an500",
+        number: "f32",
+        sizes: false,
+        budget: false,
+    },
+    Core {
+        name: "Cortex-M3",
+        target: "thumbv7m-none-eabi",
+        machine: "mps2-an385",
+        number: "f32-soft",
+        sizes: true,
+        budget: false,
+    },
+    Core {
+        name: "Cortex-M0",
+        target: "thumbv6m-none-eabi",
+        machine: "microbit",
+        number: "f32-soft",
+        sizes: true,
+        budget: false,
+    },
+];
+
+const MODELS: [&str; 2] = ["elliptic", "line"];
+const MINIMAL: [&str; 5] = [
+    "minimal_base",
+    "minimal_elliptic_prepare",
+    "minimal_elliptic",
+    "minimal_line_prepare",
+    "minimal_line",
+];
+
+/// One row of the firmware's `result model=... stack_bytes=...` line.
+#[derive(Default, Clone)]
+struct Run {
+    worst_relative_error: f64,
+    stack: u64,
+    instructions_mean: u64,
+    instructions_max: u64,
+}
+
+struct Row {
+    core: &'static str,
+    number: &'static str,
+    model: &'static str,
+    image_flash: u64,
+    image_ram: u64,
+    estimator_flash: u64,
+    preparation_flash: u64,
+    run: Run,
+    budget: bool,
+}
+
+/// `readme`: also write the table into README.md (between its firmware markers).
+pub fn run(readme: bool) -> ExitCode {
+    let start = Instant::now();
+    let mut failures: Vec<String> = Vec::new();
+    if let Err(e) = preflight() {
+        eprintln!("firmware: {e}");
+        return ExitCode::FAILURE;
+    }
+    let llvm_size = match cross::llvm_tool("llvm-size") {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("firmware: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let mut rows = Vec::new();
+    let mut built: Vec<Built> = Vec::new();
+    for core in &CORES {
+        step(
+            start,
+            &format!("{} ({}, QEMU {})", core.name, core.target, core.machine),
+        );
+        // Build once per target.
+        if !built.iter().any(|b| b.target == core.target) {
+            match build_target(core.target) {
+                Ok(b) => built.push(b),
+                Err(e) => {
+                    failures.push(format!("{}: build failed:\n{e}", core.target));
+                    continue;
+                }
+            }
+        }
+        let Built { images, test, .. } = built.iter().find(|b| b.target == core.target).unwrap();
+
+        // The firmware: every answer checked, stack and instructions measured.
+        let runs =
+            match cross::artifact(images, "firmware").and_then(|elf| run_firmware(core, &elf)) {
+                Ok(runs) => runs,
+                Err(e) => {
+                    failures.push(format!("{} firmware: {e}", core.name));
+                    Vec::new()
+                }
+            };
+
+        // The on-target tests.
+        match cross::qemu(core.machine, test) {
+            Ok((Some(0), log)) if log.contains("all tests passed!") => {
+                let n = log.lines().filter(|l| l.contains(") running `")).count();
+                println!("  on-target tests: {n} passed");
+            }
+            Ok((status, log)) => failures.push(format!(
+                "{} on-target tests failed (exit {status:?}):\n{log}",
+                core.name
+            )),
+            Err(e) => failures.push(format!("{} on-target tests: {e}", core.name)),
+        }
+
+        // The minimal images: they run, and their sizes.
+        if core.sizes {
+            match sizes(core, images, &llvm_size, &runs) {
+                Ok(mut r) => rows.append(&mut r),
+                Err(e) => failures.push(format!("{} sizes: {e}", core.name)),
+            }
+        }
+    }
+
+    step(start, "the README's command: cargo fw");
+    match fw_alias() {
+        Ok(()) => println!("  cargo fw: exit 0"),
+        Err(e) => failures.push(format!("cargo fw: {e}")),
+    }
+
+    step(
+        start,
+        "a real board's layout: MISALIGN_MEMORY_X=boards/stm32f4.x, --features rtt",
+    );
+    match board(&llvm_size) {
+        Ok(line) => println!("  {line}"),
+        Err(e) => failures.push(format!("board build: {e}")),
+    }
+
+    let (table, over) = table(&rows);
+    println!(
+        "\nEstimator on Cortex-M (profile `firmware`, bytes; budget per sample on the FPU core: \
+         {FLASH_BUDGET} B flash, {STACK_BUDGET} B stack; README \"Size, stack, panics\")\n\n{table}"
+    );
+    failures.extend(over);
+    if readme && failures.is_empty() {
+        match write_readme(&table) {
+            Ok(()) => println!("wrote the table into README.md"),
+            Err(e) => failures.push(e),
+        }
+    }
+    step(start, "done");
+    if failures.is_empty() {
+        println!("firmware: every image and on-target test passed, within budget");
+        ExitCode::SUCCESS
+    } else {
+        for f in &failures {
+            eprintln!("\nFAILED: {f}");
+        }
+        eprintln!("\nfirmware: {} failure(s)", failures.len());
+        ExitCode::FAILURE
+    }
+}
+
+fn step(start: Instant, what: &str) {
+    println!("\n=== {what} ({}s)", start.elapsed().as_secs());
+}
+
+/// QEMU, defmt-print (installed here if missing, pinned), llvm-size.
+fn preflight() -> Result<(), String> {
+    if !cross::have("qemu-system-arm") {
+        return Err("qemu-system-arm not found: apt-get install -y qemu-system-arm".into());
+    }
+    if !cross::have("defmt-print") {
+        println!(
+            "defmt-print not found: cargo install defmt-print {}",
+            cross::DEFMT_PRINT_VERSION
+        );
+        let status =
+            std::process::Command::new(std::env::var_os("CARGO").unwrap_or("cargo".into()))
+                .args([
+                    "install",
+                    "--locked",
+                    "defmt-print",
+                    "--version",
+                    cross::DEFMT_PRINT_VERSION,
+                ])
+                .status()
+                .map_err(|e| format!("cannot run cargo install: {e}"))?;
+        if !status.success() || !cross::have("defmt-print") {
+            return Err("could not install defmt-print (is ~/.cargo/bin on PATH?)".into());
+        }
+    }
+    Ok(())
+}
+
+/// What one target's builds made.
+struct Built {
+    target: &'static str,
+    /// The firmware and minimal images (profile `firmware`).
+    images: Artifacts,
+    /// The on-target test (profile `test`).
+    test: PathBuf,
+}
+
+/// Builds the firmware-profile images and the on-target test for `target`.
+fn build_target(target: &'static str) -> Result<Built, String> {
+    let mut cmd = cross::cargo();
+    cmd.args([
+        "build",
+        "--profile",
+        "firmware",
+        "--target",
+        target,
+        "--features",
+        "firmware",
+    ])
+    .args([
+        "--message-format=json-render-diagnostics",
+        "--example",
+        "firmware",
+    ]);
+    for m in MINIMAL {
+        cmd.args(["--example", m]);
+    }
+    let images = cross::build(&mut cmd)?;
+    let tests = cross::build(cross::cargo().args([
+        "test",
+        "--no-run",
+        "--target",
+        target,
+        "--features",
+        "firmware",
+        "--test",
+        "on_target",
+        "--message-format=json-render-diagnostics",
+    ]))?;
+    Ok(Built {
+        target,
+        images,
+        test: cross::artifact(&tests, "on_target")?,
+    })
+}
+
+/// Runs the firmware on `core`: exit 0 and one `result` line per contact model.
+fn run_firmware(core: &Core, elf: &Path) -> Result<Vec<(String, Run)>, String> {
+    let (status, log) = cross::qemu(core.machine, elf)?;
+    let results: Vec<(String, Run)> = log.lines().filter_map(parse_result).collect();
+    if status != Some(0) || results.len() != MODELS.len() {
+        return Err(format!(
+            "exit {status:?}, {} result lines:\n{log}",
+            results.len()
+        ));
+    }
+    for (model, r) in &results {
+        println!(
+            "  firmware {model}: answers match the reference (worst relative error {:.1e}); \
+             stack {} B, instructions {} mean / {} max",
+            r.worst_relative_error, r.stack, r.instructions_mean, r.instructions_max
+        );
+    }
+    Ok(results)
+}
+
+/// `result model=elliptic core=f32 samples=36 failures=0 worst_relative_error=... stack_bytes=...`.
+fn parse_result(line: &str) -> Option<(String, Run)> {
+    let rest = &line[line.find("result model=")?..];
+    let field = |key: &str| -> Option<&str> {
+        rest.split_whitespace()
+            .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+    };
+    let num = |key: &str| field(key)?.parse::<u64>().ok();
+    Some((
+        field("model")?.to_string(),
+        Run {
+            worst_relative_error: field("worst_relative_error")?.parse().ok()?,
+            stack: num("stack_bytes")?,
+            instructions_mean: num("instructions_mean")?,
+            instructions_max: num("instructions_max")?,
+        },
+    ))
+}
+
+/// Runs the minimal images (each must exit 0) and measures them.
+fn sizes(
+    core: &Core,
+    images: &Artifacts,
+    llvm_size: &Path,
+    runs: &[(String, Run)],
+) -> Result<Vec<Row>, String> {
+    let mut measured = Vec::new();
+    for name in MINIMAL {
+        let elf = cross::artifact(images, name)?;
+        match cross::qemu(core.machine, &elf)? {
+            (Some(0), _) => {}
+            (status, log) => return Err(format!("{name} exited {status:?}:\n{log}")),
+        }
+        measured.push((name, Sections::of(llvm_size, &elf)?));
+    }
+    let get = |name: &str| &measured.iter().find(|(n, _)| *n == name).unwrap().1;
+    let base = get("minimal_base").flash();
+    Ok(MODELS
+        .iter()
+        .map(|&model| {
+            let full = get(&format!("minimal_{model}"));
+            let prepare = get(&format!("minimal_{model}_prepare"));
+            Row {
+                core: core.name,
+                number: core.number,
+                model,
+                image_flash: full.flash(),
+                image_ram: full.ram(),
+                estimator_flash: full.flash().saturating_sub(prepare.flash()),
+                preparation_flash: prepare.flash().saturating_sub(base),
+                run: runs
+                    .iter()
+                    .find(|(m, _)| m == model)
+                    .map(|(_, r)| r.clone())
+                    .unwrap_or_default(),
+                budget: core.budget,
+            }
+        })
+        .collect())
+}
+
+/// The README's command, through the alias and the runner: `cargo fw`.
+fn fw_alias() -> Result<(), String> {
+    let out = cross::cargo()
+        .arg("fw")
+        .env_remove("MISALIGN_QEMU_MACHINE")
+        .output()
+        .map_err(|e| format!("cannot run cargo fw: {e}"))?;
+    if out.status.success() {
+        Ok(())
+    } else {
+        Err(format!(
+            "exit {:?}:\n{}{}",
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        ))
+    }
+}
+
+/// A real board's build without editing the crate: the STM32F4 layout (flash at
+/// 0x08000000, 128 KiB RAM) and RTT logging. Checks where the image landed and runs it
+/// on QEMU's netduinoplus2 (an STM32F405), where its log is in RTT (unread) and its
+/// exit status says whether every answer matched.
+fn board(llvm_size: &Path) -> Result<String, String> {
+    let built = cross::build(
+        cross::cargo()
+            .env("MISALIGN_MEMORY_X", "boards/stm32f4.x")
+            .args(["build", "--release", "--target", "thumbv7em-none-eabihf"])
+            .args(["--features", "rtt", "--example", "firmware"])
+            .arg("--message-format=json-render-diagnostics"),
+    )?;
+    let elf = cross::artifact(&built, "firmware")?;
+    let sections = Sections::of(llvm_size, &elf)?;
+    let vectors = sections.addr(".vector_table");
+    let ram = sections.addr(".data");
+    if vectors != Some(0x0800_0000) || ram != Some(0x2000_0000) {
+        return Err(format!(
+            "vector table at {vectors:x?}, .data at {ram:x?}: want 0x08000000, 0x20000000"
+        ));
+    }
+    match cross::qemu("netduinoplus2", &elf)? {
+        (Some(0), _) => Ok(format!(
+            "vector table at 0x08000000, RAM at 0x20000000; {} B of flash; runs on netduinoplus2: exit 0",
+            sections.flash()
+        )),
+        (status, log) => Err(format!("netduinoplus2 exit {status:?}:\n{log}")),
+    }
+}
+
+/// The size and stack table (markdown), and the budget failures.
+fn table(rows: &[Row]) -> (String, Vec<String>) {
+    let mut t = String::from(
+        "| core | number | model | image flash | image RAM | estimator flash | preparation | estimator stack | instructions mean / max |\n\
+         |---|---|---|--:|--:|--:|--:|--:|--:|\n",
+    );
+    let mut over = Vec::new();
+    for r in rows {
+        let flash_over = r.budget && r.estimator_flash > FLASH_BUDGET;
+        let stack_over = r.budget && r.run.stack > STACK_BUDGET;
+        let mark = |over: bool| if over { " **over budget**" } else { "" };
+        writeln!(
+            t,
+            "| {} | {} | {} | {} | {} | {}{} | {} | {}{} | {} / {} |",
+            r.core,
+            r.number,
+            r.model,
+            r.image_flash,
+            r.image_ram,
+            r.estimator_flash,
+            mark(flash_over),
+            r.preparation_flash,
+            r.run.stack,
+            mark(stack_over),
+            r.run.instructions_mean,
+            r.run.instructions_max
+        )
+        .unwrap();
+        if flash_over || stack_over {
+            over.push(format!(
+                "{} {} estimator over budget: {} B flash (budget {FLASH_BUDGET}), {} B stack (budget {STACK_BUDGET})",
+                r.core, r.model, r.estimator_flash, r.run.stack
+            ));
+        }
+    }
+    (t, over)
+}
+
+/// Writes `table` between the firmware markers of README.md.
+fn write_readme(table: &str) -> Result<(), String> {
+    let path = crate::root().join("README.md");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("README.md: {e}"))?;
+    let (begin, end) = ("<!-- firmware:begin -->", "<!-- firmware:end -->");
+    let (Some(a), Some(b)) = (text.find(begin), text.find(end)) else {
+        return Err("README.md has no firmware markers".into());
+    };
+    let new = format!("{}{begin}\n{table}{}", &text[..a], &text[b..]);
+    std::fs::write(&path, new).map_err(|e| format!("README.md: {e}"))
+}
