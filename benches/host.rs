@@ -19,7 +19,7 @@ use std::hint::black_box;
 
 fn estimate(c: &mut Criterion) {
     let scene = samples::scene();
-    let inputs = samples::practical(256);
+    let inputs: Vec<(f64, f64)> = samples::practical(256).collect();
     let core = EllipticScene::new(&scene).unwrap();
     let (load_lsb, _) = exact_lsb(samples::LOAD_MAX, 1 << 30, 0.0);
     let angle_lsb = 1e-8;

@@ -75,7 +75,7 @@ mod check {
 #[defmt_test::tests]
 mod tests {
     use misalign::float::{EllipticScene, LineScene, Tables};
-    use misalign::kernels::octave::{OctaveTable, narrow_rows};
+    use misalign::kernels::octave::{OctaveTable, Row, narrow_rows};
     use misalign::reference::{self, Regime};
     use misalign::{Error, Scene, ThetaRelation, tables};
 
@@ -275,17 +275,11 @@ mod tests {
         const SKIP: usize = 20;
         const G_ROWS: usize = tables::G_OF_THETA_ROWS.len();
         const T_ROWS: usize = tables::THETA_OF_G_ROWS.len();
-        static G: [[f32; 7]; G_ROWS - SKIP] = narrow_rows(&tables::G_OF_THETA_ROWS, SKIP);
-        static T: [[f32; 7]; T_ROWS] = narrow_rows(&tables::THETA_OF_G_ROWS, 0);
+        static G: [Row; G_ROWS - SKIP] = narrow_rows(&tables::G_OF_THETA_ROWS, SKIP);
+        static T: [Row; T_ROWS] = narrow_rows(&tables::THETA_OF_G_ROWS, 0);
         let narrow = Tables {
-            g: OctaveTable {
-                first_exponent: tables::G_OF_THETA.first_exponent + SKIP as i32,
-                coeffs: &G,
-            },
-            theta_of_g: OctaveTable {
-                first_exponent: tables::THETA_OF_G.first_exponent,
-                coeffs: &T,
-            },
+            g: OctaveTable::new(tables::G_OF_THETA.first_exponent() + SKIP as i32, &G),
+            theta_of_g: OctaveTable::new(tables::THETA_OF_G.first_exponent(), &T),
         };
         let scene = demo();
         let full = EllipticScene::new(&scene).unwrap();

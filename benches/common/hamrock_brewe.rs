@@ -47,7 +47,11 @@ impl HamrockBrewe {
         let (k1, k2) = (1.0 / self.r1, 1.0 / self.r2);
         let sum = 0.5 * self.curvature_sum; // A + B
         let diff = 0.5 * libm::sqrtf(k1 * k1 + k2 * k2 + 2.0 * k1 * k2 * libm::cosf(2.0 * phi)); // B - A
-        let (a_curv, b_curv) = (sum - diff, sum + diff); // A <= B
+        // A = sum - diff cancels in f32 at small phi (cos 2phi rounds to 1); a careful
+        // engineer uses A B = sum^2 - diff^2 = k1 k2 sin^2(phi) instead.
+        let b_curv = sum + diff;
+        let sin = libm::sinf(phi);
+        let a_curv = k1 * k2 * sin * sin / b_curv; // A <= B
         let ratio = b_curv / a_curv; // Ry / Rx > 1 (Rx = 1/(2B) across, Ry = 1/(2A) along)
         let k = 1.0339 * libm::powf(ratio, 0.6360);
         let e = 1.0003 + 0.5968 / ratio;

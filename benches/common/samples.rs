@@ -13,14 +13,13 @@ pub fn scene() -> misalign::Scene {
 
 /// `n` samples, log-spaced in phi (1e-5 to 1e-2 rad) and in P (50 N to 5 kN), with
 /// alternating sign of phi; a fixed low-discrepancy walk, no random generator.
-pub fn practical(n: usize) -> Vec<(f64, f64)> {
-    (0..n)
-        .map(|i| {
-            let u = (i as f64 + 0.5) / n as f64;
-            let v = ((i as f64) * 0.618_033_988_749_894_9).fract();
-            let phi = 1e-5 * 1e3f64.powf(u);
-            let load = 50.0 * 100f64.powf(v);
-            (load, if i % 2 == 0 { phi } else { -phi })
-        })
-        .collect()
+pub fn practical(n: usize) -> impl Iterator<Item = (f64, f64)> {
+    (0..n).map(move |i| {
+        let u = (i as f64 + 0.5) / n as f64;
+        let w = (i as f64) * 0.618_033_988_749_894_9;
+        let v = w - libm::floor(w);
+        let phi = 1e-5 * libm::pow(1e3, u);
+        let load = 50.0 * libm::pow(100.0, v);
+        (load, if i % 2 == 0 { phi } else { -phi })
+    })
 }

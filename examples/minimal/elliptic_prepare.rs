@@ -17,10 +17,7 @@ fn main() -> ! {
     use misalign::Scene;
     use misalign::float::{EllipticScene, Tables};
     use misalign::kernels::octave::OctaveTable;
-    const NONE: OctaveTable<'static, 7> = OctaveTable {
-        first_exponent: 0,
-        coeffs: &[],
-    };
+    const NONE: OctaveTable<'static> = OctaveTable::new(0, &[]);
     let empty = Tables {
         g: NONE,
         theta_of_g: NONE,

@@ -120,7 +120,7 @@ pub mod stack {
 /// indicative there (use the DWT cycle counter on hardware; it reads 0 in QEMU).
 pub mod counter {
     use cortex_m::peripheral::SYST;
-    use cortex_m::peripheral::syst::SystClkSource;
+    pub use cortex_m::peripheral::syst::SystClkSource;
 
     const RELOAD: u32 = 0x00ff_ffff;
 
@@ -135,24 +135,39 @@ pub mod counter {
     }
 
     impl Counter {
-        /// Takes over SysTick (no interrupt) and calibrates it.
-        pub fn new(mut syst: SYST) -> Self {
+        /// Takes over SysTick (no interrupt), clocked by the core, and calibrates it.
+        pub fn new(syst: SYST) -> Self {
+            Self::with_clock(syst, SystClkSource::Core, 4096)
+        }
+
+        /// The same on SysTick's external reference clock, calibrated on `2 loops`
+        /// instructions: coarser, but 24 bits then last far longer (the benchmark's f64
+        /// reference on a Cortex-M0 takes ~10 million instructions, the core clock's
+        /// 24 bits about 10 million). `ticks_per_1000() == 0` when the board has no
+        /// reference clock.
+        pub fn with_clock(mut syst: SYST, source: SystClkSource, loops: u32) -> Self {
             syst.disable_interrupt();
-            syst.set_clock_source(SystClkSource::Core);
+            syst.disable_counter();
+            syst.set_clock_source(source);
             syst.set_reload(RELOAD);
             syst.clear_current();
             syst.enable_counter();
             // Two loop lengths: the difference cancels the cost of reading the timer.
             let short = elapsed(|| spin(64));
-            let long = elapsed(|| spin(64 + 4096));
+            let long = elapsed(|| spin(64 + loops));
             let mut counter = Counter {
                 _syst: syst,
                 ticks: long.wrapping_sub(short) & RELOAD,
-                instructions: 2 * 4096,
+                instructions: 2 * loops,
                 overhead: 0,
             };
             counter.overhead = counter.measure(|| ()).1;
             counter
+        }
+
+        /// Gives SysTick back.
+        pub fn release(self) -> SYST {
+            self._syst
         }
 
         /// Runs `f` and returns its result and the instructions it took (at most

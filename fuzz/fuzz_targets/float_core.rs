@@ -21,7 +21,7 @@ struct Input {
 }
 
 fuzz_target!(|i: Input| {
-    let _ = (cbrt::inv_cbrt(i.load), sqrt::inv_sqrt(i.load), axial_force::axial_force_ratio(i.phi));
+    let _ = (cbrt::cbrt(i.load), sqrt::inv_sqrt(i.load), axial_force::axial_force_ratio(i.phi));
     let Ok(scene) = Scene::new(i.r1, i.r2, i.g, i.nu, i.mu) else { return };
     if let Ok(core) = EllipticScene::new(&scene) {
         let core = core.with_risk_slip_ratio(i.risk);

@@ -1,8 +1,8 @@
 //! The elliptic contact (paper sections 5-7) in f32.
 
 use super::{DEFAULT_RISK_SLIP_RATIO, Estimate, check};
-use crate::kernels::axial_force::axial_force_ratio;
-use crate::kernels::cbrt::{cbrt, inv_cbrt};
+use crate::kernels::axial_force::axial_force_ratio_nonnegative;
+use crate::kernels::cbrt::{cbrt, cbrt_normal};
 use crate::kernels::octave::OctaveTable;
 use crate::kernels::small_theta;
 use crate::reference::hertz_scale;
@@ -13,6 +13,10 @@ use core::f32::consts::{FRAC_PI_2, PI};
 /// f32 and take over from the tables.
 const SMALL_THETA: f32 = 9.094_947e-13; // 2^-40
 const SMALL_G: f32 = 7.450_581e-9; // 2^-27
+/// Loads outside [2^-120, 2^120] N take the cold path: zero, or a cube root that must
+/// scale. As bits: the lower end and the width of the range.
+const LIGHT_LOAD_BITS: u32 = 0x0380_0000; // 2^-120
+const NORMAL_LOAD_SPAN: u32 = 0x7b80_0000 - 0x0380_0000; // up to 2^120
 
 /// The tables one elliptic scene reads per sample: g(theta) (eqs 5, 6, 16) and its
 /// inverse (eq 18). [`Tables::FULL`] covers theta from 0 to pi/2; a firmware whose
@@ -21,9 +25,9 @@ const SMALL_G: f32 = 7.450_581e-9; // 2^-27
 #[derive(Debug, Clone, Copy)]
 pub struct Tables<'a> {
     /// g(theta) = m n theta.
-    pub g: OctaveTable<'a, 7>,
+    pub g: OctaveTable<'a>,
     /// theta(g), the inverse of g.
-    pub theta_of_g: OctaveTable<'a, 7>,
+    pub theta_of_g: OctaveTable<'a>,
 }
 
 impl Tables<'static> {
@@ -107,9 +111,10 @@ impl<'t> EllipticScene<'t> {
         })
     }
 
-    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`].
+    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`]
+    /// (a threshold that is not positive, NaN included, flags every sample).
     pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Self {
-        self.risk_slip_ratio = slip_ratio;
+        self.risk_slip_ratio = if slip_ratio > 0.0 { slip_ratio } else { 0.0 };
         self
     }
 
@@ -122,27 +127,28 @@ impl<'t> EllipticScene<'t> {
     /// narrowed tables.
     #[inline]
     pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
-        check(load, phi)?;
         let abs_phi = phi.abs();
         let theta = self.radius_factor * abs_phi;
-        if theta > FRAC_PI_2 {
+        // On the bits (theta >= 0): above pi/2, and also inf and NaN, whose patterns lie
+        // above; so a non-finite phi is refused here too.
+        if theta.to_bits() > FRAC_PI_2.to_bits() {
             return Err(Error::Angle);
         }
-        if load == 0.0 {
-            let s = if theta == 0.0 { 0.0 } else { f32::INFINITY };
-            return Ok(Estimate::new(
-                s,
-                0.0,
-                Some(0.0),
-                abs_phi,
-                self.risk_slip_ratio,
-            ));
-        }
-        let r = inv_cbrt(load); // P^(-1/3)
+        // One unsigned compare on the bits: load outside [2^-120, 2^120] (0, negative,
+        // NaN and inf included) goes to the cold path, which sorts them out.
+        let cbrt_load = if load.to_bits().wrapping_sub(LIGHT_LOAD_BITS) > NORMAL_LOAD_SPAN {
+            match self.extreme_load(load, phi, abs_phi, theta)? {
+                Ok(cbrt_load) => cbrt_load,
+                Err(zero_load) => return Ok(zero_load),
+            }
+        } else {
+            cbrt_normal(load)
+        };
         let g = self.g_of_theta(theta)?;
-        let s = self.slip_gain * g * r; // eq (16)
-        let force = (self.friction * (load * axial_force_ratio(s))).copysign(phi); // eq (21), F <= mu P
-        let g0 = self.critical_gain * (load * r * r); // eq (18) at d/b = 1
+        let s = self.slip_gain * g / cbrt_load; // eq (16)
+        // eq (21); F <= mu P, formed so that mu P cannot overflow before the ratio.
+        let force = (self.friction * (load * axial_force_ratio_nonnegative(s))).copysign(phi);
+        let g0 = self.critical_gain * cbrt_load; // eq (18) at d/b = 1
         let critical = self.theta_of_g(g0)?.map(|t| t * self.inv_radius_factor);
         Ok(Estimate::new(
             s,
@@ -151,6 +157,32 @@ impl<'t> EllipticScene<'t> {
             abs_phi,
             self.risk_slip_ratio,
         ))
+    }
+
+    /// Loads outside [2^-120, 2^120] N: bad input (a typed error), zero load (an
+    /// unloaded contact slips wherever it is misaligned: d/b = inf, F = 0, phi0 = 0, the
+    /// finished estimate in `Ok(Err(..))`), or a cube root that must scale (`Ok(Ok(..))`).
+    #[cold]
+    #[inline(never)]
+    fn extreme_load(
+        &self,
+        load: f32,
+        phi: f32,
+        abs_phi: f32,
+        theta: f32,
+    ) -> Result<Result<f32, Estimate>, Error> {
+        check(load, phi)?;
+        if load == 0.0 {
+            let s = if theta == 0.0 { 0.0 } else { f32::INFINITY };
+            return Ok(Err(Estimate::new(
+                s,
+                0.0,
+                Some(0.0),
+                abs_phi,
+                self.risk_slip_ratio,
+            )));
+        }
+        Ok(Ok(cbrt(load)))
     }
 
     #[inline(always)]
@@ -176,7 +208,7 @@ impl<'t> EllipticScene<'t> {
     /// theta0 with g(theta0) = g; `Ok(None)` above g(pi/2) = pi/2 (no critical angle).
     #[inline(always)]
     fn theta_of_g(&self, g: f32) -> Result<Option<f32>, Error> {
-        if g > FRAC_PI_2 {
+        if g.to_bits() > FRAC_PI_2.to_bits() {
             return Ok(None);
         }
         match self.tables.theta_of_g.eval(g) {

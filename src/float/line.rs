@@ -52,9 +52,10 @@ impl LineScene {
         })
     }
 
-    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`].
+    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`]
+    /// (a threshold that is not positive, NaN included, flags every sample).
     pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Self {
-        self.risk_slip_ratio = slip_ratio;
+        self.risk_slip_ratio = if slip_ratio > 0.0 { slip_ratio } else { 0.0 };
         self
     }
 

@@ -70,7 +70,10 @@ impl Estimate {
 /// 0), angle finite.
 #[inline(always)]
 fn check(load: f32, phi: f32) -> Result<(), crate::Error> {
-    if !(0.0..f32::INFINITY).contains(&load) {
+    // On the bits: +0 and positive finite values are below the +inf pattern; -0 is
+    // the one negative pattern accepted. (Two integer compares instead of float ones.)
+    let bits = load.to_bits();
+    if bits >= 0x7f80_0000 && bits != 0x8000_0000 {
         return Err(crate::Error::Load);
     }
     if (phi.to_bits() & 0x7fff_ffff) >= 0x7f80_0000 {

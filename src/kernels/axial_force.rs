@@ -26,6 +26,16 @@ pub fn axial_force_ratio(s: f32) -> f32 {
     if s.is_nan() || s <= 0.0 {
         return 0.0;
     }
+    axial_force_ratio_nonnegative(s)
+}
+
+/// [`axial_force_ratio`] for `s >= 0` (d/b as the estimators form it: never negative or
+/// NaN), without the checks for what cannot come.
+#[inline(always)]
+pub(crate) fn axial_force_ratio_nonnegative(s: f32) -> f32 {
+    if s >= 1.0 {
+        return 1.0;
+    }
     if s < 0.5 {
         s * horner(&AXIAL_FORCE_LOW, s)
     } else {

@@ -1,29 +1,45 @@
 //! Octave tables: a function of x > 0 stored as one polynomial per octave of x,
-//! in the local variable `u = mantissa(x) - 3/2` in [-1/2, 1/2). The octave comes
-//! from the exponent bits: no logarithm, no search, no division. The tables
+//! in the local variable `u = mantissa(x)` in [1, 2), taken from the bits as they
+//! are. The octave comes from the exponent bits: no logarithm, no search, no
+//! division. The tables
 //! themselves are generated from the f64 reference (`cargo xtask tables`, src/tables.rs).
 
-/// A function tabulated from `2^first_exponent` up to `2^(first_exponent + len)`,
-/// each octave a polynomial of degree `C - 1` (coefficients lowest first).
+/// Degree of the polynomial per octave.
+pub const DEGREE: usize = 6;
+
+/// One octave's coefficients, lowest power first, padded to 8 so that a row is 32
+/// bytes and its address one shift (the pad is never read).
+pub type Row = [f32; 8];
+
+/// A function tabulated from `2^first_exponent` up to `2^(first_exponent + rows)`,
+/// each octave a polynomial of degree [`DEGREE`].
 #[derive(Debug, Clone, Copy)]
-pub struct OctaveTable<'a, const C: usize> {
-    /// Unbiased exponent of the first octave.
-    pub first_exponent: i32,
-    /// One row of coefficients per octave.
-    pub coeffs: &'a [[f32; C]],
+pub struct OctaveTable<'a> {
+    /// Biased exponent bits of the first octave (`first_exponent + 127`).
+    first_row: u32,
+    coeffs: &'a [Row],
 }
 
-impl<const C: usize> OctaveTable<'_, C> {
+impl<'a> OctaveTable<'a> {
+    /// The table whose first row is the octave `[2^first_exponent, 2^(first_exponent + 1))`.
+    pub const fn new(first_exponent: i32, coeffs: &'a [Row]) -> Self {
+        OctaveTable {
+            first_row: (first_exponent + 127) as u32,
+            coeffs,
+        }
+    }
+
     /// The value at `x`, or `None` when x is outside the table (below, above, negative,
     /// NaN or infinite: their exponent bits fall outside the rows).
     #[inline(always)]
     pub fn eval(&self, x: f32) -> Option<f32> {
         let bits = x.to_bits();
-        let row = (bits >> 23).wrapping_sub((self.first_exponent + 127) as u32) as usize;
-        let c = self.coeffs.get(row)?;
-        let u = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000) - 1.5;
-        let mut acc = c[C - 1];
-        let mut k = C - 1;
+        let c = self
+            .coeffs
+            .get((bits >> 23).wrapping_sub(self.first_row) as usize)?;
+        let u = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000); // mantissa in [1, 2)
+        let mut acc = c[DEGREE];
+        let mut k = DEGREE;
         while k > 0 {
             k -= 1;
             acc = acc * u + c[k];
@@ -31,14 +47,19 @@ impl<const C: usize> OctaveTable<'_, C> {
         Some(acc)
     }
 
+    /// Unbiased exponent of the first octave.
+    pub fn first_exponent(&self) -> i32 {
+        self.first_row as i32 - 127
+    }
+
     /// Smallest x in the table, `2^first_exponent`.
     pub fn lower(&self) -> f32 {
-        libm::ldexpf(1.0, self.first_exponent)
+        libm::ldexpf(1.0, self.first_exponent())
     }
 
     /// x below this are above the table, `2^(first_exponent + rows)`.
     pub fn upper(&self) -> f32 {
-        libm::ldexpf(1.0, self.first_exponent + self.coeffs.len() as i32)
+        libm::ldexpf(1.0, self.first_exponent() + self.coeffs.len() as i32)
     }
 }
 

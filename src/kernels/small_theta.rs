@@ -4,7 +4,7 @@
 //! `Lam = ln(8 sqrt(Lam) / theta) - 1`. This path is rare (phi of a nanoradian or
 //! less) and uses libm's `logf` for Lam: a few hundred instructions.
 
-use super::cbrt::{cbrt, inv_cbrt};
+use super::cbrt::cbrt;
 use super::sqrt::sqrt;
 
 /// `(8/pi^2)^(1/3)`.
@@ -45,7 +45,7 @@ pub fn g_small(theta: f32) -> f32 {
 /// `1/m(theta)` for `0 < theta < 2^-40`.
 pub fn inv_m_small(theta: f32) -> f32 {
     let lam = lambda(libm::logf(theta));
-    two_thirds_power(theta) * inv_cbrt(lam) * (1.0 / M_SCALE)
+    two_thirds_power(theta) / (cbrt(lam) * M_SCALE)
 }
 
 /// The theta with `g(theta) = g`, for `0 < g < 2^-27`.

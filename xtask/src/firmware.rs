@@ -216,7 +216,7 @@ fn step(start: Instant, what: &str) {
 }
 
 /// QEMU, defmt-print (installed here if missing, pinned), llvm-size.
-fn preflight() -> Result<(), String> {
+pub(crate) fn preflight() -> Result<(), String> {
     if !cross::have("qemu-system-arm") {
         return Err("qemu-system-arm not found: apt-get install -y qemu-system-arm".into());
     }

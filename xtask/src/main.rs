@@ -1,5 +1,6 @@
 //! Chores for people and CI alike: `cargo xtask <task>`.
 
+mod bench;
 mod cross;
 mod figures;
 mod firmware;
@@ -27,6 +28,11 @@ tasks:
     figures [--check]              write the paper's Figs 1-4 (and the speed against
                                    error from docs/bench.csv, if any) as SVG to docs/
                                    (--check: fail if a committed SVG differs)
+    bench [--csv] [--short]        speed against error: the benchmark image on Cortex-M0, M3,
+                                   M4F, M7 in QEMU (instructions) and the same code on the
+                                   host against the reference data (error); writes
+                                   docs/bench.csv, docs/speed-vs-error.svg and the README
+                                   table (--short: fewer samples, writes nothing)
     firmware [--readme]            build every firmware image and on-target test, run them
                                    in QEMU (Cortex-M4F, M7, M3, M0), print the size and
                                    stack table (--readme: write it into README.md); fail
@@ -109,6 +115,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Some("figures") => figures::run(&root().join("docs"), flag("--check")),
+        Some("bench") => bench::run(flag("--csv"), flag("--short")),
         Some("firmware") => firmware::run(flag("--readme")),
         Some("nopanic") => nopanic::run(),
         _ => {

@@ -108,11 +108,12 @@ pub fn fit(spec: &OctaveSpec) -> Vec<Vec<f32>> {
             } else {
                 1.0
             };
-            // Local variable u = t - 1/2 in [-1/2, 1/2): smaller powers, less rounding.
+            // Local variable: the mantissa X = 1 + t in [1, 2), which the firmware gets
+            // from the bits with no subtraction (one instruction less per lookup).
             chebyshev_fit(
-                |u| (spec.f)(x_of(spec, seg, u + 0.5)),
-                -0.5,
-                span - 0.5,
+                |u| (spec.f)(x_of(spec, seg, u - 1.0)),
+                1.0,
+                span + 1.0,
                 spec.degree,
             )
             .iter()
@@ -128,7 +129,7 @@ pub fn eval(spec: &OctaveSpec, coeffs: &[Vec<f32>], x: f32) -> Option<f32> {
     let base = ((spec.first_exponent + 127) as u32) << spec.segments_log2;
     let index = (x.to_bits() >> shift).checked_sub(base)? as usize;
     let t = (x.to_bits() & ((1 << shift) - 1)) as f32 * (1.0 / (1u32 << shift) as f32);
-    coeffs.get(index).map(|c| horner_f32(c, t - 0.5))
+    coeffs.get(index).map(|c| horner_f32(c, t + 1.0))
 }
 
 /// Worst relative error of the f32 table against the f64 function over `samples`
@@ -182,7 +183,13 @@ pub fn fit_axial_force(low: usize, high: usize) -> (Vec<f32>, Vec<f32>) {
 fn write_coeffs(out: &mut String, coeffs: &[Vec<f32>]) {
     for c in coeffs {
         out.push_str("    [");
-        for (i, x) in c.iter().enumerate() {
+        let padded: Vec<f32> = c
+            .iter()
+            .copied()
+            .chain(std::iter::repeat(0.0))
+            .take(8)
+            .collect();
+        for (i, x) in padded.iter().enumerate() {
             if i > 0 {
                 out.push_str(", ");
             }
@@ -200,7 +207,7 @@ pub fn source() -> String {
         "//! Tables of the f32 core, generated from the f64 reference by `cargo xtask tables`.\n\
          //! Do not edit: a test regenerates this file and fails on any drift.\n\n\
          use crate::fixed::uniform::UniformTable;\n\
-         use crate::kernels::octave::OctaveTable;\n\n",
+         use crate::kernels::octave::{OctaveTable, Row};\n\n",
     );
     for spec in specs() {
         assert_eq!(
@@ -216,7 +223,8 @@ pub fn source() -> String {
             spec.name
         )
         .unwrap();
-        writeln!(out, "pub const {}_ROWS: [[f32; {d}]; {n}] = [", spec.name).unwrap();
+        assert_eq!(d, 7, "the library's rows hold degree 6");
+        writeln!(out, "pub const {}_ROWS: [Row; {n}] = [", spec.name).unwrap();
         write_coeffs(&mut out, &coeffs);
         out.push_str("];\n\n");
         writeln!(out, "/// {}", spec.doc).unwrap();
@@ -228,13 +236,10 @@ pub fn source() -> String {
         .unwrap();
         writeln!(
             out,
-            "pub const {}: OctaveTable<'static, {d}> = OctaveTable {{",
-            spec.name
+            "pub const {0}: OctaveTable<'static> = OctaveTable::new({1}, &{0}_ROWS);\n",
+            spec.name, spec.first_exponent
         )
         .unwrap();
-        writeln!(out, "    first_exponent: {},", spec.first_exponent).unwrap();
-        writeln!(out, "    coeffs: &{}_ROWS,", spec.name).unwrap();
-        out.push_str("};\n\n");
     }
     let (lo, hi) = fit_axial_force(AXIAL_FORCE_DEGREES.0, AXIAL_FORCE_DEGREES.1);
     let pieces = [
