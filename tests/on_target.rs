@@ -299,4 +299,58 @@ mod tests {
         let line = LineScene::new(&scene).unwrap().with_risk_slip_ratio(0.1);
         defmt::assert!(line.estimate(2e5, 5e-4).unwrap().microslip_risk); // d/b = 0.12
     }
+
+    /// The fixed-point core's public paths (the Cortex-M0 and M3 run it in the
+    /// firmware): estimate, details and line contact against the reference within its
+    /// 1e-4, and its input range.
+    #[test]
+    fn fixed_core_matches_the_reference() {
+        use misalign::fixed::{FixedEllipticScene, FixedLineScene, Log2};
+        let rel = |got: f64, want: f64| {
+            if got == want {
+                0.0
+            } else {
+                ((got - want) / want).abs()
+            }
+        };
+        let (load_lsb, angle_lsb) = (1e-3, 1e-11);
+        for scene in [demo(), unequal()] {
+            let fixed = FixedEllipticScene::new(&scene, load_lsb, angle_lsb).unwrap();
+            let line = FixedLineScene::new(&scene, load_lsb, angle_lsb).unwrap();
+            for p in [1000u32 * 1000, 4000 * 1000] {
+                for a in [-150_000_000i32, 2_000_000, 40_000_000, 500_000_000] {
+                    let (load, phi) = (p as f64 * load_lsb, a as f64 * angle_lsb);
+                    let r = reference::elliptic(&scene, load, phi).unwrap();
+                    let e = fixed.estimate(p, a).unwrap();
+                    defmt::assert!(rel(e.slip_ratio.to_f64(), r.slip_ratio) <= 1e-4);
+                    let force =
+                        e.axial_force.to_f64() * if e.axial_force_negative { -1.0 } else { 1.0 };
+                    defmt::assert!(rel(force, r.axial_force) <= 1e-4);
+                    defmt::assert!(
+                        rel(
+                            e.critical_angle.unwrap().to_f64(),
+                            r.critical_angle.unwrap()
+                        ) <= 1e-4
+                    );
+                    let d = fixed.details(p, a).unwrap();
+                    defmt::assert!(
+                        rel(d.m.to_f64(), r.shape.m) <= 1e-4 && rel(d.b.to_f64(), r.b) <= 1e-4
+                    );
+                    let l = reference::line(&scene, load, phi).unwrap();
+                    let e = line.estimate(p, a).unwrap();
+                    defmt::assert!(rel(e.slip_ratio.to_f64(), l.slip_ratio) <= 1e-4);
+                    defmt::assert!(
+                        rel(e.critical_angle.unwrap().to_f64(), l.critical_angle) <= 1e-4
+                    );
+                }
+            }
+            // Zero load, zero angle, and the declared input range.
+            defmt::assert!(fixed.estimate(0, 1000).unwrap().slip_ratio == Log2::INFINITY);
+            defmt::assert!(fixed.estimate(1000, 0).unwrap().slip_ratio == Log2::ZERO);
+            let max = fixed.input_range().angle_max;
+            if max < i32::MAX as u32 {
+                defmt::assert!(fixed.estimate(1000, max as i32 + 1) == Err(Error::Angle));
+            }
+        }
+    }
 }

@@ -9,6 +9,13 @@
 static SCENE: [f64; 5] = [0.05, 0.05, 79.3e9, 0.3, 0.3];
 /// One sample `(load, phi)`.
 static SAMPLE: [f32; 2] = [1000.0, 2e-4];
+/// The same sample for the fixed-point core: counts of [`LOAD_LSB`] and [`ANGLE_LSB`].
+static COUNTS: (u32, i32) = (1_000_000, 20_000_000);
+
+/// The fixed-point core's load LSB in the minimal images (N per count).
+pub const LOAD_LSB: f64 = 1e-3;
+/// The fixed-point core's angle LSB in the minimal images (rad per count).
+pub const ANGLE_LSB: f64 = 1e-11;
 
 fn read<T: Copy>(x: &T) -> T {
     // SAFETY: a reference is valid for a read.
@@ -29,6 +36,11 @@ pub fn scene() -> (f64, f64, f64, f64, f64) {
 /// The sample `(load, phi)`.
 pub fn sample() -> (f32, f32) {
     (read(&SAMPLE[0]), read(&SAMPLE[1]))
+}
+
+/// The sample as fixed-point counts `(load, angle)`.
+pub fn counts() -> (u32, i32) {
+    read(&COUNTS)
 }
 
 /// Keeps `x` alive, as if the answer went out in a report: the optimiser must compute

@@ -9,7 +9,7 @@ mod common;
 #[cfg(target_os = "none")]
 mod panic;
 
-#[cfg(target_os = "none")]
+#[cfg(all(target_os = "none", target_abi = "eabihf"))]
 #[cortex_m_rt::entry]
 fn main() -> ! {
     use misalign::{Scene, float::LineScene};
@@ -19,6 +19,19 @@ fn main() -> ! {
     };
     let (load, phi) = common::sample();
     common::emit((scene, load, phi));
+    common::exit(0)
+}
+
+/// Without an FPU (Cortex-M0, M3) the image holds the fixed-point core.
+#[cfg(all(target_os = "none", not(target_abi = "eabihf")))]
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    use misalign::{Scene, fixed::FixedLineScene};
+    let (r1, r2, g, nu, mu) = common::scene();
+    let prepared = Scene::new(r1, r2, g, nu, mu)
+        .and_then(|s| FixedLineScene::new(&s, common::LOAD_LSB, common::ANGLE_LSB));
+    let Ok(scene) = prepared else { common::exit(2) };
+    common::emit((scene, common::counts()));
     common::exit(0)
 }
 
