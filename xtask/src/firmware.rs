@@ -25,7 +25,7 @@ use std::time::Instant;
 /// Per-sample estimator budget: flash (code + tables) and stack, in bytes. Applied to
 /// the cores marked `budget` below; lower them when the estimator beats them.
 pub const FLASH_BUDGET: u64 = 8 * 1024;
-pub const STACK_BUDGET: u64 = 512;
+pub const STACK_BUDGET: u64 = 256;
 
 struct Core {
     name: &'static str,
