@@ -10,6 +10,10 @@
 //!
 //! Each prepared scene states the input range it accepts ([`InputRange`]); outside it
 //! the answer is a typed error, never a wrapped value.
+//!
+//! The `fixed` crate was weighed and not used: its types fix the binary point at compile
+//! time, while these quantities span ten decades per scene and need a per-value
+//! exponent; a Q8.24 logarithm is one.
 
 pub mod logexp;
 pub mod uniform;
