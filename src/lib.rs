@@ -17,8 +17,10 @@
 //! # Ok::<(), misalign::Error>(())
 //! ```
 //!
-//! Layers: [`scene`] (one installation, validated), [`reference`] (the whole paper
-//! in f64). See ARCHITECTURE.md for which module owns what.
+//! Layers: [`scene`] (one installation, validated), [`reference`](mod@reference) (the
+//! whole paper in f64), [`float`] (the f32 core), [`fixed`] (the fixed-point core),
+//! [`kernels`] and [`tables`] (what the cores compute with). See ARCHITECTURE.md for
+//! which module owns what.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]

@@ -1,7 +1,7 @@
 //! The f64 reference: every equation of the paper, to a few ulps, `no_std` (libm).
 //! It is the ground truth the f32 and fixed-point cores are tested against and the
 //! source of their tables. Sub-modules follow the paper: [`normal`] (section 5),
-//! [`tangential`] (sections 6-7), [`line`] (section 8); this module holds the
+//! [`tangential`] (sections 6-7), [`line`](mod@line) (section 8); this module holds the
 //! per-sample results and the model choice of section 9.
 
 mod carlson;
@@ -438,7 +438,7 @@ impl Line {
 /// case the line solution with the load per unit length `P / length`.
 ///
 /// # Errors
-/// As [`elliptic`] and [`line`]; [`Error::PlaneHasNoEllipse`] for a plane without length.
+/// As [`elliptic`] and [`line()`]; [`Error::PlaneHasNoEllipse`] for a plane without length.
 pub fn estimate(scene: &Scene, load: f64, phi: f64) -> Result<Estimate, Error> {
     check_sample(load, phi)?;
     match scene.length() {
