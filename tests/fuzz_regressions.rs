@@ -116,3 +116,19 @@ fn overflowing_mu_p_times_zero_ratio() {
         assert!(!e.axial_force.is_nan());
     }
 }
+
+/// Fuzz (reference, in CI): at d/b = 0.9999997 eq (21) is 1 - 5e-17, and its sum
+/// rounded one ulp above 1; F/(mu P) never exceeds 1.
+#[test]
+fn axial_force_ratio_never_exceeds_one() {
+    use misalign::reference::tangential::axial_force_ratio;
+    for s in [
+        0.9999997112900018,
+        1.0 - 1e-9,
+        1.0 - f64::EPSILON,
+        0.999_999,
+    ] {
+        let f = axial_force_ratio(s);
+        assert!(f <= 1.0 && f > 0.999_999_999, "{s}: {f}");
+    }
+}

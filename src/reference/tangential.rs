@@ -65,7 +65,9 @@ pub fn axial_force_ratio(s: f64) -> f64 {
     let s2 = s * s;
     let root = libm::sqrt((1.0 - s) * (1.0 + s));
     let first = s2 * s2 * (3.0 + s2) / (4.0 * (1.0 + (1.0 + 0.5 * s2) * root));
-    first + 1.5 * s * libm::acos(s)
+    // Eq (21) is below 1 for s < 1 by (4 sqrt 2 / 5)(1 - s)^(5/2); once that is below an
+    // ulp the sum can round one ulp above 1: F never exceeds mu P.
+    libm::fmin(first + 1.5 * s * libm::acos(s), 1.0)
 }
 
 /// `d(F/(mu P))/ds = (3/2) (acos s - s sqrt(1 - s^2))` for `s < 1`, 0 beyond.

@@ -13,8 +13,17 @@ fn have(cmd: &mut Command) -> bool {
     cmd.output().map(|o| o.status.success()).unwrap_or(false)
 }
 
+/// How long each target runs.
+pub enum Budget {
+    /// Wall-clock seconds (exploration; differs from run to run).
+    Seconds(u32),
+    /// A fixed number of inputs from a fixed seed: the same inputs on every machine, so
+    /// that CI's pass is repeatable.
+    Runs(u64),
+}
+
 /// Runs the targets; Err with a message on a crash or a missing tool.
-pub fn run(root: &Path, seconds: u32) -> Result<(), String> {
+pub fn run(root: &Path, budget: Budget) -> Result<(), String> {
     if !have(Command::new("cargo").args(["+nightly", "--version"])) {
         return Err(
             "cargo-fuzz needs a nightly toolchain (`rustup toolchain install nightly`)".into(),
@@ -30,18 +39,16 @@ pub fn run(root: &Path, seconds: u32) -> Result<(), String> {
             return Err("cargo install cargo-fuzz failed".into());
         }
     }
+    let limits: Vec<String> = match budget {
+        Budget::Seconds(s) => vec![format!("-max_total_time={s}")],
+        Budget::Runs(n) => vec![format!("-runs={n}"), "-seed=1".into()],
+    };
     for target in TARGETS {
-        eprintln!("fuzzing {target} for {seconds} s");
+        eprintln!("fuzzing {target}: {}", limits.join(" "));
         let status = Command::new("cargo")
             .current_dir(root)
-            .args([
-                "+nightly",
-                "fuzz",
-                "run",
-                target,
-                "--",
-                &format!("-max_total_time={seconds}"),
-            ])
+            .args(["+nightly", "fuzz", "run", target, "--"])
+            .args(&limits)
             .status()
             .map_err(|e| e.to_string())?;
         if !status.success() {

@@ -20,7 +20,8 @@ usage: cargo xtask <task>
 tasks:
     tables [--check]               generate src/tables.rs from the f64 reference
                                    (--check: fail if the committed file differs)
-    fuzz [--seconds N]             every fuzz target for N seconds (default 60; nightly)
+    fuzz [--seconds N | --runs N]  every fuzz target for N seconds (default 60), or for N
+                                   inputs from a fixed seed (repeatable; CI); nightly
     sweep [--quick] [--readme]     every f32 kernel over every input of its domain against
                                    the reference (--quick strides; --readme writes the table)
     tables --explore | --explore-force | --explore-fixed | --derivatives
@@ -57,13 +58,17 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Some("fuzz") => {
-            let seconds = args
-                .iter()
-                .position(|a| a == "--seconds")
-                .and_then(|i| args.get(i + 1))
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(60);
-            match fuzz::run(&root(), seconds) {
+            let value = |name: &str| {
+                args.iter()
+                    .position(|a| a == name)
+                    .and_then(|i| args.get(i + 1))
+                    .and_then(|s| s.parse::<u64>().ok())
+            };
+            let budget = match (value("--runs"), value("--seconds")) {
+                (Some(n), _) => fuzz::Budget::Runs(n),
+                (None, s) => fuzz::Budget::Seconds(s.unwrap_or(60) as u32),
+            };
+            match fuzz::run(&root(), budget) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => {
                     eprintln!("xtask fuzz: {e}");
