@@ -141,15 +141,7 @@ impl FixedEllipticScene {
             )
         };
         if a == 0 {
-            return Ok(FixedEstimate {
-                slip_ratio: Log2::ZERO,
-                regime: Regime::Partial,
-                axial_force: Log2::ZERO,
-                axial_force_negative: false,
-                critical_angle: critical,
-                margin,
-                microslip_risk: false,
-            });
+            return Ok(zero_angle(critical, margin));
         }
         // d/b = A g(theta) P^(-1/3) (eq 16).
         let log_g = lookup(LOG_G_LOW, LOG_G_HIGH, self.log_theta_lsb + log2_u32(a))?;
@@ -253,6 +245,19 @@ pub struct FixedDetails {
 fn lookup(low: UniformTable<'static>, high: UniformTable<'static>, x: i32) -> Result<i32, Error> {
     let table = if x < high.start { low } else { high };
     table.eval(x).ok_or(Error::OutOfRange)
+}
+
+/// Zero angle: no slip and no force; the critical angle and margin still stand.
+pub(super) fn zero_angle(critical: Option<Log2>, margin: Option<i32>) -> FixedEstimate {
+    FixedEstimate {
+        slip_ratio: Log2::ZERO,
+        regime: Regime::Partial,
+        axial_force: Log2::ZERO,
+        axial_force_negative: false,
+        critical_angle: critical,
+        margin,
+        microslip_risk: false,
+    }
 }
 
 /// Zero load: an unloaded contact slips wherever it is misaligned (eq 16 with P = 0).

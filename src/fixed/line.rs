@@ -1,6 +1,6 @@
 //! Line contact (paper section 8) in fixed point: no table beyond log2 and exp2.
 
-use super::elliptic::zero_load;
+use super::elliptic::{zero_angle, zero_load};
 use super::logexp::{exp2_fixed, log2_u32};
 use super::{FixedEstimate, InputRange, Log2, constant, margin_counts};
 use crate::float::DEFAULT_RISK_SLIP_RATIO;
@@ -92,15 +92,7 @@ impl FixedLineScene {
             a,
         ));
         if a == 0 {
-            return Ok(FixedEstimate {
-                slip_ratio: Log2::ZERO,
-                regime: Regime::Partial,
-                axial_force: Log2::ZERO,
-                axial_force_negative: false,
-                critical_angle: critical,
-                margin,
-                microslip_risk: false,
-            });
+            return Ok(zero_angle(critical, margin));
         }
         let ls = self
             .log_slip

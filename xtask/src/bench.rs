@@ -111,6 +111,25 @@ fn worst3(got: (f64, f64, f64), row: &HashMap<String, String>) -> f64 {
         .max(rel(got.2, num(row, "phi0")))
 }
 
+/// Angle counts with the sign of phi.
+fn signed(counts: u32, phi: f64) -> i32 {
+    if phi < 0.0 {
+        -(counts as i32)
+    } else {
+        counts as i32
+    }
+}
+
+/// d/b, F and phi0 of a fixed-point estimate, as f64.
+fn fixed3(x: &misalign::fixed::FixedEstimate) -> (f64, f64, f64) {
+    let force = x.axial_force.to_f64() * if x.axial_force_negative { -1.0 } else { 1.0 };
+    (
+        x.slip_ratio.to_f64(),
+        force,
+        x.critical_angle.map_or(f64::NAN, |c| c.to_f64()),
+    )
+}
+
 /// Errors of every (model, operation) on the host, over the reference files.
 pub fn errors() -> Result<HashMap<(String, String), f64>, String> {
     let scenes = read("vectors_scene.csv")?;
@@ -149,22 +168,8 @@ pub fn errors() -> Result<HashMap<(String, String), f64>, String> {
         let (load_lsb, pc) = exact_lsb(p, 1 << 30, 0.0);
         let (angle_lsb, ac) = exact_lsb(phi, 1 << 30, FixedEllipticScene::min_angle_lsb(&s));
         let x = FixedEllipticScene::new(&s, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
-        let x = x
-            .estimate(pc, if phi < 0.0 { -(ac as i32) } else { ac as i32 })
-            .map_err(|e| e.to_string())?;
-        let force = x.axial_force.to_f64() * if x.axial_force_negative { -1.0 } else { 1.0 };
-        put(
-            "fixed",
-            "estimate",
-            worst3(
-                (
-                    x.slip_ratio.to_f64(),
-                    force,
-                    x.critical_angle.map_or(f64::NAN, |c| c.to_f64()),
-                ),
-                row,
-            ),
-        );
+        let x = x.estimate(pc, signed(ac, phi)).map_err(|e| e.to_string())?;
+        put("fixed", "estimate", worst3(fixed3(&x), row));
         let hb = hamrock_brewe::HamrockBrewe::new(
             s.r1(),
             s.r2(),
@@ -282,22 +287,8 @@ pub fn errors() -> Result<HashMap<(String, String), f64>, String> {
         let ((load_lsb, pc), (angle_lsb, ac)) =
             (exact_lsb(p, 1 << 30, 0.0), exact_lsb(phi, 1 << 30, 0.0));
         let x = FixedLineScene::new(&s, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
-        let x = x
-            .estimate(pc, if phi < 0.0 { -(ac as i32) } else { ac as i32 })
-            .map_err(|e| e.to_string())?;
-        let force = x.axial_force.to_f64() * if x.axial_force_negative { -1.0 } else { 1.0 };
-        put(
-            "fixed",
-            "estimate:line",
-            worst3(
-                (
-                    x.slip_ratio.to_f64(),
-                    force,
-                    x.critical_angle.map_or(f64::NAN, |c| c.to_f64()),
-                ),
-                row,
-            ),
-        );
+        let x = x.estimate(pc, signed(ac, phi)).map_err(|e| e.to_string())?;
+        put("fixed", "estimate:line", worst3(fixed3(&x), row));
     }
     Ok(e)
 }
