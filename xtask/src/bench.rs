@@ -403,10 +403,35 @@ fn readable(rows: &[Row]) -> String {
 
 /// The README's "Accuracy and cost" table: per kernel and per core, error and
 /// instructions on the M0 and the M4F.
+/// Bytes of table data (flash) that an operation reads, from the generated tables
+/// themselves; `None` where it is code only or not ours (libm). Code sizes are in the
+/// firmware's table (`cargo xtask firmware`).
+fn table_bytes(model: &str, operation: &str) -> Option<usize> {
+    use misalign::tables as t;
+    use std::mem::size_of_val as size;
+    let force = size(&t::AXIAL_FORCE_LOW) + size(&t::AXIAL_FORCE_HIGH);
+    let log_exp = size(t::LOG2_MANTISSA.values) + size(t::EXP2_FRACTION.values);
+    let log_g = size(t::LOG_G_LOW.values) + size(t::LOG_G_HIGH.values);
+    let log_theta = size(t::LOG_THETA_LOW.values) + size(t::LOG_THETA_HIGH.values);
+    Some(match (model, operation) {
+        ("f32", "estimate") => size(&t::G_OF_THETA_ROWS) + size(&t::THETA_OF_G_ROWS) + force,
+        ("f32", "table:g") => size(&t::G_OF_THETA_ROWS),
+        ("f32", "table:theta_of_g") => size(&t::THETA_OF_G_ROWS),
+        ("f32", "kernel:axial_force") => force,
+        ("f32", "estimate:line" | "kernel:cbrt" | "kernel:inv_sqrt") => 0,
+        ("fixed", "estimate") => log_exp + log_g + log_theta + size(t::LOG_FORCE_OVER_S.values),
+        ("fixed", "estimate:line") => log_exp,
+        ("fixed", "kernel:log2") => size(t::LOG2_MANTISSA.values),
+        ("fixed", "kernel:exp2") => size(t::EXP2_FRACTION.values),
+        ("fixed", "table:log_g") => log_g,
+        _ => return None,
+    })
+}
+
 fn accuracy_and_cost(rows: &[Row]) -> String {
     let mut s = String::new();
-    writeln!(s, "| model | operation | max relative error | instructions on Cortex-M0 (mean / max) | instructions on Cortex-M4F (mean / max) |").unwrap();
-    writeln!(s, "|---|---|--:|--:|--:|").unwrap();
+    writeln!(s, "| model | operation | max relative error | instructions on Cortex-M0 (mean / max) | instructions on Cortex-M4F (mean / max) | table bytes |").unwrap();
+    writeln!(s, "|---|---|--:|--:|--:|--:|").unwrap();
     let mut seen = Vec::new();
     for r in rows {
         let key = (r.model.clone(), r.operation.clone());
@@ -418,14 +443,16 @@ fn accuracy_and_cost(rows: &[Row]) -> String {
             find(rows, cpu, &r.model, &r.operation)
                 .map_or("-".to_string(), |x| format!("{} / {}", x.mean, x.max))
         };
+        let bytes = table_bytes(&r.model, &r.operation).map_or("-".to_string(), |b| b.to_string());
         writeln!(
             s,
-            "| {} | `{}` | {:.1e} | {} | {} |",
+            "| {} | `{}` | {:.1e} | {} | {} | {} |",
             r.model,
             r.operation,
             r.error,
             on("cortex-m0"),
-            on("cortex-m4f")
+            on("cortex-m4f"),
+            bytes
         )
         .unwrap();
     }
