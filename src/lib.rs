@@ -30,6 +30,7 @@
 extern crate std;
 
 mod error;
+pub mod estimator;
 pub mod fixed;
 pub mod float;
 pub mod kernels;
@@ -39,6 +40,7 @@ pub mod scene;
 pub mod tables;
 
 pub use error::Error;
+pub use estimator::{Estimate, Estimator};
 
 /// The README's examples run as doctests.
 #[cfg(doctest)]

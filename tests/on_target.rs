@@ -292,11 +292,15 @@ mod tests {
         defmt::assert!(!e.microslip_risk);
         defmt::assert!(
             full.with_risk_slip_ratio(0.5)
+                .unwrap()
                 .estimate(1000.0, 2e-4)
                 .unwrap()
                 .microslip_risk
         );
-        let line = LineScene::new(&scene).unwrap().with_risk_slip_ratio(0.1);
+        let line = LineScene::new(&scene)
+            .unwrap()
+            .with_risk_slip_ratio(0.1)
+            .unwrap();
         defmt::assert!(line.estimate(2e5, 5e-4).unwrap().microslip_risk); // d/b = 0.12
     }
 

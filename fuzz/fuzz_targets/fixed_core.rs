@@ -21,7 +21,7 @@ struct Input {
     load: u32,
     angle: i32,
     bits: u32,
-    risk: f64,
+    risk: f32,
 }
 
 fuzz_target!(|i: Input| {

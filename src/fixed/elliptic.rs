@@ -2,8 +2,10 @@
 
 use super::logexp::{div3, exp2_fixed, log2_u32};
 use super::uniform::{ONE, UniformTable};
-use super::{FixedEstimate, InputRange, LOG2_HALF_PI, Log2, constant, margin_counts};
-use crate::float::DEFAULT_RISK_SLIP_RATIO;
+use super::{
+    FixedEstimate, InputRange, LOG2_HALF_PI, Log2, Units, constant, log_risk, margin_counts,
+};
+use crate::estimator::DEFAULT_RISK_SLIP_RATIO;
 use crate::reference::{Regime, hertz_scale};
 use crate::tables::{
     LOG_FORCE_OVER_S, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW, LOG_THETA_HIGH, LOG_THETA_LOW,
@@ -31,6 +33,8 @@ pub struct FixedEllipticScene {
     /// log2(3 x load LSB / (2 pi)): log2 p0 = this + log2(counts) - log2 a - log2 b (eq 7).
     log_pressure: i32,
     range: InputRange,
+    /// What one count stands for (the estimator contract).
+    pub(super) units: Units,
 }
 
 impl FixedEllipticScene {
@@ -76,6 +80,7 @@ impl FixedEllipticScene {
             log_risk: constant(DEFAULT_RISK_SLIP_RATIO as f64)?,
             log_hertz: constant(v * cbrt_lsb)?,
             log_pressure: constant(3.0 * load_lsb / (2.0 * PI))?,
+            units: Units::new(load_lsb, angle_lsb)?,
             range: InputRange {
                 load_min: if load_min > u32::MAX as f64 {
                     u32::MAX
@@ -94,13 +99,18 @@ impl FixedEllipticScene {
         libm::exp2(LOG_G_LOW.start as f64 / ONE as f64) / scene.radius_factor() * (1.0 + 1e-12)
     }
 
-    /// The same scene with another d/b threshold (> 0) for the risk flag.
+    /// The same scene with another d/b threshold for the risk flag.
     ///
     /// # Errors
     /// [`Error::OutOfRange`] for a threshold that is not positive and finite.
-    pub fn with_risk_slip_ratio(mut self, slip_ratio: f64) -> Result<Self, Error> {
-        self.log_risk = constant(slip_ratio)?;
+    pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Result<Self, Error> {
+        self.log_risk = log_risk(slip_ratio)?;
         Ok(self)
+    }
+
+    /// The d/b threshold of the risk flag.
+    pub fn risk_slip_ratio(&self) -> f32 {
+        Log2(self.log_risk).to_f32()
     }
 
     /// The inputs this scene accepts.

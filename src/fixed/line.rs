@@ -2,8 +2,8 @@
 
 use super::elliptic::{zero_angle, zero_load};
 use super::logexp::{exp2_fixed, log2_u32};
-use super::{FixedEstimate, InputRange, Log2, constant, margin_counts};
-use crate::float::DEFAULT_RISK_SLIP_RATIO;
+use super::{FixedEstimate, InputRange, Log2, Units, constant, log_risk, margin_counts};
+use crate::estimator::DEFAULT_RISK_SLIP_RATIO;
 use crate::reference::Regime;
 use crate::{Error, Scene};
 use core::f64::consts::{FRAC_PI_2, PI};
@@ -23,6 +23,8 @@ pub struct FixedLineScene {
     /// log2 of the d/b risk threshold.
     log_risk: i32,
     range: InputRange,
+    /// What one count stands for (the estimator contract).
+    pub(super) units: Units,
 }
 
 impl FixedLineScene {
@@ -50,6 +52,7 @@ impl FixedLineScene {
             log_angle_lsb: constant(angle_lsb)?,
             log_force: constant(mu * load_lsb)?,
             log_risk: constant(DEFAULT_RISK_SLIP_RATIO as f64)?,
+            units: Units::new(load_lsb, angle_lsb)?,
             range: InputRange {
                 load_min: 1,
                 angle_max: libm::fmin(libm::floor(FRAC_PI_2 / angle_lsb), 2_147_483_648.0) as u32,
@@ -57,13 +60,18 @@ impl FixedLineScene {
         })
     }
 
-    /// The same scene with another d/b threshold (> 0) for the risk flag.
+    /// The same scene with another d/b threshold for the risk flag.
     ///
     /// # Errors
     /// [`Error::OutOfRange`] for a threshold that is not positive and finite.
-    pub fn with_risk_slip_ratio(mut self, slip_ratio: f64) -> Result<Self, Error> {
-        self.log_risk = constant(slip_ratio)?;
+    pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Result<Self, Error> {
+        self.log_risk = log_risk(slip_ratio)?;
         Ok(self)
+    }
+
+    /// The d/b threshold of the risk flag.
+    pub fn risk_slip_ratio(&self) -> f32 {
+        Log2(self.log_risk).to_f32()
     }
 
     /// The inputs this scene accepts.

@@ -62,6 +62,26 @@ impl Log2 {
         }
     }
 
+    /// The value as f32, by integer operations only (no libm, no soft-float exp2):
+    /// relative error at most [`logexp::EXP2_MAX_REL_ERROR`] plus half an f32 ulp;
+    /// below f32's normal range it is 0, above it +infinity.
+    pub fn to_f32(self) -> f32 {
+        let l = self.0;
+        if l == i32::MIN {
+            return 0.0;
+        }
+        let biased = (l >> 24) + 127;
+        if l == i32::MAX || biased >= 255 {
+            return f32::INFINITY;
+        }
+        if biased <= 0 {
+            return 0.0;
+        }
+        // 2^fraction with 23 fraction bits, in [2^23, 2^24).
+        let mantissa = exp2_fixed(l & (ONE - 1), 23);
+        f32::from_bits(((biased as u32) << 23) + (mantissa - (1 << 23)))
+    }
+
     /// The value as an unsigned fixed-point number with `frac_bits` fraction bits,
     /// truncated, saturating at `u32::MAX`.
     pub fn to_fixed(self, frac_bits: u32) -> u32 {
@@ -103,6 +123,108 @@ pub struct FixedEstimate {
     pub margin: Option<i32>,
     /// d/b at or above the scene's risk threshold.
     pub microslip_risk: bool,
+}
+
+/// The units of a fixed-point scene's inputs: what one count of load and of angle
+/// stands for, kept in f32 to convert SI samples and answers (the estimator contract).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Units {
+    /// N (or N/m) per load count.
+    load_lsb: f32,
+    /// rad per angle count.
+    angle_lsb: f32,
+}
+
+/// Largest f32 below 2^32 and 2^31: counts that fit u32 and i32.
+const U32_COUNTS: f32 = 4_294_967_040.0;
+const I32_COUNTS: f32 = 2_147_483_520.0;
+
+impl Units {
+    /// The units of LSBs already checked positive and finite.
+    pub(crate) fn new(load_lsb: f64, angle_lsb: f64) -> Result<Self, Error> {
+        let (load_lsb, angle_lsb) = (load_lsb as f32, angle_lsb as f32);
+        if load_lsb.is_normal() && angle_lsb.is_normal() {
+            Ok(Units {
+                load_lsb,
+                angle_lsb,
+            })
+        } else {
+            Err(Error::OutOfRange)
+        }
+    }
+
+    /// A sample in N and rad as counts, rounded to the nearest.
+    #[inline]
+    pub(crate) fn counts(&self, load: f32, phi: f32) -> Result<(u32, i32), Error> {
+        if load.is_nan() || load < 0.0 || load == f32::INFINITY {
+            return Err(Error::Load);
+        }
+        if !phi.is_finite() {
+            return Err(Error::Angle);
+        }
+        let load = load / self.load_lsb + 0.5;
+        let angle = phi.abs() / self.angle_lsb + 0.5;
+        if load > U32_COUNTS || angle > I32_COUNTS {
+            return Err(Error::OutOfRange);
+        }
+        let angle = angle as i32; // in [0, 2^31): fits
+        Ok((load as u32, if phi < 0.0 { -angle } else { angle }))
+    }
+
+    /// A fixed-point answer in SI f32 (a margin saturated at the i32 range of counts
+    /// stays saturated: choose the angle LSB so that the margins of interest fit).
+    pub(crate) fn estimate(&self, e: &FixedEstimate) -> crate::Estimate {
+        let force = e.axial_force.to_f32();
+        crate::Estimate {
+            slip_ratio: e.slip_ratio.to_f32(),
+            regime: e.regime,
+            axial_force: if e.axial_force_negative {
+                -force
+            } else {
+                force
+            },
+            critical_angle: e.critical_angle.map(Log2::to_f32),
+            margin: e.margin.map(|m| m as f32 * self.angle_lsb),
+            microslip_risk: e.microslip_risk,
+        }
+    }
+}
+
+/// The estimator contract for the fixed-point scenes: counts in, [`FixedEstimate`]
+/// out; [`Estimator::estimate_si`] converts through the scene's [`Units`].
+macro_rules! fixed_estimator {
+    ($($scene:ty),*) => {$(
+        impl crate::Estimator for $scene {
+            type Load = u32;
+            type Angle = i32;
+            type Output = FixedEstimate;
+            #[inline(always)]
+            fn estimate(&self, load: u32, angle: i32) -> Result<FixedEstimate, Error> {
+                <$scene>::estimate(self, load, angle)
+            }
+            #[inline(always)]
+            fn input(&self, load: f32, phi: f32) -> Result<(u32, i32), Error> {
+                self.units.counts(load, phi)
+            }
+            #[inline(always)]
+            fn to_estimate(&self, output: &FixedEstimate) -> crate::Estimate {
+                self.units.estimate(output)
+            }
+            fn risk_slip_ratio(&self) -> f32 {
+                <$scene>::risk_slip_ratio(self)
+            }
+            fn with_risk_slip_ratio(self, slip_ratio: f32) -> Result<Self, Error> {
+                <$scene>::with_risk_slip_ratio(self, slip_ratio)
+            }
+        }
+    )*};
+}
+
+fixed_estimator!(FixedEllipticScene, FixedLineScene);
+
+/// The Q8.24 log2 of a risk threshold (positive and finite).
+fn log_risk(slip_ratio: f32) -> Result<i32, Error> {
+    constant(crate::estimator::check_risk(slip_ratio)? as f64)
 }
 
 /// An LSB for which `x = counts x LSB` holds exactly (to f64 rounding) with an integer

@@ -1,6 +1,7 @@
 //! The elliptic contact (paper sections 5-7) in f32.
 
 use super::{DEFAULT_RISK_SLIP_RATIO, Estimate, check};
+use crate::estimator::check_risk;
 use crate::kernels::axial_force::axial_force_ratio_nonnegative;
 use crate::kernels::cbrt::{cbrt, cbrt_normal};
 use crate::kernels::octave::OctaveTable;
@@ -111,11 +112,18 @@ impl<'t> EllipticScene<'t> {
         })
     }
 
-    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`]
-    /// (a threshold that is not positive, NaN included, flags every sample).
-    pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Self {
-        self.risk_slip_ratio = if slip_ratio > 0.0 { slip_ratio } else { 0.0 };
-        self
+    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`].
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] for a threshold that is not positive and finite.
+    pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Result<Self, Error> {
+        self.risk_slip_ratio = check_risk(slip_ratio)?;
+        Ok(self)
+    }
+
+    /// The d/b threshold of [`Estimate::microslip_risk`].
+    pub fn risk_slip_ratio(&self) -> f32 {
+        self.risk_slip_ratio
     }
 
     /// The estimate for load `load` (N) and misalignment `phi` (rad, signed).

@@ -1,6 +1,7 @@
 //! Line contact (paper section 8) in f32: no table, one inverse square root per sample.
 
 use super::{DEFAULT_RISK_SLIP_RATIO, Estimate, check};
+use crate::estimator::check_risk;
 use crate::kernels::sqrt::inv_sqrt;
 use crate::{Error, Scene};
 use core::f32::consts::FRAC_PI_2;
@@ -52,11 +53,18 @@ impl LineScene {
         })
     }
 
-    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`]
-    /// (a threshold that is not positive, NaN included, flags every sample).
-    pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Self {
-        self.risk_slip_ratio = if slip_ratio > 0.0 { slip_ratio } else { 0.0 };
-        self
+    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`].
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] for a threshold that is not positive and finite.
+    pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Result<Self, Error> {
+        self.risk_slip_ratio = check_risk(slip_ratio)?;
+        Ok(self)
+    }
+
+    /// The d/b threshold of [`Estimate::microslip_risk`].
+    pub fn risk_slip_ratio(&self) -> f32 {
+        self.risk_slip_ratio
     }
 
     /// The estimate for load `load` (N/m, or N with a length) and misalignment `phi`

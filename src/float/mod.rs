@@ -16,35 +16,15 @@ mod line;
 pub use elliptic::{Details, EllipticScene, Tables};
 pub use line::LineScene;
 
+use crate::estimator::Estimator;
+#[doc(no_inline)]
+pub use crate::estimator::{DEFAULT_RISK_SLIP_RATIO, Estimate};
 use crate::reference::Regime;
-
-/// The slip ratio at and above which [`Estimate::microslip_risk`] is raised, unless the
-/// scene sets another: 0.8, so that the flag comes before gross slip (d/b = 1).
-pub const DEFAULT_RISK_SLIP_RATIO: f32 = 0.8;
-
-/// The per-sample answer of both cores' f32 paths. Units SI: N (N/m for line contact
-/// without a length), rad.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Estimate {
-    /// Slip ratio d/b (eqs 16, 23); 0 at phi = 0, +inf at P = 0 with phi != 0.
-    pub slip_ratio: f32,
-    /// Partial slip (d/b < 1) or gross slip.
-    pub regime: Regime,
-    /// Axial force F with the sign of phi (eqs 21, 27, 29).
-    pub axial_force: f32,
-    /// Critical angle phi0 at this load (rad), where d/b = 1; `None` when no
-    /// theta <= pi/2 reaches d/b = 1 (elliptic contact at very high load).
-    pub critical_angle: Option<f32>,
-    /// `phi0 - |phi|` (rad): positive while part of the contact sticks.
-    pub margin: Option<f32>,
-    /// d/b at or above the scene's risk threshold.
-    pub microslip_risk: bool,
-}
 
 impl Estimate {
     /// Builds the common fields from d/b, F/(mu P) and phi0.
     #[inline(always)]
-    fn new(
+    pub(crate) fn new(
         slip_ratio: f32,
         force: f32,
         critical_angle: Option<f32>,
@@ -134,6 +114,25 @@ impl Prepared {
         }
     }
 
+    /// The d/b threshold of [`Estimate::microslip_risk`].
+    pub fn risk_slip_ratio(&self) -> f32 {
+        match self {
+            Prepared::Elliptic(e) => e.risk_slip_ratio(),
+            Prepared::Line(l) => l.risk_slip_ratio(),
+        }
+    }
+
+    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`].
+    ///
+    /// # Errors
+    /// [`crate::Error::OutOfRange`] for a threshold that is not positive and finite.
+    pub fn with_risk_slip_ratio(self, slip_ratio: f32) -> Result<Self, crate::Error> {
+        Ok(match self {
+            Prepared::Elliptic(e) => Prepared::Elliptic(e.with_risk_slip_ratio(slip_ratio)?),
+            Prepared::Line(l) => Prepared::Line(l.with_risk_slip_ratio(slip_ratio)?),
+        })
+    }
+
     /// The estimate of the chosen model (load in N; see [`LineScene`] for its units).
     ///
     /// # Errors
@@ -145,3 +144,35 @@ impl Prepared {
         }
     }
 }
+
+/// The estimator contract for the f32 scenes: SI values in and out, so that
+/// [`Estimator::input`] and [`Estimator::to_estimate`] are the identity.
+macro_rules! f32_estimator {
+    ($($scene:ty),*) => {$(
+        impl Estimator for $scene {
+            type Load = f32;
+            type Angle = f32;
+            type Output = Estimate;
+            #[inline(always)]
+            fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, crate::Error> {
+                <$scene>::estimate(self, load, phi)
+            }
+            #[inline(always)]
+            fn input(&self, load: f32, phi: f32) -> Result<(f32, f32), crate::Error> {
+                Ok((load, phi))
+            }
+            #[inline(always)]
+            fn to_estimate(&self, output: &Estimate) -> Estimate {
+                *output
+            }
+            fn risk_slip_ratio(&self) -> f32 {
+                <$scene>::risk_slip_ratio(self)
+            }
+            fn with_risk_slip_ratio(self, slip_ratio: f32) -> Result<Self, crate::Error> {
+                <$scene>::with_risk_slip_ratio(self, slip_ratio)
+            }
+        }
+    )*};
+}
+
+f32_estimator!(EllipticScene<'_>, LineScene, Prepared);
