@@ -11,6 +11,7 @@ use core::f64::consts::{FRAC_PI_2, PI};
 /// A prepared line-contact scene for the fixed-point core. Loads are per unit length
 /// (N/m) without a scene length, total (N) with one, as for [`crate::float::LineScene`].
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FixedLineScene {
     /// log2 of `sqrt(pi (1 - nu) G R l) / (2 mu)` x angle LSB / sqrt(load LSB) (eq 23).
     log_slip: i32,

@@ -24,6 +24,7 @@ const NORMAL_LOAD_SPAN: u32 = 0x7b80_0000 - 0x0380_0000; // up to 2^120
 /// scene declares a narrower range of misalignment can pass narrower ones (built at
 /// compile time with [`crate::kernels::octave::narrow_rows`]) and link only those rows.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Tables<'a> {
     /// g(theta) = m n theta.
     pub g: OctaveTable<'a>,
@@ -41,6 +42,7 @@ impl Tables<'static> {
 
 /// A prepared elliptic-contact scene: the per-sample constants of eqs (4), (16), (18).
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct EllipticScene<'t> {
     /// `c = 2 sqrt(R1 R2) / (R1 + R2)` (eq 4): theta = c |phi|.
     radius_factor: f32,
@@ -286,6 +288,7 @@ impl<'t> EllipticScene<'t> {
 
 /// The contact ellipse of one sample, on request ([`EllipticScene::details`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Details {
     /// Auxiliary angle theta (rad), eq (4).
     pub theta: f32,

@@ -69,6 +69,7 @@ fn check(load: f32, phi: f32) -> Result<(), crate::Error> {
 /// prepared; a firmware that knows its model uses [`EllipticScene`] or [`LineScene`]
 /// directly and links only that one.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Prepared {
     /// The contact ellipse fits on the rollers.
     Elliptic(EllipticScene<'static>),

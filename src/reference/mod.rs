@@ -27,6 +27,7 @@ pub const PRESSURE_LIMIT: f64 = 0.05;
 
 /// Which solution produced a result.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ContactModel {
     /// The contact ellipse, sections 5-7.
     Elliptic,
@@ -47,6 +48,7 @@ impl ContactModel {
 /// Where the theory's assumptions are stretched. The numbers are still the paper's
 /// equations evaluated exactly; these flags say how far to trust the physics.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Validity {
     /// |phi| above [`ANGLE_LIMIT`], or a critical angle above it.
     pub large_angle: bool,
@@ -65,6 +67,7 @@ impl Validity {
 
 /// Results of the elliptic solution (sections 5-7) for one sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Elliptic {
     /// Misalignment phi (rad), signed, as given.
     pub phi: f64,
@@ -104,6 +107,7 @@ pub struct Elliptic {
 
 /// Results of the line-contact solution (section 8) for one sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Line {
     /// Misalignment phi (rad), signed, as given.
     pub phi: f64,
@@ -137,6 +141,7 @@ pub struct Line {
 
 /// A result of either model, as chosen by [`estimate`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Estimate {
     /// The ellipse fits on the rollers (or no length was given).
     Elliptic(Elliptic),
