@@ -29,9 +29,12 @@
 //! let scene = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3)?;
 //! let core = Prepared::new(&scene, 5e3, 1e-5)?;
 //! let mut monitor = Monitor::new(core, Config::default()).expect("the defaults are valid");
-//! for i in 0..120u32 {
-//!     // 2 kN, 0.1 mrad, one sample a second.
-//!     monitor.process(Sample::new(i * 1000, 2e3, 1e-4).with_speed(2.0));
+//! for i in 0..300u32 {
+//!     // About 2 kN and 0.1 mrad with some noise (a value exactly constant for two
+//!     // minutes is a stuck sensor), one sample a second.
+//!     let noise = (i % 7) as f32;
+//!     let (load, phi) = (2e3 + noise, 1e-4 + 1e-7 * noise);
+//!     monitor.process(Sample::new(i * 1000, load, phi).with_speed(2.0));
 //! }
 //! assert_eq!(monitor.state(), RiskState::Normal);
 //! assert!(monitor.statistics().total_energy() > 0.0);
