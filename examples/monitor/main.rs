@@ -28,7 +28,9 @@ type Res<T> = Result<T, Box<dyn Error>>;
 #[command(name = "monitor", about, long_about = None)]
 struct Args {
     /// A recorded trace instead of the built-in scenario: CSV with columns `t` (s),
-    /// `P` (N), `phi` (rad) and optionally `V` (m/s) and `F` (N).
+    /// `P` (N), `phi` (rad) and optionally `V` (m/s) and `F` (N); an empty `V` or `F`
+    /// cell is "not measured" (nominal speed, estimated F), anything unreadable a
+    /// sensor fault.
     #[arg(long, value_name = "FILE.csv")]
     trace: Option<PathBuf>,
     /// The scene: CSV with one row of `R1,R2,G,nu,mu` (m, m, Pa, -, -) and an
@@ -132,9 +134,14 @@ fn read_trace(path: &PathBuf) -> Res<Vec<Sample>> {
         }
         // The node's free-running u32 ms counter.
         let time_ms = ((time_s * 1e3).round() as i64).rem_euclid(1 << 32) as u32;
+        // An empty cell of an optional column: not measured this time.
+        let optional = |j: Option<usize>| {
+            j.filter(|&j| !row.get(j).unwrap_or("").trim().is_empty())
+                .map(|j| num(j) as f32)
+        };
         let mut s = Sample::new(time_ms, num(p) as f32, num(phi) as f32);
-        s.speed = v.map(|j| num(j) as f32);
-        s.axial_force = f.map(|j| num(j) as f32).filter(|x| !x.is_nan());
+        s.speed = optional(v);
+        s.axial_force = optional(f);
         samples.push(s);
     }
     Ok(samples)

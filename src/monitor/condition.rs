@@ -33,7 +33,7 @@ fn median(values: &mut [f32]) -> f32 {
 /// in its place. The raw value enters the window either way, so that a real step
 /// passes once it fills half the window. No test until the window is full.
 pub(crate) fn hampel(window: &mut Window, x: f32, filter: &SpikeFilter, floor: f32) -> Option<f32> {
-    let n = usize::from(filter.window).min(SPIKE_WINDOW_CAPACITY);
+    let n = usize::from(filter.window).clamp(1, SPIKE_WINDOW_CAPACITY);
     let mut verdict = None;
     if window.len() >= n {
         let mut values = [0.0f32; SPIKE_WINDOW_CAPACITY];

@@ -28,7 +28,7 @@ pub enum FaultCause {
 }
 
 /// The values behind an event: the last valid estimate (for a `SensorFault` event,
-/// the one before the fault). SI units.
+/// the one before the fault; all zero when there was none yet). SI units.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Reading {

@@ -364,7 +364,7 @@ impl<E: Estimator> Monitor<E> {
                 iv.start_ms = now;
             }
             iv.sum += m;
-            iv.count += 1;
+            iv.count = iv.count.saturating_add(1);
             if now.saturating_sub(iv.start_ms) >= u64::from(tc.interval_ms) {
                 let point = TrendPoint {
                     time_ms: now as u32,
