@@ -586,7 +586,14 @@ fn the_scenario_shows_every_condition_and_is_deterministic() {
     let events = replay_scenario(&mut m, &a);
     let s = m.statistics();
     assert_eq!((s.faults.gap, s.events_dropped), (1, 0));
-    assert!(s.faults.stuck > 0 && s.spikes > 0);
+    assert!(s.faults.stuck > 0);
+    // Every injected spike is rejected, and nothing else.
+    let injected = (0..scenario::SHIFT_S)
+        .filter(|t| t % scenario::SPIKE_EVERY_S == scenario::SPIKE_EVERY_S - 1)
+        .filter(|t| !(scenario::STOP_S.0..scenario::STOP_S.1).contains(t))
+        .filter(|t| !(scenario::DROPOUT_S.0..scenario::DROPOUT_S.1).contains(t))
+        .count();
+    assert_eq!(s.spikes as usize, injected);
     assert!(s.time_in_state_ms[RiskState::Stopped.index()] >= 1_200_000 - 60_000);
     for state in [
         RiskState::Microslip,
@@ -607,4 +614,50 @@ fn the_scenario_shows_every_condition_and_is_deterministic() {
     // The clock wrapped an hour in, unnoticed.
     assert_eq!(s.faults.time_backwards, 0);
     assert_eq!(m.elapsed_ms(), u64::from(scenario::SHIFT_S - 1) * 1000);
+}
+
+#[test]
+fn hampel_rejects_a_spike_but_follows_a_real_step() {
+    let spikes = Some(misalign::monitor::SpikeFilter {
+        window: 7,
+        k: 4.0,
+        load_floor: 50.0,
+        angle_floor: 1e-5,
+    });
+    let mut m = Monitor::new(core(), Config { spikes, ..plain() }).unwrap();
+    let phi = |i: u32| 1e-4 + 1e-7 * (i % 5) as f32;
+    for i in 0..20 {
+        m.process(Sample::new(i * 1000, LOAD + (i % 3) as f32, phi(i)));
+    }
+    // One sample at three times the load: replaced by the window's median.
+    m.process(Sample::new(20_000, 3.0 * LOAD, phi(20)));
+    assert_eq!(m.statistics().spikes, 1);
+    assert!((m.reading().unwrap().load - LOAD).abs() < 5.0);
+    // A lasting step to 1.5 times the load: rejected only until it fills half the window.
+    for i in 21..40 {
+        m.process(Sample::new(i * 1000, 1.5 * LOAD + (i % 3) as f32, phi(i)));
+    }
+    assert!(m.statistics().spikes <= 1 + 4, "{}", m.statistics().spikes);
+    assert!((m.reading().unwrap().load - 1.5 * LOAD).abs() < 5.0);
+}
+
+#[test]
+fn smoothing_weight_follows_the_real_time_step() {
+    let config = Config {
+        smoothing_tau_s: 3.0,
+        ..plain()
+    };
+    let (a, b) = (1e-4f32, 2e-4f32);
+    // One step of 3 s: 1 - 1/e of the way.
+    let mut m = Monitor::new(core(), config).unwrap();
+    m.process(Sample::new(0, LOAD, a));
+    m.process(Sample::new(3_000, LOAD + 1.0, b));
+    let one = m.reading().unwrap().phi;
+    assert!(((one - a) / (b - a) - (1.0 - (-1.0f32).exp())).abs() < 1e-5);
+    // Two steps of 1.5 s at the same value: the same place, whatever the sampling.
+    let mut m = Monitor::new(core(), config).unwrap();
+    m.process(Sample::new(0, LOAD, a));
+    m.process(Sample::new(1_500, LOAD + 1.0, b));
+    m.process(Sample::new(3_000, LOAD + 2.0, b));
+    assert!((m.reading().unwrap().phi - one).abs() < 1e-9);
 }

@@ -22,6 +22,16 @@ use std::path::PathBuf;
 
 type Res<T> = Result<T, Box<dyn Error>>;
 
+/// `println!` that ends the program quietly when stdout is closed (`| head`).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        let mut out = std::io::stdout().lock();
+        if writeln!(out, $($arg)*).is_err() {
+            std::process::exit(0);
+        }
+    }};
+}
+
 /// Replays the built-in scenario (or a trace) through the condition monitor: risk
 /// states, events, wear and time to critical.
 #[derive(Parser, Debug)]
@@ -227,7 +237,7 @@ fn replay<E: Estimator>(
     for (i, sample) in samples.enumerate() {
         let state = monitor.process(sample);
         while let Some(e) = monitor.pop_event() {
-            println!("{}", event_line(&e));
+            say!("{}", event_line(&e));
             events.push(e);
         }
         if let Some(r) = monitor.reading() {
@@ -268,13 +278,16 @@ fn hms(ms: u64) -> String {
 fn summary<E: Estimator>(m: &Monitor<E>) {
     let s = m.statistics();
     let total_ms: u64 = s.time_in_state_ms.iter().sum();
-    println!(
+    say!(
         "\n{:<14} {:>10} {:>7} {:>14}",
-        "state", "time", "%", "energy (J)"
+        "state",
+        "time",
+        "%",
+        "energy (J)"
     );
     for state in RiskState::ALL {
         let ms = s.time_in_state_ms[state.index()];
-        println!(
+        say!(
             "{:<14} {:>10} {:>6.1}% {:>14.3}",
             state.as_str(),
             hms(ms),
@@ -282,7 +295,7 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
             s.energy[state.index()].total()
         );
     }
-    println!(
+    say!(
         "{:<14} {:>10} {:>7} {:>14.3}",
         "total",
         hms(total_ms),
@@ -290,11 +303,14 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         s.total_energy()
     );
     let f = &s.faults;
-    println!(
+    say!(
         "\nsamples {}  repeated timestamps {}  spikes rejected {}  events dropped {}",
-        s.samples, s.repeated_timestamps, s.spikes, s.events_dropped
+        s.samples,
+        s.repeated_timestamps,
+        s.spikes,
+        s.events_dropped
     );
-    println!(
+    say!(
         "faults {}: non-finite {}, out of range {}, stuck {}, gap {}, time backwards {}, driver {}, estimator {}",
         f.total(),
         f.non_finite,
@@ -305,14 +321,14 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         f.driver,
         f.estimator
     );
-    println!(
+    say!(
         "max d/b {:.3}  max |F| {:.1} N  min margin {}",
         s.max_slip_ratio,
         s.max_axial_force,
         s.min_margin
             .map_or("-".into(), |m| format!("{:.3} mrad", m * 1e3))
     );
-    println!(
+    say!(
         "final state {}  time to critical {}",
         m.state().as_str(),
         m.time_to_critical()
@@ -401,11 +417,11 @@ fn run<E: Estimator>(core: E, args: &Args, samples: Vec<Sample>, builtin: bool) 
     });
     let monitor = Monitor::new(core, config).map_err(|e| format!("configuration: {e}"))?;
     if builtin {
-        println!(
+        say!(
             "built-in scenario: one 8 h shift of a press roller pair (see misalign::monitor::scenario)"
         );
     }
-    println!("{:>9}    {:<4} {:<42}", "t", "seq", "event");
+    say!("{:>9}    {:<4} {:<42}", "t", "seq", "event");
     let r = replay(monitor, samples.into_iter(), total);
     summary(&r.monitor);
     if let Some(path) = &args.events {

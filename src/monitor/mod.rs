@@ -173,8 +173,8 @@ impl<E: Estimator> Monitor<E> {
         }
     }
 
-    /// Clears the conditioning after a gap or a backwards step: old values say nothing
-    /// about the new ones.
+    /// Clears the conditioning after a sample that was not estimated (a fault, a
+    /// stop): the values before it say nothing about the ones after.
     fn restart_conditioning(&mut self) {
         self.load_window.clear();
         self.angle_window.clear();
@@ -209,9 +209,6 @@ impl<E: Estimator> Monitor<E> {
         *t = t.saturating_add(u64::from(dt_ms));
         if config.gap_ms > 0 && dt_ms > config.gap_ms {
             fault = Some(FaultCause::Gap);
-        }
-        if fault.is_some() {
-            self.restart_conditioning();
         }
         let st = &mut self.status;
         // Sensor checks, the first fault found wins.
@@ -261,6 +258,10 @@ impl<E: Estimator> Monitor<E> {
         };
         if let Some(f) = fault {
             self.status.stats.faults.count(f);
+        }
+        if candidate == RiskState::SensorFault || candidate == RiskState::Stopped {
+            // Not estimated: what the windows and the filter hold is stale now.
+            self.restart_conditioning();
         }
         let changed = self.status.alarm.offer(&config, candidate, now);
         let st = &mut self.status;

@@ -34,10 +34,15 @@ pub const ANGLE_MIN: f64 = 1e-5;
 /// The generator's seed.
 pub const SEED: u32 = 0x2545_f491;
 
-const DROPOUT_S: (u32, u32) = (2 * 3600, 2 * 3600 + 180);
-const STUCK_S: (u32, u32) = (3 * 3600, 3 * 3600 + 300);
-const STOP_S: (u32, u32) = (5 * 3600, 5 * 3600 + 1200);
-const SPIKE_EVERY_S: u32 = 1777;
+/// The dropout: no samples from the first to before the second second.
+pub const DROPOUT_S: (u32, u32) = (2 * 3600, 2 * 3600 + 180);
+/// The angle sensor repeats one value from the first to before the second second.
+pub const STUCK_S: (u32, u32) = (3 * 3600, 3 * 3600 + 300);
+/// The machine stands from the first to before the second second.
+pub const STOP_S: (u32, u32) = (5 * 3600, 5 * 3600 + 1200);
+/// A single-sample spike at every second `s` with `s % SPIKE_EVERY_S ==
+/// SPIKE_EVERY_S - 1`, except while the machine stands.
+pub const SPIKE_EVERY_S: u32 = 1777;
 
 /// The scenario's samples, in order (an iterator of [`SHIFT_S`] minus the dropout's
 /// samples).
