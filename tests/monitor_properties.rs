@@ -190,6 +190,24 @@ proptest! {
         check(core, config, &samples)?;
     }
 
+    /// The state taken out anywhere in a bad stream and put back goes on identically.
+    #[test]
+    fn restored_state_goes_on_identically(samples in samples(), config in configs(), cut in 0usize..300) {
+        let core = EllipticScene::new(&scene()).unwrap();
+        let Ok(mut whole) = Monitor::new(core, config) else { return Ok(()) };
+        let mut resumed = Monitor::new(core, config).unwrap();
+        let cut = cut.min(samples.len());
+        for s in &samples[..cut] {
+            whole.process(*s);
+            resumed.process(*s);
+        }
+        let mut resumed = Monitor::restore(core, config, &resumed.snapshot()).unwrap();
+        for s in &samples[cut..] {
+            prop_assert_eq!(whole.process(*s), resumed.process(*s));
+        }
+        prop_assert_eq!(whole.snapshot(), resumed.snapshot());
+    }
+
     /// Undrained, the queue keeps the newest events and counts every other one.
     #[test]
     fn no_event_is_lost_without_a_count(samples in samples(), drain_every in 1usize..50) {

@@ -63,7 +63,7 @@ pub use config::{
 pub use events::{EVENT_CAPACITY, Event, EventKind, FaultCause, Reading};
 pub use risk::{Alarm, RiskState};
 pub use sample::{Channel, Clock, Sample};
-pub use state::{MonitorState, Status};
+pub use state::{MonitorState, STATE_BUDGET_BYTES, Saved, Status};
 pub use stats::{FaultCounts, Statistics};
 pub use trend::{TrendInterval, TrendPoint, time_to_critical};
 pub use wear::{EnergySum, dissipated_power};
@@ -302,15 +302,11 @@ impl<E: Estimator> Monitor<E> {
         let st = &mut self.status;
         let (mut load, mut phi) = (sample.load, sample.phi);
         if let Some(filter) = &config.spikes {
-            if let Some(m) =
-                condition::hampel(&mut self.load_window, load, filter, filter.load_floor)
-            {
+            if let Some(m) = self.load_window.hampel(load, filter, filter.load_floor) {
                 load = m;
                 st.stats.spikes = st.stats.spikes.saturating_add(1);
             }
-            if let Some(m) =
-                condition::hampel(&mut self.angle_window, phi, filter, filter.angle_floor)
-            {
+            if let Some(m) = self.angle_window.hampel(phi, filter, filter.angle_floor) {
                 phi = m;
                 st.stats.spikes = st.stats.spikes.saturating_add(1);
             }
@@ -318,8 +314,9 @@ impl<E: Estimator> Monitor<E> {
         let dt_s = dt_ms as f32 * 1e-3;
         if config.smoothing_tau_s > 0.0 {
             if let Some([l, p]) = st.smoothed {
-                load = condition::smooth(l, load, dt_s, config.smoothing_tau_s);
-                phi = condition::smooth(p, phi, dt_s, config.smoothing_tau_s);
+                let w = condition::smoothing_weight(dt_s, config.smoothing_tau_s);
+                load = l + w * (load - l);
+                phi = p + w * (phi - p);
             }
             st.smoothed = Some([load, phi]);
         }

@@ -176,11 +176,14 @@ impl<E: Estimator> Monitor<E> {
         let mut m = Monitor::new(estimator, config)?;
         m.status = state.status;
         // The buffers were filled from at most their own capacity: the pushes fit.
+        let n = config
+            .spikes
+            .map_or(SPIKE_WINDOW_CAPACITY, |s| usize::from(s.window));
         for x in state.load_window.iter() {
-            let _ = m.load_window.push_back(x);
+            m.load_window.push_back(x, n);
         }
         for x in state.angle_window.iter() {
-            let _ = m.angle_window.push_back(x);
+            m.angle_window.push_back(x, n);
         }
         for p in state.trend.iter() {
             let _ = m.trend.push_back(p);
@@ -191,3 +194,8 @@ impl<E: Estimator> Monitor<E> {
         Ok(m)
     }
 }
+
+/// The whole state fits issue 10's RAM budget of 1 KiB on every target (checked when
+/// the crate compiles).
+pub const STATE_BUDGET_BYTES: usize = 1024;
+const _: () = assert!(core::mem::size_of::<MonitorState>() <= STATE_BUDGET_BYTES);
