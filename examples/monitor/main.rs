@@ -6,6 +6,7 @@
 //! trace through `misalign::monitor::Monitor`; prints every event as it happens and a
 //! summary table. See `--help`.
 
+mod input;
 mod plot;
 
 use clap::{Parser, ValueEnum};
@@ -83,78 +84,6 @@ pub struct Point {
     pub state: RiskState,
     pub load: f32,
     pub phi: f32,
-}
-
-fn read_scene(path: &Option<PathBuf>) -> Res<Scene> {
-    let Some(path) = path else {
-        let [r1, r2, g, nu, mu] = scenario::SCENE;
-        return Ok(Scene::new(r1, r2, g, nu, mu)?);
-    };
-    let mut reader = csv::Reader::from_path(path)?;
-    let headers = reader.headers()?.clone();
-    let row = reader
-        .records()
-        .next()
-        .ok_or("the scene file has no row")??;
-    let get = |name: &str| -> Res<Option<f64>> {
-        match headers.iter().position(|h| h.trim() == name) {
-            Some(i) => Ok(Some(row.get(i).unwrap_or("").trim().parse::<f64>()?)),
-            None => Ok(None),
-        }
-    };
-    let need = |name: &str| -> Res<f64> {
-        get(name)?.ok_or_else(|| format!("the scene file lacks column {name}").into())
-    };
-    let scene = Scene::new(
-        need("R1")?,
-        need("R2")?,
-        need("G")?,
-        need("nu")?,
-        need("mu")?,
-    )?;
-    Ok(match get("length")? {
-        Some(l) => scene.with_length(l)?,
-        None => scene,
-    })
-}
-
-fn read_trace(path: &PathBuf) -> Res<Vec<Sample>> {
-    let mut reader = csv::Reader::from_path(path)?;
-    let headers = reader.headers()?.clone();
-    let col = |name: &str| headers.iter().position(|h| h.trim() == name);
-    let (t, p, phi) = match (col("t"), col("P"), col("phi")) {
-        (Some(t), Some(p), Some(phi)) => (t, p, phi),
-        _ => return Err("the trace needs columns t, P, phi".into()),
-    };
-    let (v, f) = (col("V"), col("F"));
-    let mut samples = Vec::new();
-    for (i, row) in reader.records().enumerate() {
-        let row = row?;
-        // An unreadable number becomes NaN: the monitor counts it as a sensor fault.
-        let num = |j: usize| {
-            row.get(j)
-                .unwrap_or("")
-                .trim()
-                .parse::<f64>()
-                .unwrap_or(f64::NAN)
-        };
-        let time_s = num(t);
-        if !time_s.is_finite() {
-            return Err(format!("row {}: t is not a number", i + 2).into());
-        }
-        // The node's free-running u32 ms counter.
-        let time_ms = ((time_s * 1e3).round() as i64).rem_euclid(1 << 32) as u32;
-        // An empty cell of an optional column: not measured this time.
-        let optional = |j: Option<usize>| {
-            j.filter(|&j| !row.get(j).unwrap_or("").trim().is_empty())
-                .map(|j| num(j) as f32)
-        };
-        let mut s = Sample::new(time_ms, num(p) as f32, num(phi) as f32);
-        s.speed = optional(v);
-        s.axial_force = optional(f);
-        samples.push(s);
-    }
-    Ok(samples)
 }
 
 fn event_line(e: &Event) -> String {
@@ -476,9 +405,15 @@ fn run<E: Estimator>(core: E, args: &Args, samples: Vec<Sample>, builtin: bool) 
 fn main() -> std::process::ExitCode {
     let args = Args::parse();
     let result = (|| -> Res<()> {
-        let scene = read_scene(&args.scene)?;
+        let scene = match &args.scene {
+            Some(path) => input::read_scene(std::fs::File::open(path)?)?,
+            None => {
+                let [r1, r2, g, nu, mu] = scenario::SCENE;
+                Scene::new(r1, r2, g, nu, mu)?
+            }
+        };
         let (samples, builtin) = match &args.trace {
-            Some(path) => (read_trace(path)?, false),
+            Some(path) => (input::read_trace(std::fs::File::open(path)?)?, false),
             None => (scenario::Scenario::new().collect::<Vec<_>>(), true),
         };
         let load_max = samples
