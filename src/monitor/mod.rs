@@ -83,6 +83,21 @@ pub struct Monitor<E> {
     events: events::EventQueue,
 }
 
+/// The monitor's state, time, status and undelivered events (the estimator, the
+/// configuration and the buffers are left out).
+#[cfg(feature = "defmt")]
+impl<E> defmt::Format for Monitor<E> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(
+            f,
+            "Monitor {{ state: {}, status: {}, pending_events: {} }}",
+            self.status.alarm.state,
+            self.status,
+            self.events.len()
+        );
+    }
+}
+
 /// Checks one channel's value: non-finite, then out of `[lo, hi]`.
 fn check(x: f32, lo: f32, hi: f32, channel: Channel) -> Option<FaultCause> {
     if !x.is_finite() {

@@ -47,6 +47,7 @@ pub const SPIKE_EVERY_S: u32 = 1777;
 /// The scenario's samples, in order (an iterator of [`SHIFT_S`] minus the dropout's
 /// samples).
 #[derive(Debug, Clone)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Scenario {
     second: u32,
     rng: u32,
