@@ -82,6 +82,8 @@ pub struct Point {
     pub margin: Option<f32>,
     pub force: f32,
     pub state: RiskState,
+    /// Whether this sample gave a new reading (not stopped, not faulted).
+    pub fresh: bool,
     pub load: f32,
     pub phi: f32,
 }
@@ -163,14 +165,22 @@ fn replay<E: Estimator>(
     let mut events = Vec::new();
     let mut points = Vec::new();
     let mut last_percent = usize::MAX;
+    let mut last_reading = None;
     for (i, sample) in samples.enumerate() {
         let state = monitor.process(sample);
         while let Some(e) = monitor.pop_event() {
             say!("{}", event_line(&e));
             events.push(e);
         }
-        if let Some(r) = monitor.reading() {
+        // A point only for a new reading (not while stopped or faulted): the figure
+        // shows gaps there, not the last value held.
+        let reading = monitor.reading();
+        let fresh = reading.is_some() && reading != last_reading;
+        last_reading = reading;
+        let r = reading.unwrap_or_default();
+        {
             points.push(Point {
+                fresh,
                 t: monitor.elapsed_ms() as f64 / 1e3,
                 slip_ratio: r.slip_ratio,
                 margin: r.margin,
@@ -333,11 +343,15 @@ fn run<E: Estimator>(core: E, args: &Args, samples: Vec<Sample>, builtin: bool) 
     let config = Config::default();
     let total = samples.len();
     let table = args.thresholds.as_ref().map(|_| {
-        let load_max = samples
+        // The load range the trace covers: up to its 99.9th percentile, so that a
+        // spike does not stretch it.
+        let mut loads: Vec<f32> = samples
             .iter()
             .map(|s| s.load)
             .filter(|l| l.is_finite())
-            .fold(0.0f32, f32::max);
+            .collect();
+        loads.sort_by(f32::total_cmp);
+        let load_max = loads.get(loads.len() * 999 / 1000).copied().unwrap_or(0.0) * 1.2;
         thresholds(
             &core,
             &config,

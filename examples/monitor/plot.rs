@@ -11,6 +11,9 @@ const GREEN_: RGBColor = RGBColor(0, 158, 115);
 const VERMILION: RGBColor = RGBColor(213, 94, 0);
 const GREY: RGBColor = RGBColor(150, 150, 150);
 
+/// A step longer than this (h) between plotted points is drawn as a gap.
+const GAP_H: f64 = 60.0 / 3600.0;
+
 /// At most this many points per curve (evenly decimated).
 const MAX_POINTS: usize = 4000;
 
@@ -35,6 +38,7 @@ pub fn timeline(path: &Path, points: &[Point], events: &[Event]) -> Res<()> {
     ];
     for (area, (name, colour, get)) in panels.iter().zip(series) {
         let values: Vec<(f64, f32)> = decimate(points)
+            .filter(|p| p.fresh || name == "state")
             .filter_map(|p| Some((p.t / 3600.0, finite(get(p)?)?)))
             .collect();
         let (mut lo, mut hi) = values
@@ -75,7 +79,15 @@ pub fn timeline(path: &Path, points: &[Point], events: &[Event]) -> Res<()> {
                 style,
             )))?;
         }
-        chart.draw_series(LineSeries::new(values, colour.stroke_width(1)))?;
+        // One line per run of samples: a stop, a fault or a dropout leaves a gap.
+        let mut start = 0;
+        for i in 1..=values.len() {
+            if i == values.len() || values[i].0 - values[i - 1].0 > GAP_H {
+                let run = values[start..i].iter().copied();
+                chart.draw_series(LineSeries::new(run, colour.stroke_width(1)))?;
+                start = i;
+            }
+        }
         if name == "d/b" {
             for (y, label) in [(0.8f32, "warning"), (1.0, "alarm")] {
                 if y > lo - pad && y < hi + pad {
@@ -117,6 +129,7 @@ pub fn thresholds(path: &Path, table: &[ThresholdRow], points: &[Point]) -> Res<
         .y_desc("misalignment (mrad)")
         .draw()?;
     let samples: Vec<(f64, f64)> = decimate(points)
+        .filter(|p| p.fresh)
         .filter(|p| f64::from(p.load) <= p_max && f64::from(p.phi.abs()) * 1e3 <= phi_max)
         .map(|p| (f64::from(p.load), f64::from(p.phi.abs()) * 1e3))
         .collect();
