@@ -185,6 +185,25 @@ fn start_up_inhibit_suppresses_alarms_after_a_start() {
 }
 
 #[test]
+fn a_load_dip_shorter_than_the_off_delay_neither_stops_nor_clears_an_alarm() {
+    // An inhibit (60 s) longer than the off-delay (30 s): were the dip a start, the
+    // inhibit would clear the alarm.
+    let config = Config {
+        inhibit_ms: 60_000,
+        on_delay_ms: 0,
+        ..plain()
+    };
+    let mut m = Monitor::new(core(), config).unwrap();
+    feed(&mut m, 0, 70, angle_for(1.2, LOAD));
+    assert_eq!(m.state(), RiskState::GrossSlip);
+    // Two samples below the stop load, then the alarm condition goes on.
+    m.process(Sample::new(70_000, 10.0, angle_for(1.2, LOAD)));
+    m.process(Sample::new(71_000, 10.0, angle_for(1.2, LOAD)));
+    let states = feed(&mut m, 72, 90, angle_for(1.2, LOAD));
+    assert!(states.iter().all(|&s| s == RiskState::GrossSlip));
+}
+
+#[test]
 fn stopped_has_no_alarm_and_no_wear() {
     let mut m = Monitor::new(core(), plain()).unwrap();
     feed(&mut m, 0, 60, angle_for(0.5, LOAD));

@@ -256,12 +256,9 @@ impl<E: Estimator> Monitor<E> {
         }
         let candidate = match fault {
             Some(_) => RiskState::SensorFault,
-            None if !running => {
-                st.alarm.note_running(false, now);
-                RiskState::Stopped
-            }
+            None if !running => RiskState::Stopped,
             None => {
-                st.alarm.note_running(true, now);
+                st.alarm.note_running(now);
                 match self.estimate(sample, dt_ms, held, now) {
                     Ok(c) => c,
                     Err(f) => {

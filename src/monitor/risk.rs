@@ -111,8 +111,9 @@ pub struct Alarm {
     /// A different candidate and the time (ms) it first appeared, on the same side
     /// (more or less severe) since.
     pub pending: Option<(RiskState, u64)>,
-    /// Monotonic time (ms) the machine last started (first sample or leaving
-    /// `Stopped`): the start-up inhibit runs from here.
+    /// Monotonic time (ms) the machine last started (its first running sample since
+    /// the monitor started or since the state was `Stopped`): the start-up inhibit runs
+    /// from here.
     pub started_ms: Option<u64>,
 }
 
@@ -148,12 +149,13 @@ impl Alarm {
             .is_none_or(|s| now_ms.saturating_sub(s) < u64::from(config.inhibit_ms))
     }
 
-    /// Notes whether the machine runs at `now_ms`, for the start-up inhibit.
-    pub(crate) fn note_running(&mut self, running: bool, now_ms: u64) {
-        match (running, self.started_ms) {
-            (true, None) => self.started_ms = Some(now_ms),
-            (false, Some(_)) => self.started_ms = None,
-            _ => {}
+    /// Notes a running sample at `now_ms`: the first since the monitor started or
+    /// since the state was `Stopped` starts the start-up inhibit. A stop that is not
+    /// reported (shorter than the off-delay) does not restart it, so that a dip of
+    /// the load never clears an alarm through the inhibit.
+    pub(crate) fn note_running(&mut self, now_ms: u64) {
+        if self.started_ms.is_none() {
+            self.started_ms = Some(now_ms);
         }
     }
 
@@ -181,6 +183,10 @@ impl Alarm {
         if now_ms.saturating_sub(since) >= u64::from(delay) {
             let previous = self.state;
             self.state = candidate;
+            if candidate == RiskState::Stopped {
+                // The next start runs the start-up inhibit again.
+                self.started_ms = None;
+            }
             self.since_ms = now_ms;
             self.pending = None;
             Some(previous)
