@@ -144,6 +144,39 @@ fn hx711_pin_errors_are_bus_faults() {
     sck_pin.done();
 }
 
+#[test]
+fn hx711_pin_error_mid_word_power_cycles_the_chip_before_the_next_read() {
+    let io = MockError::Io(std::io::ErrorKind::Other);
+    // Ready, first clock pulse, DOUT fails: a bus error, PD_SCK brought low again.
+    let mut dout = vec![
+        PinTx::get(State::Low),
+        PinTx::get(State::Low).with_error(io),
+    ];
+    let mut sck = vec![
+        PinTx::set(State::Low),
+        PinTx::set(State::High),
+        PinTx::set(State::Low),
+    ];
+    // The next read powers the chip down and up, then reads a whole word.
+    sck.extend([PinTx::set(State::High), PinTx::set(State::Low)]);
+    hx711_read(0x00_0321, 1, &mut dout, &mut sck);
+    let mut adc = Hx711::new(
+        PinMock::new(&dout),
+        PinMock::new(&sck),
+        NoopDelay::new(),
+        Timeout::HX711_10SPS,
+    )
+    .unwrap();
+    assert!(matches!(
+        adc.read(Hx711Channel::A128),
+        Err(AdcError::Bus(_))
+    ));
+    assert_eq!(adc.read(Hx711Channel::A128), Ok(0x321));
+    let (mut d, mut s, _) = adc.release();
+    d.done();
+    s.done();
+}
+
 /// 100 ms conversions (10 samples/s).
 const PERIOD_NS: u64 = 100_000_000;
 

@@ -64,6 +64,9 @@ pub struct Hx711<Dout, Sck, D> {
     timeout: Timeout,
     /// The channel and gain of the conversion under way.
     pending: Hx711Channel,
+    /// A pin failed in the middle of a read: the chip is at an unknown bit, so the
+    /// next attempt power-cycles it first.
+    resync: bool,
 }
 
 impl<Dout, Sck, D> Hx711<Dout, Sck, D>
@@ -87,6 +90,7 @@ where
             delay,
             timeout,
             pending: Hx711Channel::A128,
+            resync: false,
         })
     }
 
@@ -107,14 +111,23 @@ where
 
     /// One attempt: `None` if no conversion is ready, or if the ready one was made with
     /// another channel or gain than `channel` (it is clocked out, discarded, and the
-    /// next conversion is set to `channel`).
+    /// next conversion is set to `channel`). After a pin error in the middle of a read,
+    /// the next attempt power-cycles the chip (and gives `None`), so that a half-read
+    /// word is never taken for a conversion.
     pub fn try_read(
         &mut self,
         channel: Hx711Channel,
     ) -> Result<Option<i32>, PinError<Dout::Error, Sck::Error>> {
+        if self.resync {
+            self.power_down()?;
+            self.power_up()?;
+            self.resync = false;
+            return Ok(None);
+        }
         if !self.is_ready()? {
             return Ok(None);
         }
+        self.resync = true;
         let mut bits: u32 = 0;
         for _ in 0..24 {
             let high = self.pulse()?;
@@ -123,6 +136,7 @@ where
         for _ in 0..channel.extra_pulses() {
             self.pulse()?;
         }
+        self.resync = false;
         let made_with = core::mem::replace(&mut self.pending, channel);
         // Sign-extend the 24-bit two's complement code.
         let raw = ((bits << 8) as i32) >> 8;
