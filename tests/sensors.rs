@@ -585,6 +585,45 @@ fn sim_adc_out_of_its_channels_is_an_error_not_a_panic() {
     assert_eq!(adc.read(0), Ok(5));
 }
 
+#[test]
+fn a_scenario_replayed_through_the_simulated_chips_reads_back() {
+    use misalign::sensors::sim::TraceEncoder;
+    let clock = SimClock::new();
+    let chip = SimHx711::new(&clock, PERIOD_NS, &[]);
+    let mut load = sim_cell(&chip, &clock);
+    let mut probes = calibrated_probes(SimAdc::new(Rails::signed_bits(16).unwrap(), [&[], &[]]));
+    let mut cal = probes.calibration();
+    cal.zero_offset_m = 20e-6;
+    probes.set_calibration(cal).unwrap();
+    let mut encoder = TraceEncoder::new(load.calibration(), cal, 1e-3, 2);
+    let lsb_p = load.calibration().newtons_per_count;
+    // A steady load and angle for 40 samples, then a drift: no fault, values within the
+    // dither (2 counts) plus rounding.
+    for i in 0..80 {
+        let (p, phi) = if i < 40 {
+            (1500.0, 1e-4)
+        } else {
+            (1500.0 + 10.0 * i as f32, 1e-4 + 2e-6 * i as f32)
+        };
+        let codes = encoder.codes(p, phi);
+        chip.feed(codes.load);
+        probes.adc_mut().feed(0, codes.probe1);
+        probes.adc_mut().feed(1, codes.probe2);
+        let got_p = load.read().unwrap();
+        let got_phi = probes.read().unwrap().phi_rad;
+        assert!((got_p - p).abs() <= 3.0 * lsb_p, "{i}: {got_p} vs {p}");
+        // Probe 1: 1e-7 m a count, probe 2: 1.25e-7; 0.4 m span.
+        assert!(
+            (got_phi - phi).abs() <= (3.0 * 1e-7 + 3.0 * 1.25e-7) / 0.4,
+            "{i}: {got_phi} vs {phi}"
+        );
+    }
+    assert_eq!(load.detector().counts().total(), 0);
+    let exact = TraceEncoder::new(load.calibration(), cal, 1e-3, 0).codes(0.0, 0.0);
+    assert_eq!(exact.probe1, probe1_counts(1.02e-3));
+    assert_eq!(exact.probe2, probe2_counts(1e-3));
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 

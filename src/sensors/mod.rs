@@ -41,7 +41,7 @@
 //!   no hang".
 //! - **`ads1x1x` 0.3** (embedded-hal 1.0, maintained): a sound ADS1013/4/5/1113/4/5
 //!   driver whose one-shot `read` is non-blocking (`nb::WouldBlock` while converting).
-//!   It is wrapped, not forked: the [`ads1x1x`](crate::sensors::ads1x1x) module (feature
+//!   It is wrapped, not forked: the `sensors::ads1x1x` module (feature
 //!   `ads1x1x`) adapts it to this module's [`Adc`] trait with a bounded wait.
 //!
 //! embedded-hal 1.0 has no ADC trait (it was dropped from 1.0), hence the small [`Adc`]

@@ -13,15 +13,17 @@
 //!   same faults (timeout, bus error).
 //!
 //! A trace is a slice of raw codes, replayed in a loop; [`SimHx711::feed`] and
-//! [`SimAdc::feed`] put a one-off code ahead of it (e.g. a code computed from a
-//! scenario's load through [`LoadCalibration::counts_for`](super::LoadCalibration::counts_for)).
+//! [`SimAdc::feed`] put a one-off code ahead of it. [`TraceEncoder`] turns a scenario's
+//! samples (load P in N, angle phi in rad) into the codes that the calibrated sensors
+//! read back as those values, with a small dither so that a steady value is not taken
+//! for a stuck sensor.
 
 use core::cell::{Cell, RefCell};
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::{self, ErrorType, InputPin, OutputPin};
 
-use super::{Adc, AdcError, Hx711Channel, Rails};
+use super::{Adc, AdcError, Hx711Channel, LoadCalibration, MisalignmentCalibration, Rails};
 
 /// Simulated time, ns, shared by the delays and the simulated chips.
 #[derive(Debug, Default)]
@@ -405,4 +407,74 @@ fn next_code(trace: &[i32], next: &mut usize, fed: &mut Option<i32>) -> i32 {
     let raw = trace.get(*next % trace.len().max(1)).copied();
     *next = next.wrapping_add(1);
     raw.unwrap_or(0)
+}
+
+/// The raw codes of one sample: the load cell's and the two probes'.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SampleCodes {
+    /// The load cell's code.
+    pub load: i32,
+    /// Probe 1's code.
+    pub probe1: i32,
+    /// Probe 2's code.
+    pub probe2: i32,
+}
+
+/// Turns a scenario's samples into raw codes for the simulated chips: the codes the
+/// given calibrations read back as load P and angle phi (probe 2 held at `d2_m`,
+/// probe 1 at `d2_m + zero_offset_m + span_m * tan(phi)`), each with a deterministic
+/// dither of up to `dither` counts (xorshift32), as real noise would have.
+#[derive(Debug, Clone, Copy)]
+pub struct TraceEncoder<C> {
+    load: LoadCalibration<C>,
+    probes: MisalignmentCalibration,
+    d2_m: f32,
+    dither: u32,
+    state: u32,
+}
+
+impl<C: Copy> TraceEncoder<C> {
+    /// An encoder for these calibrations; `dither` counts of noise (0: exact codes).
+    pub fn new(
+        load: LoadCalibration<C>,
+        probes: MisalignmentCalibration,
+        d2_m: f32,
+        dither: u32,
+    ) -> Self {
+        TraceEncoder {
+            load,
+            probes,
+            d2_m,
+            dither,
+            state: 0x9E37_79B9,
+        }
+    }
+
+    /// A dither in `-dither ..= dither`.
+    fn noise(&mut self) -> i32 {
+        let mut x = self.state;
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        self.state = x;
+        let width = u64::from(self.dither) * 2 + 1;
+        // In -dither ..= dither; `as` truncates (no panic) for a dither beyond i32.
+        ((u64::from(x) % width) as i64 - i64::from(self.dither)) as i32
+    }
+
+    /// The codes of a sample with load `p_n` N and angle `phi_rad` rad.
+    pub fn codes(&mut self, p_n: f32, phi_rad: f32) -> SampleCodes {
+        let pr = &self.probes;
+        let d1 = self.d2_m + pr.zero_offset_m + pr.span_m * libm::tanf(phi_rad);
+        let (load, probe1, probe2) = (
+            self.load.counts_for(p_n),
+            pr.probe1.counts_for(d1),
+            pr.probe2.counts_for(self.d2_m),
+        );
+        SampleCodes {
+            load: load.saturating_add(self.noise()),
+            probe1: probe1.saturating_add(self.noise()),
+            probe2: probe2.saturating_add(self.noise()),
+        }
+    }
 }
