@@ -736,6 +736,43 @@ mod ads1115 {
     }
 
     #[test]
+    fn a_bus_that_reads_all_ones_is_out_of_range_then_stuck() {
+        // Every register reads 0xFFFF: "conversion done" and a code of -1 on both
+        // channels (AIN0, then AIN1 with MUX = 101).
+        let ones = || I2cTx::write_read(ADDR, vec![0x01], vec![0xFF, 0xFF]);
+        let mut tx = Vec::new();
+        for _ in 0..8 {
+            for config in [[0xC5, 0x83], [0xD5, 0x83]] {
+                tx.push(ones());
+                tx.push(I2cTx::write(ADDR, vec![0x01, config[0], config[1]]));
+                tx.push(ones());
+                tx.push(I2cTx::write_read(ADDR, vec![0x00], vec![0xFF, 0xFF]));
+            }
+        }
+        let mut i2c = I2cMock::new(&tx);
+        let adc = adapter(&i2c, Timeout::ADS1115_128SPS);
+        let cal = calibrated_probes(SimAdc::new(Rails::signed_bits(16).unwrap(), [&[], &[]]))
+            .calibration();
+        let limits = RawLimits::new(adc.rails());
+        let channels = (Ads1115Channel::A0, Ads1115Channel::A1);
+        let mut probes = Misalignment::new(adc, channels, cal, limits).unwrap();
+        // -1 count is 80 um below probe 1's range: out of range, until the eighth equal
+        // code in a row makes it stuck.
+        let kinds: Vec<_> = (0..8).map(|_| probes.read().unwrap_err()).collect();
+        let out = SensorFault {
+            sensor: SensorId::Probe1,
+            kind: FaultKind::OutOfRange,
+        };
+        assert_eq!(kinds[..7], [out; 7]);
+        assert_eq!(kinds[7].kind, FaultKind::Stuck);
+        let (d1, d2) = probes.detectors();
+        assert_eq!((d1.counts().out_of_range, d1.counts().stuck), (7, 1));
+        // Probe 2 reads 0 m at -400 counts: -1 is a plausible 50 um, caught as stuck.
+        assert_eq!((d2.counts().out_of_range, d2.counts().stuck), (0, 1));
+        i2c.done();
+    }
+
+    #[test]
     fn an_unanswered_address_is_a_bus_fault_of_the_probe() {
         let nack = || I2cTx::write_read(ADDR, vec![0x01], vec![0, 0]).with_error(ErrorKind::Other);
         let tx = [nack(), nack()];

@@ -177,7 +177,10 @@ impl RawLimits {
 /// Finds and counts the faults of one sensor in its raw codes and calibrated values.
 ///
 /// It keeps the last code and how often it repeated, so it sees stuck values and
-/// jumps; every fault it returns is counted in [`counts`](Self::counts).
+/// jumps; every fault it returns is counted in [`counts`](Self::counts). A constant
+/// garbage code inside the rails and the calibrated range (a bus reading all ones that
+/// happens to map to a plausible value) cannot be told from a steady signal until it
+/// has repeated `stuck_after` times: that many readings is the detection delay.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FaultDetector {

@@ -39,6 +39,7 @@ impl Hx711Channel {
 
 /// A pin error of the [`Hx711`] driver.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum PinError<EIn, EOut> {
     /// Reading DOUT failed.
     Dout(EIn),

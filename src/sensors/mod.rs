@@ -94,6 +94,7 @@ pub trait Adc {
 
 /// Why an [`Adc`] read gave no code.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum AdcError<E> {
     /// No conversion was ready within the bounded wait (a disconnected chip or probe).
     Timeout,

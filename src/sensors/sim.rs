@@ -411,6 +411,7 @@ fn next_code(trace: &[i32], next: &mut usize, fed: &mut Option<i32>) -> i32 {
 
 /// The raw codes of one sample: the load cell's and the two probes'.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SampleCodes {
     /// The load cell's code.
     pub load: i32,

@@ -12,8 +12,10 @@ pub fn rolling_speed(pulses: u32, pulses_per_rev: u32, radius_m: f32, dt_s: f32)
     if pulses_per_rev == 0 || dt_s.is_nan() || dt_s <= 0.0 {
         return None;
     }
-    let revs_per_s = (f64::from(pulses) / f64::from(pulses_per_rev)) / f64::from(dt_s);
-    let v = (2.0 * PI as f64 * f64::from(radius_m) * revs_per_s) as f32;
+    // f32 throughout (no soft f64 on a Cortex-M0 per sample); the counts of one
+    // interval are far below 2^24, where f32 is exact.
+    let revs_per_s = pulses as f32 / pulses_per_rev as f32 / dt_s;
+    let v = 2.0 * PI * radius_m * revs_per_s;
     v.is_finite().then_some(v)
 }
 
