@@ -65,7 +65,8 @@ fn hx711_channel_change_discards_the_conversion_made_with_the_old_gain() {
     let (mut dout, mut sck) = (Vec::new(), vec![PinTx::set(State::Low)]);
     hx711_read(0x00_1000, 2, &mut dout, &mut sck);
     hx711_read(0x00_0042, 2, &mut dout, &mut sck);
-    let bits = || std::iter::repeat_n(DelayTx::delay_us(1), 48 + 4);
+    // 1 us before the first edge, 1 us high and 1 us low for each of 26 pulses.
+    let bits = || std::iter::repeat_n(DelayTx::delay_us(1), 1 + 2 * 26);
     let delays = bits()
         .chain([DelayTx::delay_us(700)])
         .chain(bits())
@@ -291,6 +292,20 @@ fn sim_hx711_switches_channel_and_gain() {
     let before = chip.conversions();
     adc.read(Hx711Channel::A128).unwrap();
     assert_eq!(chip.conversions(), before + 1);
+}
+
+#[test]
+fn the_80_sps_timeout_covers_a_channel_change() {
+    let clock = SimClock::new();
+    let trace = noisy(-5);
+    let chip = SimHx711::new(&clock, 12_500_000, &trace);
+    let mut adc = Hx711::new(chip.dout(), chip.sck(), clock.delay(), Timeout::HX711_80SPS).unwrap();
+    assert_eq!(adc.read(Hx711Channel::B32), Ok(-5 + 2));
+    assert!(clock.now_ns() <= 50_000_000);
+    // At 10 samples/s the same wait is too short: a timeout, not a hang.
+    let slow = SimHx711::new(&clock, 100_000_000, &trace);
+    let mut adc = Hx711::new(slow.dout(), slow.sck(), clock.delay(), Timeout::HX711_80SPS).unwrap();
+    assert_eq!(adc.read(Hx711Channel::A128), Err(AdcError::Timeout));
 }
 
 #[test]

@@ -129,6 +129,8 @@ where
             return Ok(None);
         }
         self.resync = true;
+        // DOUT low to the first rising edge: at least 0.1 us (T1).
+        self.delay.delay_us(1);
         let mut bits: u32 = 0;
         for _ in 0..24 {
             let high = self.pulse()?;

@@ -152,6 +152,12 @@ impl Timeout {
         polls: 500,
         interval_us: 1000,
     };
+    /// For an HX711 at 80 samples/s (RATE pin high; 12.5 ms a conversion, 50 ms to
+    /// settle): 100 checks 500 µs apart.
+    pub const HX711_80SPS: Timeout = Timeout {
+        polls: 100,
+        interval_us: 500,
+    };
     /// For an ADS1115 at its default 128 samples/s (7.8 ms a conversion): 40 checks
     /// 500 µs apart.
     pub const ADS1115_128SPS: Timeout = Timeout {
