@@ -212,6 +212,123 @@ fn model_choice_round_trips() {
     assert!(mu_tally.exact > 1000 && phi_tally.exact > 500 && phi_tally.at_least > 300);
 }
 
+/// Round-trip bound of the f32 core, relative, times max(1, sensitivity).
+const FLOAT_BOUND: f64 = 2e-6;
+
+/// An f32 answer as f64, to share the tallies.
+fn wide(answer: Inverse<f32>) -> Inverse<f64> {
+    answer.map(f64::from)
+}
+
+#[test]
+fn float_round_trips_over_the_reference_scenes() {
+    use misalign::float::{EllipticScene, LineScene};
+    let (mut mu_tally, mut phi_tally) = (Tally::default(), Tally::default());
+    let mut refused = 0;
+    let mut sensitivity_worst = 0.0f64;
+    for (i, row) in read_rows("vectors_scene.csv").iter().enumerate() {
+        let scene = scene(row);
+        let (load, phi, mu) = (num(row, "P"), num(row, "phi"), num(row, "mu"));
+        let (Ok(core), Ok(placeholder)) = (
+            EllipticScene::new(&scene),
+            EllipticScene::new(&placeholder(&scene)),
+        ) else {
+            refused += 1;
+            continue;
+        };
+        let (load32, phi32) = (load as f32, phi as f32);
+        let Ok(est) = core.estimate(load32, phi32) else {
+            refused += 1;
+            continue;
+        };
+        let force = est.axial_force;
+        let answer = placeholder
+            .friction_from_axial_force(load32, phi32, force)
+            .unwrap();
+        match answer {
+            Inverse::AtLeast { value } => {
+                assert!(
+                    est.slip_ratio < 1e-5 && value <= mu as f32,
+                    "row {i}: {answer:?}"
+                );
+                mu_tally.at_least += 1;
+            }
+            _ => mu_tally.exact("f32 mu", i, wide(answer), mu, FLOAT_BOUND),
+        }
+        let answer = core.angle_from_axial_force(load32, force).unwrap();
+        // The sensitivity agrees with the reference's to 1e-4 times max(1, S): it is
+        // ~1/f'(s), and f' is steep in s near gross slip (plus the g table's difference).
+        let want = inverse::angle_elliptic(&scene, load, force as f64).unwrap();
+        if let (Some(a), Some(b)) = (answer.sensitivity(), want.sensitivity())
+            && b < SENSITIVITY_CAP
+        {
+            sensitivity_worst = sensitivity_worst.max(rel_err(a as f64, b) / b.max(1.0));
+        }
+        if force.abs() == mu as f32 * load32 {
+            let phi0 = est.critical_angle.unwrap();
+            assert_eq!(
+                answer,
+                Inverse::AtLeast {
+                    value: phi0.copysign(phi32)
+                },
+                "row {i}"
+            );
+            phi_tally.at_least += 1;
+        } else {
+            phi_tally.exact("f32 phi", i, wide(answer), phi, FLOAT_BOUND);
+        }
+    }
+    println!("refused {refused}\nmu: {mu_tally:?}\nphi: {phi_tally:?}");
+    println!("f32 phi sensitivity against the reference / max(1, S): {sensitivity_worst:.2e}");
+    assert!(sensitivity_worst < 1e-4);
+    assert!(mu_tally.exact > 1000 && phi_tally.exact > 500 && phi_tally.at_least > 500);
+
+    let (mut mu_tally, mut phi_tally) = (Tally::default(), Tally::default());
+    for (i, row) in read_rows("vectors_line.csv").iter().enumerate() {
+        let scene = scene(row);
+        let (load, phi, mu) = (num(row, "P") as f32, num(row, "phi") as f32, num(row, "mu"));
+        let core = LineScene::new(&scene).unwrap();
+        let est = core.estimate(load, phi).unwrap();
+        let force = est.axial_force;
+        let answer = LineScene::new(&placeholder(&scene))
+            .unwrap()
+            .friction_from_axial_force(load, phi, force)
+            .unwrap();
+        match answer {
+            Inverse::AtLeast { value } => {
+                assert!(
+                    est.slip_ratio < 1e-5 && value <= mu as f32,
+                    "row {i}: {answer:?}"
+                );
+                mu_tally.at_least += 1;
+            }
+            _ => mu_tally.exact("f32 line mu", i, wide(answer), mu, FLOAT_BOUND),
+        }
+        let answer = core.angle_from_axial_force(load, force).unwrap();
+        if force.abs() == mu as f32 * load {
+            let phi0 = est.critical_angle.unwrap();
+            assert_eq!(
+                answer,
+                Inverse::AtLeast {
+                    value: phi0.copysign(phi)
+                },
+                "row {i}"
+            );
+            phi_tally.at_least += 1;
+        } else {
+            phi_tally.exact(
+                "f32 line phi",
+                i,
+                wide(answer),
+                num(row, "phi"),
+                FLOAT_BOUND,
+            );
+        }
+    }
+    println!("line mu: {mu_tally:?}\nline phi: {phi_tally:?}");
+    assert!(mu_tally.exact > 300 && phi_tally.exact > 100 && phi_tally.at_least > 100);
+}
+
 #[test]
 fn forward_map_shape() {
     // F(mu) grows towards the no-slip limit pi^2 G a b |phi| / 4 (module docs).
@@ -252,6 +369,49 @@ fn forward_map_shape() {
         gross,
         Inverse::Exact {
             value: 0.01,
+            sensitivity: 1.0
+        }
+    );
+}
+
+#[test]
+fn float_bad_input() {
+    use misalign::float::{EllipticScene, LineScene, Prepared};
+    let s = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
+    let e = EllipticScene::new(&s).unwrap();
+    let l = LineScene::new(&s).unwrap();
+    let p = Prepared::new(&s, 1e4, 1e-5).unwrap();
+    for f in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        assert_eq!(e.friction_from_axial_force(1e3, 1e-4, f), Err(Error::Force));
+        assert_eq!(l.friction_from_axial_force(1e3, 1e-4, f), Err(Error::Force));
+        assert_eq!(p.angle_from_axial_force(1e3, f), Err(Error::Force));
+        assert_eq!(l.angle_from_axial_force(1e3, f), Err(Error::Force));
+    }
+    assert_eq!(e.angle_from_axial_force(f32::NAN, 1.0), Err(Error::Load));
+    assert_eq!(
+        e.friction_from_axial_force(1e3, f32::NAN, 1.0),
+        Err(Error::Angle)
+    );
+    assert_eq!(
+        e.friction_from_axial_force(1e3, 2.0, 1.0),
+        Err(Error::Angle)
+    );
+    let zero_load = Inverse::Inconsistent(Inconsistency::ZeroLoad);
+    assert_eq!(e.friction_from_axial_force(0.0, 1e-4, 1.0), Ok(zero_load));
+    assert_eq!(l.angle_from_axial_force(0.0, 1.0), Ok(zero_load));
+    let aligned = Inverse::Inconsistent(Inconsistency::NoMisalignment);
+    assert_eq!(e.friction_from_axial_force(1e3, 0.0, 1.0), Ok(aligned));
+    let opposite = Inverse::Inconsistent(Inconsistency::OppositeSign);
+    assert_eq!(l.friction_from_axial_force(1e3, -1e-4, 1.0), Ok(opposite));
+    let above = Inverse::Inconsistent(Inconsistency::AboveModel);
+    assert_eq!(e.angle_from_axial_force(1e3, -301.0), Ok(above));
+    assert_eq!(e.friction_from_axial_force(1e3, 1e-4, 1e9), Ok(above));
+    // Gross slip: mu = F / P, exactly.
+    let gross = e.friction_from_axial_force(1e3, 1e-2, 20.0).unwrap();
+    assert_eq!(
+        gross,
+        Inverse::Exact {
+            value: 0.02,
             sensitivity: 1.0
         }
     );
@@ -390,6 +550,24 @@ mod properties {
                 inverse::angle_estimate(&s, load, force),
             ].into_iter().flatten() {
                 physical(&answer, phi_max, force)?;
+            }
+        }
+
+        #[test]
+        fn float_never_panics_never_leaves_the_physical_range(
+            s in scenes(), load in prop_oneof![Just(0.0f32), any::<f32>(), (1e-6f32..1e9)],
+            phi in prop_oneof![Just(0.0f32), any::<f32>(), (-1.5f32..1.5)],
+            force in prop_oneof![Just(0.0f32), any::<f32>(), (-1e6f32..1e6)],
+        ) {
+            let Ok(p) = misalign::float::Prepared::new(&s, 1e6, 1e-6) else { return Ok(()) };
+            if let Ok(answer) = p.friction_from_axial_force(load, phi, force) {
+                let answer = answer.map(f64::from);
+                physical(&answer, f64::MAX, 1.0)?;
+                prop_assert!(answer.value().is_none_or(|v| v >= 0.0));
+            }
+            if let Ok(answer) = p.angle_from_axial_force(load, force) {
+                let phi_max = std::f64::consts::FRAC_PI_2 / s.radius_factor().min(1.0);
+                physical(&answer.map(f64::from), phi_max * (1.0 + 1e-6), f64::from(force))?;
             }
         }
 

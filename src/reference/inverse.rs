@@ -112,6 +112,17 @@ impl<T: Copy> Inverse<T> {
             _ => None,
         }
     }
+    /// The same answer with its numbers converted by `f` (e.g. f64 to f32).
+    pub fn map<U>(self, f: impl Fn(T) -> U) -> Inverse<U> {
+        match self {
+            Inverse::Exact { value, sensitivity } => Inverse::Exact {
+                value: f(value),
+                sensitivity: f(sensitivity),
+            },
+            Inverse::AtLeast { value } => Inverse::AtLeast { value: f(value) },
+            Inverse::Inconsistent(why) => Inverse::Inconsistent(why),
+        }
+    }
     /// `exact`, `at_least` or `inconsistent` (the CSV column `bound`).
     pub fn bound_str(&self) -> &'static str {
         match self {
@@ -138,7 +149,7 @@ fn check(load: f64, phi: f64, force: f64) -> Result<(), Error> {
 
 /// The cases every mu-inverse shares before the model: `Some(answer)` when F = 0 or
 /// P = 0 or phi = 0 decide it.
-fn friction_trivial(load: f64, phi: f64, force: f64) -> Option<Inverse<f64>> {
+pub(crate) fn friction_trivial(load: f64, phi: f64, force: f64) -> Option<Inverse<f64>> {
     if force == 0.0 {
         // F = 0 at P = 0 or phi = 0 holds for every mu: mu >= 0 is all it says. With
         // P, phi > 0 it is the frictionless limit of gross slip, mu = F/P = 0.
@@ -174,10 +185,7 @@ fn friction_from_ratio(
 ) -> Inverse<f64> {
     // Gross slip (mu <= K, s >= 1): F = mu P, eqs (21), (29).
     if force_per_load <= k {
-        return Inverse::Exact {
-            value: force_per_load,
-            sensitivity: 1.0,
-        };
+        return friction_bounded(force_per_load, 1.0);
     }
     let q = force_per_load / k;
     if q > no_slip_limit * (1.0 + SATURATION_ULPS) {
@@ -191,12 +199,23 @@ fn friction_from_ratio(
     };
     let mu = k / s;
     if q >= no_slip_limit * (1.0 - SATURATION_ULPS) {
-        return Inverse::AtLeast { value: mu };
+        return Inverse::AtLeast {
+            value: libm::fmin(mu, f64::MAX),
+        };
     }
     let f = ratio_over_s(s) * s;
-    Inverse::Exact {
-        value: mu,
-        sensitivity: 1.0 / (1.0 - s * slope(s) / f),
+    friction_bounded(mu, 1.0 / (1.0 - s * slope(s) / f))
+}
+
+/// An exact mu, or `AtLeast` the largest f64 where mu overflows (F/P above 1.8e308).
+fn friction_bounded(mu: f64, sensitivity: f64) -> Inverse<f64> {
+    if mu.is_finite() {
+        Inverse::Exact {
+            value: mu,
+            sensitivity,
+        }
+    } else {
+        Inverse::AtLeast { value: f64::MAX }
     }
 }
 
@@ -309,7 +328,11 @@ pub fn friction_estimate(
 
 /// The cases every phi-inverse shares: `Some(answer)` when P = 0 or F = 0 decide it.
 /// `zero_angle_sensitivity` is `S` as phi -> 0.
-fn angle_trivial(load: f64, force: f64, zero_angle_sensitivity: f64) -> Option<Inverse<f64>> {
+pub(crate) fn angle_trivial(
+    load: f64,
+    force: f64,
+    zero_angle_sensitivity: f64,
+) -> Option<Inverse<f64>> {
     if load == 0.0 {
         // Zero load: F = 0 at every phi (phi0 = 0), any other F is impossible.
         return Some(if force == 0.0 {
