@@ -11,7 +11,7 @@
 //! path (section 8) needs no table at all. Each type links only what it uses.
 
 mod elliptic;
-mod inverse;
+pub mod inverse;
 mod line;
 
 pub use elliptic::{Details, EllipticScene, Tables};
