@@ -12,9 +12,13 @@
 //!   `g = s P^(1/3) / A` and theta from the inverse table `theta(g)` that the critical
 //!   angle already uses (eq 18); line contact `phi = s phi0` (eqs 23, 27, 28).
 //!
-//! Newton steps on the existing tables measured better than new tables would: the
-//! kernel inverse is within 2e-7 of the f64 inverse (times its conditioning) with no
-//! table bytes, and `theta(g)` is the table the forward path links anyway.
+//! Newton steps on the existing tables rather than new inverse tables: the kernel
+//! inverse is within 2e-7 of the f64 inverse (times its conditioning) with no new table
+//! bytes, and `theta(g)` is the table the forward path links anyway; new tables were
+//! not built, as this leaves nothing for them to gain in accuracy. Cost (`cargo xtask
+//! bench --short`, instructions per call, mean / max over the practical samples):
+//! mu 184 / 373 and phi 211 / 364 on the Cortex-M4F (the forward estimate: 148 / 174),
+//! line contact 88 / 101 and 72 / 92.
 //!
 //! Error bound (tested in tests/inverse.rs over the public reference scenes, inputs
 //! rounded to f32, forward in f32 then inverse in f32): mu and phi within 2e-6 relative
@@ -25,11 +29,15 @@
 //! near gross slip).
 //!
 //! Section 9: [`Prepared`] fixes the model when the scene is prepared, so its inverse
-//! is that model's, unambiguous. The fixed-point core has no inverse: it serves
-//! FPU-less nodes whose forward estimate is a fixed chain of table look-ups in a
-//! logarithmic number system, and the Newton steps here need sums of terms of both
-//! signs close to cancelling (`2 - q`, `1 - u^2`, `h - f'`) which that number system
-//! does not form accurately; such a node can run this f32 code in software floats.
+//! is that model's, unambiguous.
+//!
+//! The fixed-point core ([`crate::fixed`]) has no inverse yet. In its logarithmic
+//! number system the inverse needs new log-domain tables (log s of log r, and of
+//! log(f/s)), generated and drift-tested like its forward tables, and the differences
+//! `1 - r`, `2 - q` near saturation, which that number system forms only through a
+//! difference (Gauss-logarithm) table whose error grows as they cancel; that is more
+//! than this budget. An FPU-less node (Cortex-M0, M3) can call these f32
+//! inverses in software floating point.
 
 use super::{EllipticScene, LineScene, Prepared, check};
 use crate::Error;
