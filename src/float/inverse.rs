@@ -70,13 +70,12 @@ fn check_force(load: f32, phi: f32, force: f32) -> Result<(), Error> {
 /// The cases decided before the model (F = 0, P = 0, phi = 0, signs), as the reference.
 #[inline(always)]
 fn friction_decided(load: f32, phi: f32, force: f32) -> Option<Inverse<f32>> {
-    friction_trivial(load as f64, phi as f64, force as f64).map(|a| a.map(|x| x as f32))
+    friction_trivial(load, phi, force)
 }
 
 #[inline(always)]
 fn angle_decided(load: f32, force: f32, zero_angle_sensitivity: f32) -> Option<Inverse<f32>> {
-    angle_trivial(load as f64, force as f64, zero_angle_sensitivity as f64)
-        .map(|a| a.map(|x| x as f32))
+    angle_trivial(load, force, zero_angle_sensitivity)
 }
 
 /// mu from `r = F / P` and `K = mu d/b`, given s from `q = r / K` and the slope of

@@ -133,6 +133,23 @@ impl<T: Copy> Inverse<T> {
     }
 }
 
+/// The two float types the inverses are written for (the f32 core shares the cases
+/// decided before the model with the reference).
+pub(crate) trait Real: Copy + PartialOrd {
+    const ZERO: Self;
+    const ONE: Self;
+}
+
+impl Real for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+}
+
+impl Real for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+}
+
 /// Relative distance below the no-slip limit of F(mu) within which F is taken as the
 /// limit itself (the forward map's rounding there is a few ulps): the mu-inverse then
 /// says only `AtLeast`.
@@ -149,26 +166,26 @@ fn check(load: f64, phi: f64, force: f64) -> Result<(), Error> {
 
 /// The cases every mu-inverse shares before the model: `Some(answer)` when F = 0 or
 /// P = 0 or phi = 0 decide it.
-pub(crate) fn friction_trivial(load: f64, phi: f64, force: f64) -> Option<Inverse<f64>> {
-    if force == 0.0 {
+pub(crate) fn friction_trivial<T: Real>(load: T, phi: T, force: T) -> Option<Inverse<T>> {
+    if force == T::ZERO {
         // F = 0 at P = 0 or phi = 0 holds for every mu: mu >= 0 is all it says. With
         // P, phi > 0 it is the frictionless limit of gross slip, mu = F/P = 0.
-        return Some(if load == 0.0 || phi == 0.0 {
-            Inverse::AtLeast { value: 0.0 }
+        return Some(if load == T::ZERO || phi == T::ZERO {
+            Inverse::AtLeast { value: T::ZERO }
         } else {
             Inverse::Exact {
-                value: 0.0,
-                sensitivity: 1.0,
+                value: T::ZERO,
+                sensitivity: T::ONE,
             }
         });
     }
-    if load == 0.0 {
+    if load == T::ZERO {
         return Some(Inverse::Inconsistent(Inconsistency::ZeroLoad));
     }
-    if phi == 0.0 {
+    if phi == T::ZERO {
         return Some(Inverse::Inconsistent(Inconsistency::NoMisalignment));
     }
-    if (force > 0.0) != (phi > 0.0) {
+    if (force > T::ZERO) != (phi > T::ZERO) {
         return Some(Inverse::Inconsistent(Inconsistency::OppositeSign));
     }
     None
@@ -328,22 +345,22 @@ pub fn friction_estimate(
 
 /// The cases every phi-inverse shares: `Some(answer)` when P = 0 or F = 0 decide it.
 /// `zero_angle_sensitivity` is `S` as phi -> 0.
-pub(crate) fn angle_trivial(
-    load: f64,
-    force: f64,
-    zero_angle_sensitivity: f64,
-) -> Option<Inverse<f64>> {
-    if load == 0.0 {
+pub(crate) fn angle_trivial<T: Real>(
+    load: T,
+    force: T,
+    zero_angle_sensitivity: T,
+) -> Option<Inverse<T>> {
+    if load == T::ZERO {
         // Zero load: F = 0 at every phi (phi0 = 0), any other F is impossible.
-        return Some(if force == 0.0 {
-            Inverse::AtLeast { value: 0.0 }
+        return Some(if force == T::ZERO {
+            Inverse::AtLeast { value: T::ZERO }
         } else {
             Inverse::Inconsistent(Inconsistency::ZeroLoad)
         });
     }
-    if force == 0.0 {
+    if force == T::ZERO {
         return Some(Inverse::Exact {
-            value: 0.0,
+            value: T::ZERO,
             sensitivity: zero_angle_sensitivity,
         });
     }
