@@ -469,6 +469,12 @@ fn bad_input() {
     let above = Inverse::Inconsistent(Inconsistency::AboveModel);
     assert_eq!(inverse::angle_elliptic(&s, 1e3, 301.0), Ok(above));
     assert_eq!(inverse::angle_line(&s, 1e3, -301.0), Ok(above));
+    // F within the rounding of mu P above it: saturated; further above: inconsistent.
+    let phi0 = reference::critical_angle(&s, 1e3).unwrap().0;
+    let near = inverse::angle_elliptic(&s, 1e3, 300.0 * (1.0 + 2.0 * f64::EPSILON));
+    assert_eq!(near, Ok(Inverse::AtLeast { value: phi0 }));
+    let beyond = inverse::angle_elliptic(&s, 1e3, 300.0 * (1.0 + 1e-12));
+    assert_eq!(beyond, Ok(above));
     let anything = Inverse::AtLeast { value: 0.0 };
     assert_eq!(inverse::angle_elliptic(&s, 0.0, 0.0), Ok(anything));
     assert_eq!(inverse::friction_elliptic(&s, 1e3, 0.0, 0.0), Ok(anything));

@@ -54,6 +54,10 @@ use core::f32::consts::FRAC_PI_2;
 /// limit (the f32 forward map's rounding there): the answer is then only `AtLeast`.
 const SATURATION_ULPS: f32 = 8.0 * f32::EPSILON;
 
+/// An F up to this far (relative) above mu P counts as mu P (the rounding of mu P
+/// and of F from inputs rounded to f32); further above, F is inconsistent.
+pub const ROUNDING_ABOVE_SATURATION: f32 = 4.0 * f32::EPSILON;
+
 /// Relative step of the difference that gives `d ln g / d ln theta`.
 const LOG_STEP: f32 = 1.0 / 64.0;
 
@@ -181,11 +185,11 @@ impl EllipticScene<'_> {
         }
         let saturated = self.friction * (load * 1.0); // mu P, formed as the forward path
         let abs_force = force.abs();
-        if abs_force > saturated {
+        if abs_force > saturated * (1.0 + ROUNDING_ABOVE_SATURATION) {
             return Ok(Inverse::Inconsistent(Inconsistency::AboveModel));
         }
         let g_per_slip = self.critical_gain * cbrt(load); // eq (16): g = s P^(1/3) / A
-        let answer = if abs_force == saturated {
+        let answer = if abs_force >= saturated {
             // Gross slip: only |phi| >= phi0 (eq 18 at d/b = 1).
             match self.theta_of_g(g_per_slip)? {
                 Some(theta0) => Inverse::AtLeast {
@@ -274,11 +278,11 @@ impl LineScene {
         }
         let saturated = self.friction * (load * 1.0);
         let abs_force = force.abs();
-        if abs_force > saturated {
+        if abs_force > saturated * (1.0 + ROUNDING_ABOVE_SATURATION) {
             return Ok(Inverse::Inconsistent(Inconsistency::AboveModel));
         }
         let phi0 = self.critical_gain * (load * inv_sqrt(load)); // eq (28)
-        let answer = if abs_force == saturated {
+        let answer = if abs_force >= saturated {
             Inverse::AtLeast { value: phi0 }
         } else {
             let r = abs_force / saturated;

@@ -13,7 +13,9 @@
 //!   proportional to `g(theta) = m n theta`, increasing in theta; eq 23: `s` is
 //!   proportional to |phi|), so F grows with |phi| up to the critical angle phi0
 //!   (`s = 1`, eqs 18, 28) and stays at `mu P` beyond. A measured F equal to mu P
-//!   only says `|phi| >= phi0` ([`Inverse::AtLeast`]); F above mu P is inconsistent.
+//!   only says `|phi| >= phi0` ([`Inverse::AtLeast`]), and so does an F up to
+//!   [`ROUNDING_ABOVE_SATURATION`] above it (the rounding of mu P); F further above
+//!   mu P is inconsistent.
 //!   For the ellipse at a load so high that no theta <= pi/2 reaches `s = 1`, the
 //!   largest F is `mu P f(s(pi/2)) < mu P`.
 //! - **F against mu** (P, phi fixed): `s = K / mu` with `K = mu d/b` independent of mu
@@ -154,6 +156,11 @@ impl Real for f32 {
 /// limit itself (the forward map's rounding there is a few ulps): the mu-inverse then
 /// says only `AtLeast`.
 const SATURATION_ULPS: f64 = 8.0 * f64::EPSILON;
+
+/// An F up to this far (relative) above mu P counts as mu P, the saturation: the
+/// rounding of mu P itself, formed from rounded inputs in another order. Further
+/// above, F is inconsistent.
+pub const ROUNDING_ABOVE_SATURATION: f64 = 4.0 * f64::EPSILON;
 
 /// Checks shared by all inverses: typed errors for undefined input.
 fn check(load: f64, phi: f64, force: f64) -> Result<(), Error> {
@@ -421,10 +428,10 @@ pub fn angle_elliptic(scene: &Scene, load: f64, force: f64) -> Result<Inverse<f6
 
 /// The elliptic phi-inverse for `force > 0`, its saturation at `saturated` = mu P.
 fn angle_elliptic_below(scene: &Scene, load: f64, force: f64, saturated: f64) -> Inverse<f64> {
-    if force > saturated {
+    if force > saturated * (1.0 + ROUNDING_ABOVE_SATURATION) {
         return Inverse::Inconsistent(Inconsistency::AboveModel);
     }
-    if force == saturated {
+    if force >= saturated {
         return match super::critical_angle(scene, load) {
             Some((phi0, _)) => Inverse::AtLeast { value: phi0 },
             // No theta <= pi/2 reaches gross slip: F stays below mu P.
@@ -502,10 +509,10 @@ fn angle_line_below(
         scene.friction(),
     );
     let saturated = saturated * length;
-    if force > saturated {
+    if force > saturated * (1.0 + ROUNDING_ABOVE_SATURATION) {
         return Inverse::Inconsistent(Inconsistency::AboveModel);
     }
-    if force == saturated {
+    if force >= saturated {
         return Inverse::AtLeast { value: phi0 };
     }
     let r = force / saturated;
