@@ -3,6 +3,25 @@
 //! and mu. The answer says when the inverse is ill-posed instead of giving a wrong
 //! number ([`Inverse`]).
 //!
+//! ```
+//! use misalign::{reference, Scene};
+//! use misalign::reference::inverse::{self, Inverse};
+//!
+//! let scene = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3)?;
+//! // Forward: 1 kN, 0.2 mrad (partial slip), then back from the axial force.
+//! let f = reference::elliptic(&scene, 1e3, 2e-4)?.axial_force;
+//! let answer = inverse::friction_elliptic(&scene, 1e3, 2e-4, f)?;
+//! assert_eq!(answer.bound_str(), "exact");
+//! let (mu, sensitivity) = (answer.value().unwrap(), answer.sensitivity().unwrap());
+//! assert!((mu / 0.3 - 1.0).abs() < 1e-12 && sensitivity > 1.0);
+//! let phi = inverse::angle_elliptic(&scene, 1e3, f)?.value().unwrap();
+//! assert!((phi / 2e-4 - 1.0).abs() < 1e-12);
+//! // Gross slip: F = mu P says only phi >= phi0.
+//! let f = reference::elliptic(&scene, 1e3, 1e-3)?.axial_force;
+//! assert!(matches!(inverse::angle_elliptic(&scene, 1e3, f)?, Inverse::AtLeast { .. }));
+//! # Ok::<(), misalign::Error>(())
+//! ```
+//!
 //! # Shape of the forward map
 //! Write `s = d/b` and `f(s) = F / (mu P)`: eq (21) for the ellipse, `2 s - s^2`
 //! (eq 27) for line contact, 1 for `s >= 1` (eqs 21, 29). Both `f` are increasing
