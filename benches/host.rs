@@ -66,8 +66,8 @@ fn estimate(c: &mut Criterion) {
 }
 
 fn csv_batch(c: &mut Criterion) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/reference/vectors_scene.csv");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/vectors_scene.csv");
     let Ok(input) = std::fs::read(&path) else {
         eprintln!("{} not found: CSV batch skipped", path.display());
         return;
