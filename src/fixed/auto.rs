@@ -5,7 +5,7 @@ use super::{
     FixedDetails, FixedEllipticScene, FixedEstimate, FixedLineDetails, FixedLineScene, InputRange,
     constant,
 };
-use crate::reference::{ContactModel, MODEL_SWITCH_BAND, ModelChoice};
+use crate::reference::{ContactModel, MODEL_SWITCH_BAND, ModelChoice, line_may_answer};
 use crate::{Error, Scene};
 
 /// A fixed-point scene prepared for both models, choosing one per sample by a
@@ -16,7 +16,8 @@ use crate::{Error, Scene};
 pub struct FixedAuto {
     /// `None` for a plane.
     elliptic: Option<FixedEllipticScene>,
-    line: FixedLineScene,
+    /// `None` where line contact never answers and its constants do not fit.
+    line: Option<FixedLineScene>,
     /// log2(length / 2) in Q8.24; `None` without a length (the ellipse always fits).
     log_half_length: Option<i32>,
     /// log2 of [`MODEL_SWITCH_BAND`] in Q8.24.
@@ -70,15 +71,23 @@ impl FixedAuto {
         let elliptic = match FixedEllipticScene::new(scene, load_lsb, angle_lsb) {
             Ok(e) => Some(e),
             Err(Error::PlaneHasNoEllipse) if choice != ModelChoice::Elliptic => None,
+            // Forced line contact needs the ellipse only for the flag near the switch.
+            Err(_) if choice == ModelChoice::Line => None,
             Err(e) => return Err(e),
         };
         let log_half_length = match scene.length() {
             Some(l) => Some(constant(l / 2.0)?),
             None => None,
         };
+        // The line scene, refused only where line contact may answer.
+        let line = match FixedLineScene::new(scene, load_lsb, angle_lsb) {
+            Ok(l) => Some(l),
+            Err(_) if !line_may_answer(scene, choice) => None,
+            Err(e) => return Err(e),
+        };
         Ok(FixedAuto {
             elliptic,
-            line: FixedLineScene::new(scene, load_lsb, angle_lsb)?,
+            line,
             log_half_length,
             log_band: constant(MODEL_SWITCH_BAND)?,
             choice,
@@ -94,20 +103,26 @@ impl FixedAuto {
             Some(e) => Some(e.with_risk_slip_ratio(slip_ratio)?),
             None => None,
         };
-        self.line = self.line.with_risk_slip_ratio(slip_ratio)?;
+        self.line = match self.line {
+            Some(l) => Some(l.with_risk_slip_ratio(slip_ratio)?),
+            None => None,
+        };
         Ok(self)
     }
 
     /// The inputs this scene accepts: the line scene's range, and the ellipse's where
     /// it may answer (its smallest load).
     pub fn input_range(&self) -> InputRange {
-        let line = self.line.input_range();
-        match (&self.elliptic, self.choice) {
-            (Some(e), ModelChoice::Elliptic) => e.input_range(),
-            (None, _) | (_, ModelChoice::Line) => line,
-            (Some(e), ModelChoice::Section9) => InputRange {
+        match (&self.elliptic, &self.line, self.choice) {
+            (Some(e), _, ModelChoice::Elliptic) | (Some(e), None, _) => e.input_range(),
+            (_, Some(l), ModelChoice::Line) | (None, Some(l), _) => l.input_range(),
+            (Some(e), Some(l), _) => InputRange {
                 load_min: e.input_range().load_min,
-                angle_max: line.angle_max.min(e.input_range().angle_max),
+                angle_max: l.input_range().angle_max.min(e.input_range().angle_max),
+            },
+            (None, None, _) => InputRange {
+                load_min: u32::MAX,
+                angle_max: 0,
             },
         }
     }
@@ -141,9 +156,10 @@ impl FixedAuto {
     #[inline]
     pub fn estimate(&self, load: u32, angle: i32) -> Result<FixedAutoEstimate, Error> {
         let (model, near_model_switch) = self.choose(load, angle)?;
-        let estimate = match (model, &self.elliptic) {
-            (ContactModel::Elliptic, Some(e)) => e.estimate(load, angle)?,
-            _ => self.line.estimate(load, angle)?,
+        let estimate = match (model, &self.elliptic, &self.line) {
+            (ContactModel::Elliptic, Some(e), _) => e.estimate(load, angle)?,
+            (_, _, Some(l)) => l.estimate(load, angle)?,
+            _ => return Err(Error::OutOfRange), // not reached: see `line_may_answer`
         };
         Ok(FixedAutoEstimate {
             model,
@@ -157,14 +173,12 @@ impl FixedAuto {
     /// # Errors
     /// As [`FixedAuto::estimate`].
     pub fn details(&self, load: u32, angle: i32) -> Result<FixedContactDetails, Error> {
-        match (self.choose(load, angle)?.0, &self.elliptic) {
-            (ContactModel::Elliptic, Some(e)) => {
+        match (self.choose(load, angle)?.0, &self.elliptic, &self.line) {
+            (ContactModel::Elliptic, Some(e), _) => {
                 e.details(load, angle).map(FixedContactDetails::Elliptic)
             }
-            _ => self
-                .line
-                .details(load, angle)
-                .map(FixedContactDetails::Line),
+            (_, _, Some(l)) => l.details(load, angle).map(FixedContactDetails::Line),
+            _ => Err(Error::OutOfRange), // not reached: see `line_may_answer`
         }
     }
 }

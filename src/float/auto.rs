@@ -2,7 +2,7 @@
 //! P / length when the ellipse is longer than the rollers, as `reference::estimate`.
 
 use super::{Details, EllipticScene, Estimate, LineDetails, LineScene, check};
-use crate::reference::{ContactModel, MODEL_SWITCH_BAND, ModelChoice};
+use crate::reference::{ContactModel, MODEL_SWITCH_BAND, ModelChoice, line_may_answer};
 use crate::{Error, Scene};
 use core::f32::consts::FRAC_PI_2;
 
@@ -18,7 +18,8 @@ use core::f32::consts::FRAC_PI_2;
 pub struct Auto {
     /// `None` for a plane (or radii whose c underflows f32's tables).
     elliptic: Option<EllipticScene<'static>>,
-    line: LineScene,
+    /// `None` where line contact never answers and its constants do not fit f32.
+    line: Option<LineScene>,
     /// 2 / length (1/m); 0 without a length (the ellipse always fits).
     two_over_length: f32,
     choice: ModelChoice,
@@ -62,6 +63,8 @@ impl Auto {
         let elliptic = match EllipticScene::new(scene) {
             Ok(e) => Some(e),
             Err(Error::PlaneHasNoEllipse) if choice != ModelChoice::Elliptic => None,
+            // Forced line contact needs the ellipse only for the flag near the switch.
+            Err(_) if choice == ModelChoice::Line => None,
             Err(e) => return Err(e),
         };
         let two_over_length = match scene.length() {
@@ -74,9 +77,15 @@ impl Auto {
             }
             None => 0.0,
         };
+        // The line scene, refused only where line contact may answer.
+        let line = match LineScene::new(scene) {
+            Ok(l) => Some(l),
+            Err(_) if !line_may_answer(scene, choice) => None,
+            Err(e) => return Err(e),
+        };
         Ok(Auto {
             elliptic,
-            line: LineScene::new(scene)?,
+            line,
             two_over_length,
             choice,
         })
@@ -85,7 +94,7 @@ impl Auto {
     /// The same scene with another d/b threshold for the risk flag (both models).
     pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Self {
         self.elliptic = self.elliptic.map(|e| e.with_risk_slip_ratio(slip_ratio));
-        self.line = self.line.with_risk_slip_ratio(slip_ratio);
+        self.line = self.line.map(|l| l.with_risk_slip_ratio(slip_ratio));
         self
     }
 
@@ -123,9 +132,10 @@ impl Auto {
     pub fn estimate(&self, load: f32, phi: f32) -> Result<AutoEstimate, Error> {
         Self::checked(load, phi)?;
         let (model, near_model_switch) = self.choose(load, phi);
-        let estimate = match (model, &self.elliptic) {
-            (ContactModel::Elliptic, Some(e)) => e.estimate(load, phi)?,
-            _ => self.line.estimate(load, phi)?,
+        let estimate = match (model, &self.elliptic, &self.line) {
+            (ContactModel::Elliptic, Some(e), _) => e.estimate(load, phi)?,
+            (_, _, Some(l)) => l.estimate(load, phi)?,
+            _ => return Err(Error::OutOfRange), // not reached: see `line_may_answer`
         };
         Ok(AutoEstimate {
             model,
@@ -140,9 +150,12 @@ impl Auto {
     /// As [`Auto::estimate`].
     pub fn details(&self, load: f32, phi: f32) -> Result<ContactDetails, Error> {
         Self::checked(load, phi)?;
-        match (self.choose(load, phi).0, &self.elliptic) {
-            (ContactModel::Elliptic, Some(e)) => e.details(load, phi).map(ContactDetails::Elliptic),
-            _ => self.line.details(load, phi).map(ContactDetails::Line),
+        match (self.choose(load, phi).0, &self.elliptic, &self.line) {
+            (ContactModel::Elliptic, Some(e), _) => {
+                e.details(load, phi).map(ContactDetails::Elliptic)
+            }
+            (_, _, Some(l)) => l.details(load, phi).map(ContactDetails::Line),
+            _ => Err(Error::OutOfRange), // not reached: see `line_may_answer`
         }
     }
 }

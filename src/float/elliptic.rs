@@ -241,6 +241,7 @@ impl<'t> EllipticScene<'t> {
         let theta = self.radius_factor * phi.abs();
         let inv_m = match tables::INV_M_OF_THETA.eval(theta) {
             Some(x) => x,
+            None if theta == 0.0 => return f32::INFINITY, // the strip limit: a = inf
             None if theta < SMALL_THETA => small_theta::inv_m_small(theta),
             None => 1.0, // not reached: the table covers theta up to pi/2
         };

@@ -276,6 +276,17 @@ fn length_ratio(scene: &Scene, a: f64) -> Option<f64> {
     scene.length().map(|l| 2.0 * (a / l))
 }
 
+/// Whether line contact can answer any sample of `scene` under `choice`: forced, or
+/// section 9's rule with a plane or a length. (A prepared core scene needs its line
+/// constants only then.)
+pub fn line_may_answer(scene: &Scene, choice: ModelChoice) -> bool {
+    match choice {
+        ModelChoice::Elliptic => false,
+        ModelChoice::Line => true,
+        ModelChoice::Section9 => scene.is_plane() || scene.length().is_some(),
+    }
+}
+
 /// Whether `ratio` = 2a / length lies within [`MODEL_SWITCH_BAND`] of 1.
 pub fn near_model_switch(ratio: f64) -> bool {
     (1.0 / MODEL_SWITCH_BAND..=MODEL_SWITCH_BAND).contains(&ratio)
