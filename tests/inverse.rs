@@ -381,31 +381,31 @@ fn forward_map_shape() {
     );
 }
 
-/// The f32 core through [`misalign::float::Prepared`] (section 9 decided once per
-/// scene), with a roller length that makes it pick line contact (total load and force)
-/// for half of the reference scenes.
+/// The f32 core through [`misalign::float::Auto`] (section 9 per sample), with a
+/// roller length that makes it pick line contact (total load and force) for about half
+/// of the reference scenes.
 #[test]
-fn prepared_round_trips() {
-    use misalign::float::Prepared;
+fn auto_round_trips() {
+    use misalign::float::Auto;
     let mut tally = [Tally::default(), Tally::default()];
     let mut models = [0usize; 2];
+    let mut ambiguous = 0;
     for (i, row) in read_rows("vectors_scene.csv").iter().enumerate() {
         let (load, phi, mu) = (num(row, "P"), num(row, "phi"), num(row, "mu"));
         let length = num(row, "a") * if i % 2 == 0 { 0.5 } else { 4.0 };
         let scene = scene(row).with_length(length).unwrap();
-        let (Ok(core), Ok(unread)) = (
-            Prepared::new(&scene, load, phi.abs()),
-            Prepared::new(&placeholder(&scene), load, phi.abs()),
-        ) else {
+        let (Ok(core), Ok(unread)) = (Auto::new(&scene), Auto::new(&placeholder(&scene))) else {
             continue;
         };
-        models[(core.model() == ContactModel::Line) as usize] += 1;
         let (p, a) = (load as f32, phi as f32);
-        let est = core.estimate(p, a).unwrap();
-        let force = est.axial_force;
+        let Ok(est) = core.estimate(p, a) else {
+            continue;
+        };
+        models[(est.model == ContactModel::Line) as usize] += 1;
+        let (est, force) = (est.estimate, est.estimate.axial_force);
         let answer = unread.friction_from_axial_force(p, a, force).unwrap();
         tally[0].friction(
-            "prepared mu",
+            "auto mu",
             i,
             wide(answer),
             mu,
@@ -420,22 +420,29 @@ fn prepared_round_trips() {
                 "row {i}: {answer:?}"
             );
             tally[1].at_least += 1;
+        } else if let Inverse::AtLeast { value } = answer {
+            // Both models give this F at some phi: the smaller bounds the true one.
+            assert!(value.abs() <= a.abs() * (1.0 + 2e-6), "row {i}: {answer:?}");
+            ambiguous += 1;
         } else {
-            tally[1].exact("prepared phi", i, wide(answer), phi, FLOAT_BOUND);
+            tally[1].exact("auto phi", i, wide(answer), phi, FLOAT_BOUND);
         }
     }
-    println!("models {models:?}\nmu: {:?}\nphi: {:?}", tally[0], tally[1]);
+    println!(
+        "models {models:?}, ambiguous {ambiguous}\nmu: {:?}\nphi: {:?}",
+        tally[0], tally[1]
+    );
     assert!(models[0] > 500 && models[1] > 500);
     assert!(tally[0].exact > 1000 && tally[1].exact > 500 && tally[1].at_least > 300);
 }
 
 #[test]
 fn float_bad_input() {
-    use misalign::float::{EllipticScene, LineScene, Prepared};
+    use misalign::float::{Auto, EllipticScene, LineScene};
     let s = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
     let e = EllipticScene::new(&s).unwrap();
     let l = LineScene::new(&s).unwrap();
-    let p = Prepared::new(&s, 1e4, 1e-5).unwrap();
+    let p = Auto::new(&s.with_length(0.01).unwrap()).unwrap();
     for f in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
         assert_eq!(e.friction_from_axial_force(1e3, 1e-4, f), Err(Error::Force));
         assert_eq!(l.friction_from_axial_force(1e3, 1e-4, f), Err(Error::Force));
@@ -620,7 +627,7 @@ mod properties {
             phi in prop_oneof![Just(0.0f32), any::<f32>(), (-1.5f32..1.5)],
             force in prop_oneof![Just(0.0f32), any::<f32>(), (-1e6f32..1e6)],
         ) {
-            let Ok(p) = misalign::float::Prepared::new(&s, 1e6, 1e-6) else { return Ok(()) };
+            let Ok(p) = misalign::float::Auto::new(&s) else { return Ok(()) };
             if let Ok(answer) = p.friction_from_axial_force(load, phi, force) {
                 let answer = answer.map(f64::from);
                 physical(&answer, f64::MAX, 1.0)?;

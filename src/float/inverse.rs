@@ -28,8 +28,9 @@
 //! `d ln g / d ln theta` by a difference of the g table, and S ~ 1/f'(s) is steep in s
 //! near gross slip).
 //!
-//! Section 9: [`Prepared`] fixes the model when the scene is prepared, so its inverse
-//! is that model's, unambiguous.
+//! Section 9: [`Auto`] chooses the model per sample. mu's inverse is the chosen
+//! model's (phi is known); phi's solves both models and keeps each answer only where
+//! the choice takes its model.
 //!
 //! The fixed-point core ([`crate::fixed`]) has no inverse yet. In its logarithmic
 //! number system the inverse needs new log-domain tables (log s of log r, and of
@@ -39,7 +40,7 @@
 //! than this budget. An FPU-less node (Cortex-M0, M3) can call these f32
 //! inverses in software floating point.
 
-use super::{EllipticScene, LineScene, Prepared, check};
+use super::{Auto, EllipticScene, LineScene, check};
 use crate::Error;
 use crate::kernels::axial_force_inverse::{
     force_over_slip_limit, force_ratio_slope, slip_ratio_of_force_over_slip,
@@ -47,6 +48,7 @@ use crate::kernels::axial_force_inverse::{
 };
 use crate::kernels::cbrt::cbrt;
 use crate::kernels::sqrt::{inv_sqrt, sqrt};
+use crate::reference::ContactModel;
 use crate::reference::inverse::{Inconsistency, Inverse, angle_trivial, friction_trivial};
 use core::f32::consts::FRAC_PI_2;
 
@@ -301,9 +303,10 @@ impl LineScene {
     }
 }
 
-impl Prepared {
-    /// mu from (P, phi, F) by the chosen model (see [`EllipticScene`] and [`LineScene`]
-    /// for units); suits a monitor that tracks mu per sample.
+impl Auto {
+    /// mu from (P, phi, F) by the model section 9 (or the scene's forced choice) takes
+    /// for this sample (see [`EllipticScene`] and [`LineScene`] for units); suits a
+    /// monitor that tracks mu per sample.
     ///
     /// # Errors
     /// As the chosen scene's `friction_from_axial_force`.
@@ -313,20 +316,58 @@ impl Prepared {
         phi: f32,
         force: f32,
     ) -> Result<Inverse<f32>, Error> {
-        match self {
-            Prepared::Elliptic(e) => e.friction_from_axial_force(load, phi, force),
-            Prepared::Line(l) => l.friction_from_axial_force(load, phi, force),
+        Auto::checked(load, phi)?;
+        match (self.choose(load, phi).0, &self.elliptic, &self.line) {
+            (ContactModel::Elliptic, Some(e), _) => e.friction_from_axial_force(load, phi, force),
+            (_, _, Some(l)) => l.friction_from_axial_force(load, phi, force),
+            _ => Err(Error::OutOfRange), // not reached: see `Auto::estimate`
         }
     }
 
-    /// phi from (P, F) by the chosen model.
+    /// phi from (P, F). The model depends on the unknown phi, so both are solved and
+    /// each answer counts only where the choice would take its model, as
+    /// `reference::inverse::angle_estimate`: both count gives `at_least` the smaller,
+    /// neither `inconsistent` (the switch jumps over F).
     ///
     /// # Errors
-    /// As the chosen scene's `angle_from_axial_force`.
+    /// As the scenes' `angle_from_axial_force`.
     pub fn angle_from_axial_force(&self, load: f32, force: f32) -> Result<Inverse<f32>, Error> {
-        match self {
-            Prepared::Elliptic(e) => e.angle_from_axial_force(load, force),
-            Prepared::Line(l) => l.angle_from_axial_force(load, force),
-        }
+        let elliptic = match &self.elliptic {
+            Some(e) => Some(e.angle_from_axial_force(load, force)?),
+            None => None,
+        };
+        let line = match &self.line {
+            Some(l) => Some(l.angle_from_axial_force(load, force)?),
+            None => None,
+        };
+        let picks = |answer: &Option<Inverse<f32>>, model: ContactModel| match answer {
+            Some(Inverse::Exact { value, .. } | Inverse::AtLeast { value }) => {
+                self.choose(load, *value).0 == model
+            }
+            _ => false,
+        };
+        Ok(
+            match (
+                picks(&elliptic, ContactModel::Elliptic),
+                picks(&line, ContactModel::Line),
+            ) {
+                (true, false) => {
+                    elliptic.unwrap_or(Inverse::Inconsistent(Inconsistency::AboveModel))
+                }
+                (false, true) => line.unwrap_or(Inverse::Inconsistent(Inconsistency::AboveModel)),
+                (true, true) => {
+                    let e = elliptic.and_then(|a| a.value()).unwrap_or(0.0);
+                    let l = line.and_then(|a| a.value()).unwrap_or(0.0);
+                    Inverse::AtLeast {
+                        value: if e.abs() < l.abs() { e } else { l },
+                    }
+                }
+                (false, false) => match (elliptic, line) {
+                    (Some(a @ Inverse::Inconsistent(_)), None | Some(Inverse::Inconsistent(_)))
+                    | (None, Some(a @ Inverse::Inconsistent(_))) => a,
+                    _ => Inverse::Inconsistent(Inconsistency::BetweenModels),
+                },
+            },
+        )
     }
 }

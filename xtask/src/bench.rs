@@ -3,8 +3,8 @@
 //! Speed: the benchmark image (examples/bench) on the Cortex-M0, M3, M4F and M7 in
 //! QEMU with `-icount` (instructions per call, mean and maximum over the practical
 //! samples of benches/common/samples.rs). Error: the same code on the host against the
-//! independent reference data (../shared/reference/vectors_scene.csv and
-//! vectors_line.csv). Writes docs/bench.csv, docs/speed-vs-error.svg and the README's
+//! independent reference data (tests/data/vectors_scene.csv and
+//! vectors_line.csv, or `$MISALIGN_REFERENCE_DIR`). Writes docs/bench.csv, docs/speed-vs-error.svg and the README's
 //! "Accuracy and cost" table; `--csv` prints the CSV, else a readable table.
 
 #[path = "../../benches/common/hamrock_brewe.rs"]
@@ -74,7 +74,11 @@ fn rel(got: f64, want: f64) -> f64 {
 type Rows = Vec<HashMap<String, String>>;
 
 fn read(name: &str) -> Result<Rows, String> {
-    let path = crate::root().join("../shared/reference").join(name);
+    let dir = std::env::var_os("MISALIGN_REFERENCE_DIR").map_or_else(
+        || crate::root().join("tests/data"),
+        std::path::PathBuf::from,
+    );
+    let path = dir.join(name);
     let mut r = csv::Reader::from_path(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     let headers = r.headers().map_err(|e| e.to_string())?.clone();
     r.records()
