@@ -4,8 +4,10 @@
 //! figures of the docs.
 //!
 //! `MISALIGN_POWER_LOSS=full` sweeps every checkpoint of three turns of the ring
-//! instead of the default's three chosen ones (the first write, the first that
-//! closes a sector, the first that erases one).
+//! instead of the default's four chosen ones (the first write on a blank flash; beside
+//! a stored calibration, the first, the first that closes a sector, the first that
+//! erases one), and a second power loss at every point of each recovery from the
+//! chosen ones (about 25 s; the default takes well under a second).
 
 use misalign::storage::codec::{self, CodecError, Decoded};
 use misalign::storage::wear::{self, Geometry};
@@ -134,6 +136,11 @@ impl Checkpoint for StateV3 {
         r.u32()?;
         Ok(StateV3(s))
     }
+}
+
+/// Which checkpoint a state is (see [`state`]).
+fn which(s: &State) -> u32 {
+    s.time_s[2]
 }
 
 /// The state after `n` checkpoints: each value tells which checkpoint it is.
@@ -476,10 +483,13 @@ fn checkpoints_follow_the_interval_and_on_demand() {
         Ok(Some(3))
     );
     assert_eq!(store.stats().checkpoints, 3);
-    let (store, restored) = boot(flash_of(store));
+    let (mut store, restored) = boot(flash_of(store));
     assert_eq!(restored.value, Some(state(3)));
     // The numbering goes on after a restart.
     assert_eq!(store.next_sequence(), 4);
+    // Erasing on purpose empties the region.
+    block_on(store.erase()).unwrap();
+    assert_eq!(boot(flash_of(store)).1.outcome, RestoreOutcome::Blank);
 }
 
 // ---------------------------------------------------------------------------------
@@ -500,13 +510,68 @@ fn points_of(base: &Flash, n: u32) -> (u64, u64) {
     (flash.points() - base.points(), erased_words)
 }
 
-/// Cuts the power at every point of checkpoint `n` (`base` holds 1..n), restarts and
-/// restores: exactly checkpoint n - 1 or n, never anything else; then the store goes
-/// on. Returns the points swept.
-fn sweep(base: &Flash, n: u32) -> u64 {
+/// The sensors' calibration, stored once in the same region as the state (kind 2):
+/// the map copies it forward each time the sector holding it is recycled.
+#[derive(Debug, Clone, PartialEq)]
+struct Calibration {
+    offset: [f32; 3],
+    gain: [f32; 3],
+    serial: u32,
+}
+
+impl Checkpoint for Calibration {
+    const KIND: u8 = 2;
+    const VERSION: u16 = 1;
+    const SIZE: usize = 6 * 4 + 4;
+
+    fn encode(&self, w: &mut Writer<'_>) -> Result<(), CodecError> {
+        w.each(&self.offset, |w, x| w.f32(*x))?;
+        w.each(&self.gain, |w, x| w.f32(*x))?;
+        w.u32(self.serial)
+    }
+
+    fn decode(r: &mut Reader<'_>) -> Result<Self, CodecError> {
+        Ok(Calibration {
+            offset: r.array_of(|r| r.f32())?,
+            gain: r.array_of(|r| r.f32())?,
+            serial: r.u32()?,
+        })
+    }
+}
+
+fn calibration() -> Calibration {
+    Calibration {
+        offset: [0.01, -0.02, 0.5],
+        gain: [1.001, 0.998, 1.0],
+        serial: 0x00C0_FFEE,
+    }
+}
+
+/// A blank flash, or one holding the calibration only.
+fn base(calibrated: bool) -> Flash {
+    let (mut store, _) = boot(Flash::new());
+    if calibrated {
+        block_on(store.checkpoint(&calibration())).unwrap();
+    }
+    flash_of(store)
+}
+
+fn assert_calibration(store: &mut S, calibrated: bool, what: &str) {
+    let got = block_on(store.restore::<Calibration>()).unwrap();
+    let expected = calibrated.then(calibration);
+    assert_eq!(got.value, expected, "{what}: calibration");
+}
+
+/// Cuts the power at every point of checkpoint `n` (`base` holds 1..n, and the
+/// calibration if `calibrated`), restarts and restores: exactly checkpoint n - 1 or n,
+/// never anything else, and the calibration intact; then the store goes on. Returns
+/// the points swept.
+fn sweep(base: &Flash, n: u32, calibrated: bool, second_faults: bool) -> (u64, u64) {
     let (points, _) = points_of(base, n);
     let mut first_write_rejects = 0;
+    let mut second_points = 0;
     for p in 0..points {
+        let what = format!("checkpoint {n}, point {p}, calibrated {calibrated}");
         let mut flash = base.clone();
         flash.cut_after(p);
         let (mut store, before) = boot(flash);
@@ -518,52 +583,92 @@ fn sweep(base: &Flash, n: u32) -> u64 {
         assert_eq!(
             cut,
             Err(StorageError::Flash(MockError::PowerLoss)),
-            "checkpoint {n}, point {p}"
+            "{what}"
         );
         let mut flash = flash_of(store);
         assert!(flash.is_off());
         flash.restart();
+        if second_faults {
+            second_points += sweep_recovery(&flash, calibrated, &what);
+        }
 
         let (mut store, after) = boot(flash);
-        let got = match after.outcome {
-            RestoreOutcome::Restored { sequence } => sequence,
-            RestoreOutcome::Blank if n == 1 => 0,
-            // A cut in the very first checkpoint leaves a region that is neither blank
-            // nor holds a record, as foreign data does: reported, erased, nothing
-            // restored, which is the previous state (none).
-            RestoreOutcome::Rejected(StorageEvent::ForeignRegion) if n == 1 => {
+        match after.outcome {
+            RestoreOutcome::Restored { .. } => {}
+            RestoreOutcome::Blank if n == 1 => {}
+            // A cut in the very first checkpoint on a blank region leaves a region
+            // that is neither blank nor holds a record, as foreign data does:
+            // reported, erased, nothing restored, which is the previous state (none).
+            RestoreOutcome::Rejected(StorageEvent::ForeignRegion) if n == 1 && !calibrated => {
                 first_write_rejects += 1;
-                0
             }
-            other => panic!("checkpoint {n}, point {p}: {other:?}"),
-        };
-        assert!(
-            got == n || got + 1 == n,
-            "checkpoint {n}, point {p}: restored {got}"
-        );
-        if got > 0 {
-            assert_eq!(after.value, Some(state(got)), "checkpoint {n}, point {p}");
+            other => panic!("{what}: {other:?}"),
         }
-        // The store goes on after the loss: the next checkpoint is the one restored.
-        let next = block_on(store.checkpoint(&state(got + 1)))
-            .unwrap_or_else(|e| panic!("checkpoint {n}, point {p}: after restart {e:?}"));
-        assert_eq!(next, got + 1);
-        let (_, again) = boot(flash_of(store));
-        assert_eq!(
-            again.value,
-            Some(state(got + 1)),
-            "checkpoint {n}, point {p}"
-        );
+        // Which checkpoint came back (0: none), and it is whole.
+        let got = after.value.as_ref().map_or(0, which);
+        assert!(got == n || got + 1 == n, "{what}: restored {got}");
+        if got > 0 {
+            assert_eq!(after.value, Some(state(got)), "{what}");
+        }
+        assert_calibration(&mut store, calibrated, &what);
+        // The store goes on after the loss.
+        block_on(store.checkpoint(&state(got + 1)))
+            .unwrap_or_else(|e| panic!("{what}: after restart {e:?}"));
+        let (mut store, again) = boot(flash_of(store));
+        assert_eq!(again.value, Some(state(got + 1)), "{what}");
+        assert_calibration(&mut store, calibrated, &what);
     }
     if first_write_rejects > 0 {
         eprintln!("checkpoint 1: {first_write_rejects} of {points} cuts reported as foreign");
     }
+    (points, second_points)
+}
+
+/// A second power loss at every point of the recovery from a first one (the restores,
+/// then the next checkpoint): the restart after it restores the checkpoint the first
+/// restart restored, or the recovery's new one, and the calibration intact.
+fn sweep_recovery(after_cut: &Flash, calibrated: bool, what: &str) -> u64 {
+    let (mut store, first) = boot(after_cut.clone());
+    let got = first.value.as_ref().map_or(0, which);
+    block_on(store.restore::<Calibration>()).unwrap();
+    block_on(store.checkpoint(&state(got + 1))).unwrap();
+    let points = flash_of(store).points() - after_cut.points();
+    for q in 0..points {
+        let what = format!("{what}, second cut {q}");
+        let mut flash = after_cut.clone();
+        flash.cut_after(q);
+        let mut store = open(flash);
+        let recovery = block_on(async {
+            store.restore::<State>().await?;
+            store.restore::<Calibration>().await?;
+            store.checkpoint(&state(got + 1)).await
+        });
+        assert_eq!(
+            recovery,
+            Err(StorageError::Flash(MockError::PowerLoss)),
+            "{what}"
+        );
+        let mut flash = flash_of(store);
+        flash.restart();
+        let (mut store, again) = boot(flash);
+        let k = again.value.as_ref().map_or(0, which);
+        assert!(k == got || k == got + 1, "{what}: restored {k} after {got}");
+        if k > 0 {
+            assert_eq!(again.value, Some(state(k)), "{what}");
+        }
+        assert_calibration(&mut store, calibrated, &what);
+        block_on(store.checkpoint(&state(k + 1))).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+        assert_eq!(boot(flash_of(store)).1.value, Some(state(k + 1)), "{what}");
+    }
     points
 }
 
-/// The default sweep: every byte and every erased word of three checkpoints: the first
-/// on a blank flash, the first that closes a sector, the first that erases one.
-/// `MISALIGN_POWER_LOSS=full`: every checkpoint of three turns of the ring.
+/// The default sweep: every byte and every erased word of four checkpoints: the first
+/// on a blank flash, and, with the calibration stored beside the state, the first,
+/// the first that closes a sector, and the first that erases one (copying the
+/// calibration forward). `MISALIGN_POWER_LOSS=full`: every checkpoint of three turns
+/// of the ring, and for the four above a second power loss at every point of the
+/// recovery from each first one.
 #[test]
 fn power_loss_at_every_point_restores_the_previous_or_the_new_checkpoint() {
     let full = std::env::var("MISALIGN_POWER_LOSS").is_ok_and(|v| v == "full");
@@ -576,9 +681,11 @@ fn power_loss_at_every_point_restores_the_previous_or_the_new_checkpoint() {
     .checkpoints_per_cycle() as u32;
     let last = 3 * per_turn + 2;
 
-    let mut base = Flash::new();
+    let (mut swept_points, mut second) = sweep(&base(false), 1, false, full);
+    let mut steps = 1u32;
+    let mut base = base(true);
     let (mut chosen, mut closing, mut erasing) = (vec![1], None, None);
-    let (mut swept_points, mut swept_erase_words, mut steps) = (0u64, 0u64, 0u32);
+    let mut swept_erase_words = 0u64;
     for n in 1..=last {
         let (points, erased_words) = points_of(&base, n);
         let record = codec::record_len(State::SIZE) as u64;
@@ -591,7 +698,9 @@ fn power_loss_at_every_point_restores_the_previous_or_the_new_checkpoint() {
             chosen.push(n);
         }
         if full || chosen.contains(&n) {
-            swept_points += sweep(&base, n);
+            let (first, then) = sweep(&base, n, true, full && chosen.contains(&n));
+            swept_points += first;
+            second += then;
             swept_erase_words += erased_words;
             steps += 1;
         }
@@ -605,7 +714,8 @@ fn power_loss_at_every_point_restores_the_previous_or_the_new_checkpoint() {
     assert!(swept_points >= swept_erase_words + codec::record_len(State::SIZE) as u64);
     eprintln!(
         "power loss: {steps} checkpoints swept, {swept_points} points \
-         ({swept_erase_words} erased words); closing at {closing:?}, erasing at {erasing:?}"
+         ({swept_erase_words} erased words), {second} second-fault points; \
+         closing at {closing:?}, erasing at {erasing:?}"
     );
 }
 
@@ -647,7 +757,7 @@ fn garbage_over_the_whole_region_starts_fresh_and_is_reported() {
 /// and an event; never a mix.
 #[test]
 fn garbage_in_one_sector_never_restores_a_wrong_value() {
-    let mut newest_kept = 0;
+    let (mut newest_kept, mut erased) = (0, 0);
     for sector in 0..SECTORS {
         for seed in 0..10 {
             let mut flash = written(20);
@@ -669,13 +779,18 @@ fn garbage_in_one_sector_never_restores_a_wrong_value() {
                 RestoreOutcome::Rejected(_) => assert_eq!(restored.value, None),
                 other => panic!("sector {sector}, seed {seed}: {other:?}"),
             }
+            // After the restore (which erased the region if it had to), checkpoints work.
             block_on(store.checkpoint(&state(21)))
                 .unwrap_or_else(|e| panic!("sector {sector}, seed {seed}: {e:?}"));
+            if store.stats().region_erases > 0 {
+                erased += 1;
+            }
             assert_eq!(boot(flash_of(store)).1.value, Some(state(21)));
         }
     }
     // Checkpoint 20 lives in sector 2 (8 a sector): garbage elsewhere keeps it.
     assert!(newest_kept >= 10, "{newest_kept}");
+    eprintln!("garbage in one sector: newest kept {newest_kept} of 40, region erased {erased}");
 }
 
 #[test]

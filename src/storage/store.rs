@@ -56,7 +56,8 @@ pub enum StorageError<E> {
     /// The region is full and nothing in it can be erased: more sectors are needed.
     Full,
     /// The region holds damage the map could not repair. [`Store::restore`] never
-    /// returns this: it starts fresh and reports it.
+    /// returns this (it erases the region, starts fresh and reports it);
+    /// [`Store::checkpoint`] does, and [`Store::erase`] is the remedy.
     Corrupted,
     /// The store's buffer is shorter than a record (`needed` bytes).
     BufferTooSmall {
@@ -120,7 +121,8 @@ pub enum RestoreOutcome {
         /// The format version it was written in.
         from_version: u16,
     },
-    /// The region was blank (erased): a first start, nothing to restore, nothing wrong.
+    /// Nothing of this kind was ever stored: a blank (erased) region, or one holding
+    /// only records of other kinds. A first start: nothing to restore, nothing wrong.
     Blank,
     /// The region held something unusable: start from a fresh state. Count it and
     /// report it; [`Store::stats`] counts it too.
@@ -133,12 +135,13 @@ pub enum RestoreOutcome {
 #[non_exhaustive]
 pub enum StorageEvent {
     /// The region's structure is damaged beyond the map's repair (e.g. garbage written
-    /// over it). The region was erased.
+    /// over it), or the map lists a record of this kind it cannot fetch. The region
+    /// was erased: checkpoint every kind you hold again.
     CorruptRegion,
     /// The region is not blank but holds no record of this kind: another program's
     /// data, garbage the map skipped over, or the very first checkpoint on a blank
     /// region cut by a power loss (nothing was lost then: there was nothing before
-    /// it). The region was erased.
+    /// it). The region was erased: checkpoint every kind you hold again.
     ForeignRegion,
     /// A record of another program, or another record kind, sits under this kind's key.
     ForeignRecord,
@@ -192,6 +195,15 @@ pub struct StorageStats {
     pub rejected: u32,
     /// Times the region was erased because it was corrupt or foreign.
     pub region_erases: u32,
+}
+
+/// What [`Store::restore`] found listed in the map when its key fetched nothing.
+#[derive(Default)]
+struct Held {
+    /// An item under the key being restored.
+    this_kind: bool,
+    /// An item that is one of our records, of any kind.
+    ours: bool,
 }
 
 /// A `sequential-storage` value that encodes a record straight into the map's buffer,
@@ -352,6 +364,30 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
                 Err(e) => StorageEvent::from_codec(e, T::VERSION),
             },
             Ok(None) => {
+                // Nothing of this kind: a blank region, one holding only other kinds
+                // of ours (calibration stored, state not yet), or something else.
+                match self.records_held(T::KIND).await {
+                    // The map lists a record of this kind it could not fetch: damage
+                    // the map may not be able to write past either.
+                    Ok(Held {
+                        this_kind: true, ..
+                    }) => {
+                        self.erase_region().await?;
+                        return Ok(self.rejected(StorageEvent::CorruptRegion));
+                    }
+                    Ok(Held { ours: true, .. }) => {
+                        return Ok(Restore {
+                            value: None,
+                            outcome: RestoreOutcome::Blank,
+                        });
+                    }
+                    Ok(_) => {}
+                    Err(SsError::Corrupted { .. }) => {
+                        self.erase_region().await?;
+                        return Ok(self.rejected(StorageEvent::CorruptRegion));
+                    }
+                    Err(e) => return Err(StorageError::from_ss(e)),
+                }
                 if self.region_is_blank().await? {
                     return Ok(Restore {
                         value: None,
@@ -367,11 +403,26 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
             }
             Err(e) => return Err(StorageError::from_ss(e)),
         };
+        Ok(self.rejected(event))
+    }
+
+    fn rejected<T>(&mut self, event: StorageEvent) -> Restore<T> {
         self.stats.rejected = self.stats.rejected.saturating_add(1);
-        Ok(Restore {
+        Restore {
             value: None,
             outcome: RestoreOutcome::Rejected(event),
-        })
+        }
+    }
+
+    /// What records the map lists (every item it can read, old ones included).
+    async fn records_held(&mut self, kind: u8) -> Result<Held, SsError<F::Error>> {
+        let mut held = Held::default();
+        let mut items = self.map.fetch_all_items(&mut self.buf).await?;
+        while let Some((key, bytes)) = items.next::<&[u8]>(&mut self.buf).await? {
+            held.this_kind |= key == kind;
+            held.ours |= bytes.get(..4) == Some(&codec::MAGIC[..]);
+        }
+        Ok(held)
     }
 
     /// True if every byte of the region reads 0xFF.
@@ -398,6 +449,13 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
             at += n as u32;
         }
         Ok(true)
+    }
+
+    /// Erases the whole region: every kind, every checkpoint. The remedy when
+    /// [`Store::checkpoint`] keeps failing with [`StorageError::Corrupted`] (damage
+    /// the map cannot write past); checkpoint every kind you hold again after it.
+    pub async fn erase(&mut self) -> Result<(), StorageError<F::Error>> {
+        self.erase_region().await
     }
 
     async fn erase_region(&mut self) -> Result<(), StorageError<F::Error>> {
