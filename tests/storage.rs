@@ -827,6 +827,47 @@ fn a_foreign_record_under_our_key_is_rejected() {
     assert_eq!(boot(flash_of(store)).1.value, Some(state(3)));
 }
 
+/// A flash holding another program's map with one item of `len` bytes under `key`.
+fn foreign_item(key: u8, len: usize) -> Flash {
+    let mut map = sequential_storage::map::MapStorage::<u8, _, _>::new(
+        BlockingFlash(Flash::new()),
+        sequential_storage::map::MapConfig::new(0..(SECTORS * SECTOR) as u32),
+        sequential_storage::cache::Cache::new_uncached(),
+    );
+    let mut buf = [0u8; 512];
+    let item = vec![0xA5u8; len];
+    block_on(map.store_item(&mut buf, &key, &item.as_slice())).unwrap();
+    map.destroy().0.0
+}
+
+/// An item larger than the store's buffer (a newer firmware's larger record after a
+/// downgrade, or another program's), under this kind's key or another: no error, no
+/// value, a reported event, and the region usable again.
+#[test]
+fn an_oversized_item_is_rejected_not_an_error() {
+    for (key, expected) in [
+        (State::KIND, StorageEvent::OversizedRecord),
+        (7, StorageEvent::OversizedRecord),
+    ] {
+        let (mut store, restored) = boot(foreign_item(key, 300));
+        assert_eq!(restored.value, None, "key {key}");
+        assert_eq!(
+            restored.outcome,
+            RestoreOutcome::Rejected(expected),
+            "key {key}"
+        );
+        assert_eq!(store.stats().region_erases, 1, "key {key}");
+        block_on(store.checkpoint(&state(4))).unwrap();
+        assert_eq!(boot(flash_of(store)).1.value, Some(state(4)), "key {key}");
+    }
+    // A small foreign item under another key: a foreign region.
+    let (_, restored) = boot(foreign_item(7, 10));
+    assert_eq!(
+        restored.outcome,
+        RestoreOutcome::Rejected(StorageEvent::ForeignRegion)
+    );
+}
+
 /// A fixed-size blob of kind `K`: many kinds fill a region.
 #[derive(Debug, PartialEq)]
 struct Blob<const K: u8, const N: usize>([u8; N]);

@@ -34,6 +34,7 @@ pub const fn record_len(payload: usize) -> usize {
 
 /// Why bytes could not be encoded or decoded as a record.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum CodecError {
     /// The output buffer is shorter than the record (`needed` bytes).
@@ -310,8 +311,12 @@ pub fn encode<T: Checkpoint>(
     let out = out
         .get_mut(..len)
         .ok_or(CodecError::BufferTooSmall { needed: len })?;
-    let (body, crc_bytes) = out.split_at_mut(len - 4);
-    let (header, payload) = body.split_at_mut(HEADER_LEN);
+    let (body, crc_bytes) = out
+        .split_at_mut_checked(len - 4)
+        .ok_or(CodecError::Length)?;
+    let (header, payload) = body
+        .split_at_mut_checked(HEADER_LEN)
+        .ok_or(CodecError::Length)?;
     let mut w = Writer::new(header);
     w.bytes(&MAGIC)?;
     w.u8(T::KIND)?;
@@ -351,7 +356,9 @@ pub fn decode<T: Checkpoint>(record: &[u8]) -> Result<Decoded<T>, CodecError> {
     if record.len() != record_len(payload_len) {
         return Err(CodecError::Length);
     }
-    let (body, crc_bytes) = record.split_at(record.len() - 4);
+    let (body, crc_bytes) = record
+        .split_at_checked(record.len().saturating_sub(4))
+        .ok_or(CodecError::Length)?;
     let mut crc = Reader::new(crc_bytes);
     if crc.u32()? != crc32(body) {
         return Err(CodecError::Checksum);

@@ -19,6 +19,7 @@ type NoCache = Cache<Uncached, Uncached, Uncached, u8>;
 
 /// Why a [`Store`] could not be made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum ConfigError {
     /// The region does not start or end on a sector (erase-size) boundary.
@@ -49,6 +50,7 @@ impl fmt::Display for ConfigError {
 
 /// Why a storage operation failed. `E` is the flash driver's error.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum StorageError<E> {
     /// The flash driver failed (or, on the mock flash, the power went).
@@ -143,6 +145,10 @@ pub enum StorageEvent {
     /// region cut by a power loss (nothing was lost then: there was nothing before
     /// it). The region was erased: checkpoint every kind you hold again.
     ForeignRegion,
+    /// An item larger than this store's buffer sits in the region: a newer firmware's
+    /// larger record (after a downgrade) or another program's. The region was erased:
+    /// checkpoint every kind you hold again.
+    OversizedRecord,
     /// A record of another program, or another record kind, sits under this kind's key.
     ForeignRecord,
     /// The record's CRC does not match.
@@ -195,6 +201,16 @@ pub struct StorageStats {
     pub rejected: u32,
     /// Times the region was erased because it was corrupt or foreign.
     pub region_erases: u32,
+}
+
+/// Sorts a map error met while restoring: a flash driver error is returned; anything
+/// else says the region's contents are unusable, and which way.
+fn unusable<E>(e: SsError<E>) -> Result<StorageEvent, StorageError<E>> {
+    match e {
+        SsError::Storage { value, .. } => Err(StorageError::Flash(value)),
+        SsError::BufferTooSmall(_) => Ok(StorageEvent::OversizedRecord),
+        _ => Ok(StorageEvent::CorruptRegion),
+    }
 }
 
 /// What [`Store::restore`] found listed in the map when its key fetched nothing.
@@ -337,7 +353,7 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
     /// region (damage, garbage, another program's data, a format this firmware cannot
     /// read) gives `value: None` and [`RestoreOutcome::Rejected`], never a wrong value;
     /// a damaged or foreign region is erased so that checkpoints can go on. `Err` only
-    /// for a flash driver error or a buffer too small for `T`.
+    /// for a flash driver error or a store buffer too small for `T`.
     pub async fn restore<T: Checkpoint>(&mut self) -> Result<Restore<T>, StorageError<F::Error>> {
         self.check_buffer::<T>()?;
         let found = self.map.fetch_item::<&[u8]>(&mut self.buf, &T::KIND).await;
@@ -382,11 +398,11 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
                         });
                     }
                     Ok(_) => {}
-                    Err(SsError::Corrupted { .. }) => {
+                    Err(e) => {
+                        let event = unusable(e)?;
                         self.erase_region().await?;
-                        return Ok(self.rejected(StorageEvent::CorruptRegion));
+                        return Ok(self.rejected(event));
                     }
-                    Err(e) => return Err(StorageError::from_ss(e)),
                 }
                 if self.region_is_blank().await? {
                     return Ok(Restore {
@@ -397,11 +413,11 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
                 self.erase_region().await?;
                 StorageEvent::ForeignRegion
             }
-            Err(SsError::Corrupted { .. }) => {
+            Err(e) => {
+                let event = unusable(e)?;
                 self.erase_region().await?;
-                StorageEvent::CorruptRegion
+                event
             }
-            Err(e) => return Err(StorageError::from_ss(e)),
         };
         Ok(self.rejected(event))
     }
