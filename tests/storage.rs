@@ -10,6 +10,7 @@
 //! chosen ones (about 25 s; the default takes well under a second).
 
 use misalign::storage::codec::{self, CodecError, Decoded};
+use misalign::storage::kind;
 use misalign::storage::wear::{self, Geometry};
 use misalign::storage::{
     BlockingFlash, Checkpoint, ConfigError, MockError, MockFlash, Reader, Restore, RestoreOutcome,
@@ -74,7 +75,7 @@ fn get_common(r: &mut Reader<'_>) -> Result<State, CodecError> {
 }
 
 impl Checkpoint for State {
-    const KIND: u8 = 1;
+    const KIND: u8 = kind::MONITOR_STATE;
     const VERSION: u16 = 2;
     const SIZE: usize = V1_SIZE + 1 + 8;
 
@@ -105,7 +106,7 @@ impl Checkpoint for State {
 struct StateV1(State);
 
 impl Checkpoint for StateV1 {
-    const KIND: u8 = 1;
+    const KIND: u8 = kind::MONITOR_STATE;
     const VERSION: u16 = 1;
     const SIZE: usize = V1_SIZE;
 
@@ -122,7 +123,7 @@ impl Checkpoint for StateV1 {
 struct StateV3(State);
 
 impl Checkpoint for StateV3 {
-    const KIND: u8 = 1;
+    const KIND: u8 = kind::MONITOR_STATE;
     const VERSION: u16 = 3;
     const SIZE: usize = State::SIZE + 4;
 
@@ -520,7 +521,7 @@ struct Calibration {
 }
 
 impl Checkpoint for Calibration {
-    const KIND: u8 = 2;
+    const KIND: u8 = kind::CALIBRATION;
     const VERSION: u16 = 1;
     const SIZE: usize = 6 * 4 + 4;
 

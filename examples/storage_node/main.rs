@@ -109,7 +109,7 @@ mod node {
     }
 
     impl Checkpoint for Wear {
-        const KIND: u8 = 1;
+        const KIND: u8 = misalign::storage::kind::MONITOR_STATE;
         const VERSION: u16 = 1;
         const SIZE: usize = 3 * 8 + 4;
 

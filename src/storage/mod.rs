@@ -14,7 +14,16 @@
 //!   start-up. A corrupt or foreign region restores nothing and reports a
 //!   [`StorageEvent`] ([`RestoreOutcome::Rejected`]), counted in [`Store::stats`].
 //! - [`BlockingFlash`] and [`block_on`]: the store on bare metal without an executor
-//!   (see [`blocking`]).
+//!   (see [`blocking`]). The store owns its flash; to share a driver, hand it
+//!   `&mut driver` (the flash traits are implemented for `&mut F`) or take it back with
+//!   [`Store::into_flash`].
+//!
+//! One store holds several kinds in one region (the monitor's state, the sensors'
+//! calibration: [`kind`]); its buffer `BUF` must be at least
+//! [`Store::buffer_len`] of the largest. At start-up restore each kind; after a
+//! [`RestoreOutcome::Rejected`] with [`StorageEvent::CorruptRegion`],
+//! [`StorageEvent::ForeignRegion`] or [`StorageEvent::OversizedRecord`] the region was
+//! erased: checkpoint every kind held in RAM again.
 //! - `MockFlash` (feature `_mock-flash`, semver-exempt): NOR flash in RAM with
 //!   power-loss injection at every byte written and every word erased.
 //!
@@ -61,6 +70,16 @@ pub use mock_flash::{MockError, MockFlash};
 pub use store::{
     ConfigError, Restore, RestoreOutcome, StorageError, StorageEvent, StorageStats, Store,
 };
+
+/// The record kinds ([`Checkpoint::KIND`]) of this crate's state types, fixed here so
+/// that two types never share a key in a region (a kind is never reused for another
+/// type: an old record would be read as the new type's).
+pub mod kind {
+    /// The condition monitor's state.
+    pub const MONITOR_STATE: u8 = 1;
+    /// The sensors' calibration.
+    pub const CALIBRATION: u8 = 2;
+}
 
 /// A value stored as a checkpoint: a fixed-size, versioned payload.
 ///
