@@ -975,10 +975,10 @@ fn grouped(n: u64) -> String {
 #[test]
 fn the_docs_wear_figures_are_the_computed_ones() {
     let g = wear::REFERENCE;
-    assert_eq!(g.checkpoints_per_sector(), 14);
+    assert_eq!(g.checkpoints_per_sector(), 4);
     let rows = [
-        ("15 min (default)", wear::DEFAULT_INTERVAL_S),
-        ("1 h", 3600),
+        ("1 h (default)", wear::DEFAULT_INTERVAL_S),
+        ("15 min", 900),
         ("5 min", 300),
     ];
     let module =
@@ -995,18 +995,33 @@ fn the_docs_wear_figures_are_the_computed_ones() {
     }
     let ten_years = g.min_interval_s(wear::RATED_CYCLES, 10);
     assert!(module.contains(&format!("{ten_years} s for ten years")));
-    // The shortest interval for ten years is just that.
-    assert!(g.cycles_per_year(ten_years) * 10 <= u64::from(wear::RATED_CYCLES));
-    assert!(g.cycles_per_year(ten_years - 1) * 10 > u64::from(wear::RATED_CYCLES) - 20);
+    // The shortest interval for ten years is just that: the erases of ten years at
+    // it fit the rating, one second less does not.
+    let erases_in_ten_years = |interval: u32| {
+        10 * wear::SECONDS_PER_YEAR / u64::from(interval) / g.checkpoints_per_cycle()
+    };
+    assert!(erases_in_ten_years(ten_years) <= u64::from(wear::RATED_CYCLES));
+    assert!(erases_in_ten_years(ten_years - 1) >= u64::from(wear::RATED_CYCLES));
 
     let readme =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
-    let default = g.cycles_per_year(wear::DEFAULT_INTERVAL_S);
-    let sentence = format!(
-        "{default} erase cycles per sector a year, {} years to 10 000 cycles",
-        g.years_to(wear::RATED_CYCLES, wear::DEFAULT_INTERVAL_S)
-    );
-    assert!(readme.contains(&sentence), "README lacks \"{sentence}\"");
+    let readme = readme.split_whitespace().collect::<Vec<_>>().join(" ");
+    let sentences = [
+        format!(
+            "{} erase cycles per sector a year, {} years to 10 000 cycles",
+            g.cycles_per_year(wear::DEFAULT_INTERVAL_S),
+            g.years_to(wear::RATED_CYCLES, wear::DEFAULT_INTERVAL_S)
+        ),
+        format!(
+            "every 15 minutes it would take {}, {} years",
+            grouped(g.cycles_per_year(900)),
+            g.years_to(wear::RATED_CYCLES, 900)
+        ),
+        format!("({ten_years} s for ten years here)"),
+    ];
+    for sentence in sentences {
+        assert!(readme.contains(&sentence), "README lacks \"{sentence}\"");
+    }
 }
 
 // ---------------------------------------------------------------------------------

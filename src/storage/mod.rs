@@ -38,23 +38,25 @@
 //!
 //! Each sector is erased once every `k * s` checkpoints (`k` checkpoints per sector,
 //! `s` sectors; the arithmetic is in [`wear`]). For the [`wear::REFERENCE`] geometry
-//! (a 256-byte payload, four 4 KiB sectors, 4-byte words: 14 checkpoints per sector)
-//! at the default interval of 15 minutes ([`wear::DEFAULT_INTERVAL_S`]):
+//! (an 896-byte payload, about the monitor's whole state; eight 4 KiB sectors; 4-byte
+//! words: 4 checkpoints per sector) at the default interval of one hour
+//! ([`wear::DEFAULT_INTERVAL_S`]):
 //!
 //! | interval | checkpoints a year | erase cycles per sector a year | years to 10 000 cycles |
 //! | --- | --- | --- | --- |
-//! | 15 min (default) | 35 064 | 627 | 15 |
-//! | 1 h | 8 766 | 157 | 63 |
-//! | 5 min | 105 192 | 1 879 | 5 |
+//! | 1 h (default) | 8 766 | 274 | 36 |
+//! | 15 min | 35 064 | 1 096 | 9 |
+//! | 5 min | 105 192 | 3 288 | 3 |
 //!
-//! To choose the interval: pick the longest monitoring loss you accept on a power
-//! failure; compute [`wear::Geometry::cycles_per_year`] for your record
+//! To choose the interval: pick the longest loss of accumulation (energy, time per
+//! state, counters) you accept on a power failure, and checkpoint on demand at the rare
+//! moments that must not be lost (a risk-state change, before a planned reset or a
+//! firmware update); compute [`wear::Geometry::cycles_per_year`] for your record
 //! ([`Checkpoint::SIZE`]) and region; if the part's rated cycles (10 000 for typical
 //! MCU internal flash) last fewer years than the product's life, lengthen the interval
 //! or give the region more sectors ([`wear::Geometry::min_interval_s`] gives the
-//! shortest interval for a life: 564 s for ten years at the reference geometry).
-//! Doubling the sectors halves the wear. Checkpoint on demand as well before a planned
-//! reset (firmware update), which costs one item, not an erase.
+//! shortest interval for a life: 987 s for ten years at the reference geometry).
+//! Doubling the sectors halves the wear; so does halving the record.
 
 pub mod blocking;
 pub mod codec;

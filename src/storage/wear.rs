@@ -23,9 +23,10 @@ use super::codec::record_len;
 /// Seconds in a year (365.25 days).
 pub const SECONDS_PER_YEAR: u64 = 31_557_600;
 
-/// The default checkpoint interval, seconds: 15 minutes. What a brown-out can lose at
-/// most is this much monitoring (the restored checkpoint is never older).
-pub const DEFAULT_INTERVAL_S: u32 = 900;
+/// The default checkpoint interval, seconds: one hour. What a brown-out can lose at
+/// most is this much accumulation (the restored checkpoint is never older); checkpoint
+/// on demand as well at every risk-state change, so that events are not lost.
+pub const DEFAULT_INTERVAL_S: u32 = 3600;
 
 /// The endurance the docs assume: 10 000 erase cycles per sector (typical of MCU
 /// internal flash; serial NOR parts are usually rated 100 000).
@@ -44,12 +45,14 @@ pub struct Geometry {
     pub word: usize,
 }
 
-/// The geometry of the figures in the docs: a 256-byte payload (a monitor state with
-/// some 30 f64/u32 fields and a few events) in four 4 KiB sectors of 4-byte words.
+/// The geometry of the figures in the docs: a 896-byte payload (the condition
+/// monitor's whole state, events and trend included, encodes to some 850 bytes) in
+/// eight 4 KiB sectors (a 32 KiB region) of 4-byte words. Recompute with your type's
+/// [`Checkpoint::SIZE`](super::Checkpoint::SIZE) and your region.
 pub const REFERENCE: Geometry = Geometry {
-    payload: 256,
+    payload: 896,
     sector: 4096,
-    sectors: 4,
+    sectors: 8,
     word: 4,
 };
 
