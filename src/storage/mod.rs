@@ -81,6 +81,8 @@ pub mod kind {
     pub const MONITOR_STATE: u8 = 1;
     /// The sensors' calibration.
     pub const CALIBRATION: u8 = 2;
+    /// The monitor's configuration.
+    pub const MONITOR_CONFIG: u8 = 3;
 }
 
 /// A value stored as a checkpoint: a fixed-size, versioned payload.
