@@ -29,6 +29,8 @@ pub enum Error {
     /// The f32 and fixed-point cores implement eq (4); the exact theta relation is in
     /// the reference only.
     Unsupported,
+    /// Measured axial force F is NaN or infinite.
+    Force,
     /// A value outside what a prepared scene accepts: a scene constant that does not
     /// fit the core's number format, or an input outside the declared range.
     OutOfRange,
@@ -50,6 +52,7 @@ impl fmt::Display for Error {
             Error::Unsupported => {
                 "the cores implement eq (4) only; use the reference for the exact relation"
             }
+            Error::Force => "axial force F must be finite",
             Error::OutOfRange => "value outside the range the prepared scene accepts",
         })
     }

@@ -36,6 +36,8 @@ pub mod float;
 pub mod kernels;
 pub mod reference;
 pub mod scene;
+#[cfg(feature = "sensors")]
+pub mod sensors;
 #[cfg(feature = "sequential-storage")]
 pub mod storage;
 #[rustfmt::skip]

@@ -11,6 +11,9 @@
 //! Each prepared scene states the input range it accepts ([`InputRange`]); outside it
 //! the answer is a typed error, never a wrapped value.
 //!
+//! Inverse estimates (mu or phi from a measured axial force) exist in the reference and
+//! the f32 core only; [`crate::float::inverse`] says why not here.
+//!
 //! The `fixed` crate was weighed and not used: its types fix the binary point at compile
 //! time, while these quantities span ten decades per scene and need a per-value
 //! exponent; a Q8.24 logarithm is one.

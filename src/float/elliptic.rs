@@ -43,15 +43,15 @@ impl Tables<'static> {
 #[derive(Debug, Clone, Copy)]
 pub struct EllipticScene<'t> {
     /// `c = 2 sqrt(R1 R2) / (R1 + R2)` (eq 4): theta = c |phi|.
-    radius_factor: f32,
+    pub(super) radius_factor: f32,
     /// `1 / c`.
-    inv_radius_factor: f32,
+    pub(super) inv_radius_factor: f32,
     /// `A = pi G V^(2/3) / (3 mu c)`: d/b = A g(theta) P^(-1/3) (eq 16), V = L^3/P.
-    slip_gain: f32,
+    pub(super) slip_gain: f32,
     /// `1 / A`: at d/b = 1, g(theta0) = P^(1/3) / A (eq 18).
-    critical_gain: f32,
+    pub(super) critical_gain: f32,
     /// Friction coefficient mu.
-    friction: f32,
+    pub(super) friction: f32,
     /// `V^(1/3)`: L = V^(1/3) P^(1/3) (eqs 2, 3).
     hertz_gain: f32,
     /// d/b at and above which the risk flag is raised.
@@ -194,7 +194,7 @@ impl<'t> EllipticScene<'t> {
     }
 
     #[inline(always)]
-    fn g_of_theta(&self, theta: f32) -> Result<f32, Error> {
+    pub(super) fn g_of_theta(&self, theta: f32) -> Result<f32, Error> {
         match self.tables.g.eval(theta) {
             Some(g) => Ok(g),
             None => self.g_outside(theta),
@@ -215,7 +215,7 @@ impl<'t> EllipticScene<'t> {
 
     /// theta0 with g(theta0) = g; `Ok(None)` above g(pi/2) = pi/2 (no critical angle).
     #[inline(always)]
-    fn theta_of_g(&self, g: f32) -> Result<Option<f32>, Error> {
+    pub(super) fn theta_of_g(&self, g: f32) -> Result<Option<f32>, Error> {
         if g.to_bits() > FRAC_PI_2.to_bits() {
             return Ok(None);
         }

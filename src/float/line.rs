@@ -15,11 +15,11 @@ use core::f32::consts::FRAC_PI_2;
 pub struct LineScene {
     /// `sqrt(pi (1 - nu) G R l) / (2 mu)`: d/b = this |phi| / sqrt(P) (eq 23), l the
     /// length (1 without one).
-    slip_gain: f32,
+    pub(super) slip_gain: f32,
     /// `2 mu / sqrt(pi G (1 - nu) R l)`: phi0 = this sqrt(P) (eq 28).
-    critical_gain: f32,
+    pub(super) critical_gain: f32,
     /// Friction coefficient mu.
-    friction: f32,
+    pub(super) friction: f32,
     /// d/b at and above which the risk flag is raised.
     risk_slip_ratio: f32,
 }

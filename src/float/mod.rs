@@ -11,6 +11,7 @@
 //! path (section 8) needs no table at all. Each type links only what it uses.
 
 mod elliptic;
+pub mod inverse;
 mod line;
 
 pub use elliptic::{Details, EllipticScene, Tables};

@@ -6,6 +6,7 @@
 
 mod carlson;
 mod chain;
+pub mod inverse;
 pub mod line;
 pub mod normal;
 mod solve;
@@ -226,13 +227,20 @@ fn phi_of_theta(scene: &Scene, theta: f64) -> f64 {
 /// `phi0 = 2 mu p0 / G` with p0 at phi0). Returns `(phi0, theta0)`, or `None` when
 /// d/b stays below 1 up to theta = pi/2 (or, for the exact relation, phi = pi/2).
 pub fn critical_angle(scene: &Scene, load: f64) -> Option<(f64, f64)> {
+    angle_at_slip_ratio(scene, load, 1.0)
+}
+
+/// The phi >= 0 (and its theta) at which eq (16) gives the slip ratio `slip_ratio`
+/// (> 0) at `load`; [`critical_angle`] is the case d/b = 1, the inverses of
+/// [`inverse`] use the others. `None` when no theta <= pi/2 reaches it.
+fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64, f64)> {
     if load == 0.0 {
         return Some((0.0, 0.0));
     }
     let v = hertz_scale(scene);
-    // d/b = 1  <=>  m n |phi| = 3 mu P^(1/3) / (pi G v^2).
+    // d/b = s  <=>  m n |phi| = 3 mu s P^(1/3) / (pi G v^2)  (eq 15).
     let target = chain::chain(
-        &[3.0, scene.friction(), libm::cbrt(load)],
+        &[3.0, scene.friction(), slip_ratio, libm::cbrt(load)],
         &[PI, scene.shear_modulus(), v, v],
     );
     let c = scene.radius_factor();
