@@ -1076,3 +1076,134 @@ fn the_mock_flash_behaves_as_nor_flash() {
     let _ = h.erase(0, 1024);
     assert_eq!(h.sector(0), g.sector(0));
 }
+
+// ---------------------------------------------------------------------------------
+// The sensors' calibration as a stored record (with the feature `sensors`).
+
+#[cfg(feature = "sensors")]
+mod sensor_calibration {
+    use super::*;
+    use misalign::sensors::{
+        Hx711Channel, LoadCalibration, MisalignmentCalibration, ProbeCalibration, ProbeSpec,
+        SpeedCalibration,
+    };
+    use misalign::storage::SensorCalibration;
+
+    const SPEC: ProbeSpec = ProbeSpec {
+        min_m: 0.0,
+        max_m: 2e-3,
+        linearity_m: 10e-6,
+    };
+
+    /// A calibration as the sensors' own constructors make it on site.
+    fn on_site(speed: bool) -> SensorCalibration {
+        SensorCalibration {
+            load: LoadCalibration::two_point(Hx711Channel::A64, 8_400.0, 91_000.0, 98.0665, 5e3)
+                .unwrap(),
+            misalignment: MisalignmentCalibration {
+                probe1: ProbeCalibration::two_point((1000.0, 0.0), (21000.0, 2e-3), SPEC).unwrap(),
+                probe2: ProbeCalibration::two_point((900.0, 0.0), (20500.0, 2e-3), SPEC).unwrap(),
+                span_m: 0.25,
+                zero_offset_m: 3e-6,
+            },
+            speed: speed.then_some(SpeedCalibration {
+                pulses_per_rev: 360,
+                radius_m: 0.05,
+                max_speed_m_s: 20.0,
+            }),
+        }
+    }
+
+    fn record(cal: &SensorCalibration) -> Vec<u8> {
+        let mut buf = [0u8; BUF];
+        let len = codec::encode(cal, 1, &mut buf).unwrap();
+        buf[..len].to_vec()
+    }
+
+    /// Rewrites the CRC after a test changed a payload byte: the record is then whole,
+    /// and only the type's own checks can refuse it.
+    fn reseal(mut rec: Vec<u8>) -> Vec<u8> {
+        let n = rec.len() - 4;
+        let crc = codec::crc32(&rec[..n]);
+        rec[n..].copy_from_slice(&crc.to_le_bytes());
+        rec
+    }
+
+    #[test]
+    fn the_calibration_round_trips_beside_the_state() {
+        for speed in [true, false] {
+            let (mut store, _) = boot(Flash::new());
+            block_on(store.checkpoint(&on_site(speed))).unwrap();
+            for n in 1..=40 {
+                block_on(store.checkpoint(&state(n))).unwrap();
+            }
+            let (mut store, restored) = boot(flash_of(store));
+            assert_eq!(restored.value, Some(state(40)));
+            let cal = block_on(store.restore::<SensorCalibration>()).unwrap();
+            assert_eq!(cal.value, Some(on_site(speed)));
+        }
+    }
+
+    /// Version 1 of the record, frozen.
+    const V1_CALIBRATION: &str = "\
+4d534c47020101004e0000000100000001004003465b9d9b3a00409cc500409c4500007a4496bfd6\
+33000000006f12033bacc52737000061448921db33000000006f12033bacc527370000803e9c5349\
+360168010000cdcc4c3d0000a041324cb51d";
+
+    #[test]
+    fn the_frozen_version_1_record_still_decodes() {
+        let frozen = hex(V1_CALIBRATION);
+        assert_eq!(record(&on_site(true)), frozen);
+        let d = codec::decode::<SensorCalibration>(&frozen).unwrap();
+        assert_eq!(d.value, on_site(true));
+    }
+
+    #[test]
+    fn a_calibration_that_fails_its_checks_is_not_restored() {
+        let good = record(&on_site(false));
+        let payload = codec::HEADER_LEN;
+        let mut cases = Vec::new();
+        // An unknown HX711 channel code.
+        let mut rec = good.clone();
+        rec[payload] = 3;
+        cases.push(rec);
+        // A zero load scale (bytes 5..9 of the payload).
+        let mut rec = good.clone();
+        rec[payload + 5..payload + 9].copy_from_slice(&0f32.to_le_bytes());
+        cases.push(rec);
+        // A negative probe span.
+        let span = payload + 17 + 40;
+        let mut rec = good.clone();
+        rec[span..span + 4].copy_from_slice(&(-0.25f32).to_le_bytes());
+        cases.push(rec);
+        // "No tachometer" with tachometer values behind it.
+        let speed = payload + 17 + 48;
+        let mut rec = good.clone();
+        rec[speed + 1] = 7;
+        cases.push(rec);
+        for (i, rec) in cases.into_iter().enumerate() {
+            assert_eq!(
+                codec::decode::<SensorCalibration>(&reseal(rec)),
+                Err(CodecError::InvalidValue),
+                "case {i}"
+            );
+        }
+        // And through the store: a calibration that fails its checks is reported, not
+        // restored. (Built by hand, as a broken firmware might have stored it.)
+        let mut bad = on_site(true);
+        bad.speed = Some(SpeedCalibration {
+            pulses_per_rev: 0,
+            radius_m: 0.05,
+            max_speed_m_s: 20.0,
+        });
+        let (mut store, _) = boot(Flash::new());
+        block_on(store.checkpoint(&bad)).unwrap();
+        let (mut store, _) = boot(flash_of(store));
+        let restored = block_on(store.restore::<SensorCalibration>()).unwrap();
+        assert_eq!(restored.value, None);
+        assert_eq!(
+            restored.outcome,
+            RestoreOutcome::Rejected(StorageEvent::Undecodable)
+        );
+    }
+}

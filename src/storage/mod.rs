@@ -24,6 +24,9 @@
 //! [`RestoreOutcome::Rejected`] with [`StorageEvent::CorruptRegion`],
 //! [`StorageEvent::ForeignRegion`] or [`StorageEvent::OversizedRecord`] the region was
 //! erased: checkpoint every kind held in RAM again.
+//! - `SensorCalibration` (with the feature `sensors`): the sensors' calibration (load
+//!   cell, misalignment probes, tachometer) as one record of [`kind::CALIBRATION`],
+//!   put back only if every part passes its `validate`.
 //! - `MockFlash` (feature `_mock-flash`, semver-exempt): NOR flash in RAM with
 //!   power-loss injection at every byte written and every word erased.
 //!
@@ -59,6 +62,8 @@
 //! Doubling the sectors halves the wear; so does halving the record.
 
 pub mod blocking;
+#[cfg(feature = "sensors")]
+mod calibration;
 pub mod codec;
 #[cfg(feature = "_mock-flash")]
 mod mock_flash;
@@ -66,6 +71,8 @@ mod store;
 pub mod wear;
 
 pub use blocking::{BlockingFlash, block_on};
+#[cfg(feature = "sensors")]
+pub use calibration::SensorCalibration;
 pub use codec::{CodecError, Reader, Writer};
 #[cfg(feature = "_mock-flash")]
 pub use mock_flash::{MockError, MockFlash};
