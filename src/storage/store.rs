@@ -244,6 +244,11 @@ impl<'a, T: Checkpoint> Value<'a> for Encoding<'_, T> {
     }
 }
 
+/// The store's buffer, word-aligned: some internal-flash drivers write only from
+/// aligned RAM, and the map writes items straight from this buffer.
+#[repr(C, align(4))]
+struct Aligned<const N: usize>([u8; N]);
+
 /// Checkpoints in a NOR flash region: each [`Checkpoint`] kind is one key of a
 /// `sequential-storage` map, so a new checkpoint is appended, the old one stays valid
 /// until the new one is complete, and sectors are erased in turn (wear levelling).
@@ -253,7 +258,7 @@ impl<'a, T: Checkpoint> Value<'a> for Encoding<'_, T> {
 pub struct Store<F: NorFlash, const BUF: usize> {
     map: MapStorage<u8, F, NoCache>,
     range: Range<u32>,
-    buf: [u8; BUF],
+    buf: Aligned<BUF>,
     sequence: u32,
     interval_s: u32,
     last_s: Option<u64>,
@@ -306,7 +311,7 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
         Ok(Store {
             map: MapStorage::new(flash, config, Cache::new_uncached()),
             range,
-            buf: [0; BUF],
+            buf: Aligned([0; BUF]),
             sequence: 0,
             interval_s,
             last_s: None,
@@ -356,7 +361,10 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
     /// for a flash driver error or a store buffer too small for `T`.
     pub async fn restore<T: Checkpoint>(&mut self) -> Result<Restore<T>, StorageError<F::Error>> {
         self.check_buffer::<T>()?;
-        let found = self.map.fetch_item::<&[u8]>(&mut self.buf, &T::KIND).await;
+        let found = self
+            .map
+            .fetch_item::<&[u8]>(&mut self.buf.0, &T::KIND)
+            .await;
         let event = match found {
             Ok(Some(bytes)) => match codec::decode::<T>(bytes) {
                 Ok(d) => {
@@ -433,8 +441,8 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
     /// What records the map lists (every item it can read, old ones included).
     async fn records_held(&mut self, kind: u8) -> Result<Held, SsError<F::Error>> {
         let mut held = Held::default();
-        let mut items = self.map.fetch_all_items(&mut self.buf).await?;
-        while let Some((key, bytes)) = items.next::<&[u8]>(&mut self.buf).await? {
+        let mut items = self.map.fetch_all_items(&mut self.buf.0).await?;
+        while let Some((key, bytes)) = items.next::<&[u8]>(&mut self.buf.0).await? {
             held.this_kind |= key == kind;
             held.ours |= bytes.get(..4) == Some(&codec::MAGIC[..]);
         }
@@ -453,7 +461,7 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
         let mut at = self.range.start;
         while at < self.range.end {
             let n = chunk.min((self.range.end - at) as usize);
-            let buf = self.buf.get_mut(..n).ok_or(StorageError::Internal)?;
+            let buf = self.buf.0.get_mut(..n).ok_or(StorageError::Internal)?;
             self.map
                 .flash()
                 .read(at, buf)
@@ -490,7 +498,7 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
         let sequence = self.sequence.wrapping_add(1);
         // Encode once before touching the flash: a type that breaks its `SIZE` is
         // refused with nothing written.
-        if let Err(e) = codec::encode(value, sequence, &mut self.buf) {
+        if let Err(e) = codec::encode(value, sequence, &mut self.buf.0) {
             self.stats.failed_checkpoints = self.stats.failed_checkpoints.saturating_add(1);
             return Err(StorageError::Codec(e));
         }
@@ -499,7 +507,7 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
             sequence,
             error: Cell::new(None),
         };
-        let result = self.map.store_item(&mut self.buf, &T::KIND, &item).await;
+        let result = self.map.store_item(&mut self.buf.0, &T::KIND, &item).await;
         match result {
             Ok(()) => {
                 self.sequence = sequence;
