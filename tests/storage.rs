@@ -488,6 +488,16 @@ fn checkpoints_follow_the_interval_and_on_demand() {
     assert_eq!(restored.value, Some(state(3)));
     // The numbering goes on after a restart.
     assert_eq!(store.next_sequence(), 4);
+    // A new interval applies to the interval under way; zero is refused.
+    assert_eq!(store.set_interval_s(0), Err(ConfigError::ZeroInterval));
+    assert_eq!(store.interval_s(), INTERVAL_S);
+    store.set_interval_s(10).unwrap();
+    assert_eq!(block_on(store.checkpoint_if_due(5000, &state(4))), Ok(None));
+    assert_eq!(block_on(store.checkpoint_if_due(5009, &state(4))), Ok(None));
+    assert_eq!(
+        block_on(store.checkpoint_if_due(5010, &state(4))),
+        Ok(Some(4))
+    );
     // Erasing on purpose empties the region.
     block_on(store.erase()).unwrap();
     assert_eq!(boot(flash_of(store)).1.outcome, RestoreOutcome::Blank);

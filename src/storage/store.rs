@@ -343,6 +343,16 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
         self.interval_s
     }
 
+    /// Changes the checkpoint interval (e.g. from a new configuration); the interval
+    /// under way is measured against the new value.
+    pub fn set_interval_s(&mut self, interval_s: u32) -> Result<(), ConfigError> {
+        if interval_s == 0 {
+            return Err(ConfigError::ZeroInterval);
+        }
+        self.interval_s = interval_s;
+        Ok(())
+    }
+
     fn check_buffer<T: Checkpoint>(&self) -> Result<(), StorageError<F::Error>> {
         let needed = Self::buffer_len::<T>();
         if needed > BUF {
