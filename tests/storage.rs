@@ -735,15 +735,18 @@ fn power_loss_at_every_point_restores_the_previous_or_the_new_checkpoint() {
 
 #[test]
 fn garbage_over_the_whole_region_starts_fresh_and_is_reported() {
-    for seed in 0..20 {
+    // Random bytes (20 seeds), then all zeros and all 0x55 (cold RAM, a fill pattern).
+    for seed in 0..22 {
         let mut flash = written(10);
         let mut next = rng(seed);
         for i in 0..SECTORS {
-            flash
-                .sector_mut(i)
-                .unwrap()
-                .iter_mut()
-                .for_each(|b| *b = next());
+            flash.sector_mut(i).unwrap().iter_mut().for_each(|b| {
+                *b = match seed {
+                    20 => 0x00,
+                    21 => 0x55,
+                    _ => next(),
+                }
+            });
         }
         let (mut store, restored) = boot(flash);
         assert_eq!(restored.value, None, "seed {seed}");
