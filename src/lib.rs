@@ -38,6 +38,8 @@ pub mod reference;
 pub mod scene;
 #[cfg(feature = "sensors")]
 pub mod sensors;
+#[cfg(feature = "sequential-storage")]
+pub mod storage;
 #[rustfmt::skip]
 pub mod tables;
 
