@@ -13,7 +13,7 @@ pub enum Error {
     Radius,
     /// Shear modulus G not finite and positive.
     ShearModulus,
-    /// Poisson's ratio not in [0, 0.5).
+    /// Poisson's ratio not in [0, 0.5].
     PoissonRatio,
     /// Friction coefficient mu not finite and positive.
     Friction,
@@ -21,8 +21,9 @@ pub enum Error {
     Length,
     /// Load P is NaN, infinite or negative.
     Load,
-    /// Misalignment angle phi is NaN or infinite, or maps to an auxiliary angle
-    /// theta above pi/2 (eq 4), where m(theta), n(theta) are not defined.
+    /// Misalignment angle phi is NaN or infinite, or |phi| >= pi/2 (rad): the angle
+    /// between two axes is below a right angle, and eq (4) maps it to theta < pi/2,
+    /// where m(theta), n(theta) are defined.
     Angle,
     /// The elliptic solution was asked for a plane (R2 = infinity): its contact is a
     /// strip for every phi (section 8); use the line-contact model.
@@ -30,6 +31,8 @@ pub enum Error {
     /// The f32 and fixed-point cores implement eq (4); the exact theta relation is in
     /// the reference only.
     Unsupported,
+    /// Measured axial force F is NaN or infinite.
+    Force,
     /// A value outside what a prepared scene accepts: a scene constant that does not
     /// fit the core's number format, or an input outside the declared range.
     OutOfRange,
@@ -40,17 +43,18 @@ impl fmt::Display for Error {
         f.write_str(match self {
             Error::Radius => "radius must be finite and positive (R2 may be inf)",
             Error::ShearModulus => "shear modulus G must be finite and positive",
-            Error::PoissonRatio => "Poisson's ratio nu must be in [0, 0.5)",
+            Error::PoissonRatio => "Poisson's ratio nu must be in [0, 0.5]",
             Error::Friction => "friction coefficient mu must be finite and positive",
             Error::Length => "contact length must be finite and positive",
             Error::Load => "load P must be finite and >= 0",
-            Error::Angle => "misalignment phi must be finite with theta <= pi/2",
+            Error::Angle => "misalignment phi must be finite with |phi| < pi/2 rad",
             Error::PlaneHasNoEllipse => {
                 "a plane (R2 = inf) has no contact ellipse: use line contact"
             }
             Error::Unsupported => {
                 "the cores implement eq (4) only; use the reference for the exact relation"
             }
+            Error::Force => "axial force F must be finite",
             Error::OutOfRange => "value outside the range the prepared scene accepts",
         })
     }

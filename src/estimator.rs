@@ -1,9 +1,10 @@
 //! The estimator contract: what every prepared scene of both cores answers per sample.
 //!
 //! A scene is prepared once (the f32 core's [`EllipticScene`](crate::float::EllipticScene),
-//! [`LineScene`](crate::float::LineScene), [`Prepared`](crate::float::Prepared); the
-//! fixed-point core's [`FixedEllipticScene`](crate::fixed::FixedEllipticScene) and
-//! [`FixedLineScene`](crate::fixed::FixedLineScene)); then [`Estimator::estimate`] answers
+//! [`LineScene`](crate::float::LineScene), [`Auto`](crate::float::Auto); the
+//! fixed-point core's [`FixedEllipticScene`](crate::fixed::FixedEllipticScene),
+//! [`FixedLineScene`](crate::fixed::FixedLineScene), [`FixedAuto`](crate::fixed::FixedAuto));
+//! then [`Estimator::estimate`] answers
 //! one sample in the core's own numbers (f32 SI values, or counts and base-2
 //! logarithms), and [`Estimator::estimate_si`] the same in SI f32 for code that is
 //! generic over the core, such as a condition monitor.

@@ -37,6 +37,10 @@ pub mod kernels;
 pub mod monitor;
 pub mod reference;
 pub mod scene;
+#[cfg(feature = "sensors")]
+pub mod sensors;
+#[cfg(feature = "sequential-storage")]
+pub mod storage;
 #[rustfmt::skip]
 pub mod tables;
 

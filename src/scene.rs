@@ -38,7 +38,8 @@ impl Scene {
     ///
     /// # Errors
     /// A typed [`Error`] for non-finite or non-positive radii or modulus, nu outside
-    /// [0, 0.5), or mu not finite and positive.
+    /// [0, 0.5] (only 1 - nu enters the paper's equations, so incompressible rollers,
+    /// nu = 0.5, are fine), or mu not finite and positive.
     pub fn new(
         r1: f64,
         r2: f64,
@@ -52,7 +53,7 @@ impl Scene {
         if !(shear_modulus.is_finite() && shear_modulus > 0.0) {
             return Err(Error::ShearModulus);
         }
-        if !(0.0..0.5).contains(&poisson_ratio) {
+        if !(0.0..=0.5).contains(&poisson_ratio) {
             return Err(Error::PoissonRatio);
         }
         if !(friction.is_finite() && friction > 0.0) {

@@ -1,8 +1,9 @@
 //! The estimator contract: every prepared scene of both cores answers through
 //! `Estimator`, and the fixed-point core's SI answers match the f32 core's.
 
+use misalign::fixed::FixedAuto;
 use misalign::fixed::{FixedEllipticScene, FixedLineScene, Log2};
-use misalign::float::{EllipticScene, LineScene, Prepared};
+use misalign::float::{Auto, EllipticScene, LineScene};
 use misalign::{Error, Estimate, Estimator, Scene};
 
 fn scene() -> Scene {
@@ -58,12 +59,13 @@ fn fixed_and_f32_cores_agree_through_the_contract() {
 fn f32_contract_is_the_scene_itself() {
     let s = scene();
     let core = EllipticScene::new(&s).unwrap();
-    let prepared = Prepared::new(&s, 1e4, 1e-5).unwrap();
+    // Without a length section 9 takes the ellipse for every sample.
+    let auto = Auto::new(&s).unwrap();
     for (load, phi) in [(1e3, 2e-4), (0.0, 1e-3), (5e3, -1e-2), (1.0, 0.0)] {
         let want = core.estimate(load, phi).unwrap();
         assert_eq!(Estimator::estimate(&core, load, phi).unwrap(), want);
         assert_eq!(core.estimate_si(load, phi).unwrap(), want);
-        assert_eq!(prepared.estimate_si(load, phi).unwrap(), want);
+        assert_eq!(auto.estimate_si(load, phi).unwrap(), want);
     }
     assert_eq!(core.estimate_si(f32::NAN, 0.0), Err(Error::Load));
     assert_eq!(core.estimate_si(1.0, f32::INFINITY), Err(Error::Angle));
@@ -105,7 +107,10 @@ fn risk_threshold_is_set_the_same_way_in_every_core() {
     }
     check(EllipticScene::new(&s).unwrap());
     check(FixedEllipticScene::new(&s, 1e-3, 1e-11).unwrap());
-    check(Prepared::new(&s, 1e4, 1e-5).unwrap());
+    // Rollers 1 m long: the ellipse fits, section 9 takes it.
+    let long = s.with_length(1.0).unwrap();
+    check(Auto::new(&long).unwrap());
+    check(FixedAuto::new(&long, 1e-3, 1e-10).unwrap());
 }
 
 #[test]

@@ -78,6 +78,9 @@ fn line_against_vectors_line() {
         let ((load_lsb, load), (angle_lsb, angle)) = (lsb(p, 0.0), lsb(phi, 0.0));
         let prepared = FixedLineScene::new(&scene(row), load_lsb, angle_lsb).unwrap();
         let e = prepared.estimate(load as u32, angle as i32).unwrap();
+        let d = prepared.details(load as u32, angle as i32).unwrap();
+        worst.add("b", i, d.b.to_f64(), num(row, "b"));
+        worst.add("p0", i, d.p0.to_f64(), num(row, "p0"));
         worst.add("s", i, e.slip_ratio.to_f64(), num(row, "s"));
         worst.add("F", i, signed_force(&e), num(row, "F"));
         worst.add(

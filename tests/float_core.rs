@@ -57,9 +57,11 @@ fn line_against_vectors_line() {
     let mut worst = Worst::default();
     for (i, row) in read_rows("vectors_line.csv").iter().enumerate() {
         let prepared = LineScene::new(&scene(row)).unwrap();
-        let e = prepared
-            .estimate(num(row, "P") as f32, num(row, "phi") as f32)
-            .unwrap();
+        let (p, phi) = (num(row, "P") as f32, num(row, "phi") as f32);
+        let e = prepared.estimate(p, phi).unwrap();
+        let d = prepared.details(p, phi).unwrap();
+        worst.add("b", i, d.b as f64, num(row, "b"));
+        worst.add("p0", i, d.p0 as f64, num(row, "p0"));
         worst.add("s", i, e.slip_ratio as f64, num(row, "s"));
         worst.add("F", i, e.axial_force as f64, num(row, "F"));
         worst.add(

@@ -680,3 +680,41 @@ fn smoothing_weight_follows_the_real_time_step() {
     m.process(Sample::new(3_000, LOAD + 2.0, b));
     assert!((m.reading().unwrap().phi - one).abs() < 1e-9);
 }
+
+#[test]
+fn the_model_is_chosen_once_for_the_operating_range() {
+    use misalign::monitor::model_for_range;
+    use misalign::reference::{self, ModelChoice};
+    let steel = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
+    assert_eq!(
+        model_for_range(&steel, 5e3, 1e-5),
+        Ok(ModelChoice::Elliptic)
+    );
+    let plane = Scene::new(0.05, f64::INFINITY, 79.3e9, 0.3, 0.3).unwrap();
+    assert_eq!(model_for_range(&plane, 5e3, 1e-5), Ok(ModelChoice::Line));
+    // Short rollers: the ellipse at the heaviest load and smallest angle is longer.
+    let short = steel.with_length(0.02).unwrap();
+    assert!(
+        reference::elliptic(&short, 5e3, 1e-5)
+            .unwrap()
+            .validity
+            .longer_than_rollers
+    );
+    assert_eq!(model_for_range(&short, 5e3, 1e-5), Ok(ModelChoice::Line));
+    let long = steel.with_length(2.0).unwrap();
+    assert!(
+        !reference::elliptic(&long, 5e3, 1e-3)
+            .unwrap()
+            .validity
+            .longer_than_rollers
+    );
+    assert_eq!(model_for_range(&long, 5e3, 1e-3), Ok(ModelChoice::Elliptic));
+    assert_eq!(
+        model_for_range(&steel, f64::NAN, 1e-5),
+        Err(misalign::Error::Load)
+    );
+    assert_eq!(
+        model_for_range(&steel, 5e3, 0.0),
+        Err(misalign::Error::Angle)
+    );
+}

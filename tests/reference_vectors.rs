@@ -1,4 +1,4 @@
-//! The f64 reference against the independent 50-digit values of ../shared/reference:
+//! The f64 reference against the independent 50-digit values of tests/data:
 //! every row, every quantity, within 1e-12 relative (issue 2).
 
 mod common;

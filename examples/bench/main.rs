@@ -123,6 +123,28 @@ mod run {
         // Line contact.
         each(c, f32s(), |(p, phi)| line.estimate(p, phi)).print("f32", "estimate:line");
         each(c, counts(), |(p, a)| fixed_line.estimate(p, a)).print("fixed", "estimate:line");
+        // The inverses (issue 11): mu from (P, phi, F) and phi from (P, F), with F from
+        // the forward estimate (computed outside the measured call).
+        let with_force =
+            |(p, phi): (f32, f32)| (p, phi, core.estimate(p, phi).map_or(0.0, |e| e.axial_force));
+        each(c, f32s().map(with_force), |(p, phi, f)| {
+            core.friction_from_axial_force(p, phi, f)
+        })
+        .print("f32", "inverse:mu");
+        each(c, f32s().map(with_force), |(p, _, f)| {
+            core.angle_from_axial_force(p, f)
+        })
+        .print("f32", "inverse:phi");
+        let with_line_force =
+            |(p, phi): (f32, f32)| (p, phi, line.estimate(p, phi).map_or(0.0, |e| e.axial_force));
+        each(c, f32s().map(with_line_force), |(p, phi, f)| {
+            line.friction_from_axial_force(p, phi, f)
+        })
+        .print("f32", "inverse:mu:line");
+        each(c, f32s().map(with_line_force), |(p, _, f)| {
+            line.angle_from_axial_force(p, f)
+        })
+        .print("f32", "inverse:phi:line");
         // The f32 kernels, on what they see in these estimates.
         let thetas = || f32s().map(|(_, phi)| phi.abs());
         each(c, thetas(), |t| G_OF_THETA.eval(t)).print("f32", "table:g");
@@ -170,6 +192,22 @@ mod run {
             reference::line(&scene, p, phi)
         })
         .print("reference", "estimate:line");
+        let with_ref_force = |(p, phi): (f64, f64)| {
+            let f = reference::elliptic(&scene, p, phi).map_or(0.0, |e| e.axial_force);
+            (p, phi, f)
+        };
+        each(
+            c,
+            samples::practical(few).map(with_ref_force),
+            |(p, phi, f)| reference::inverse::friction_elliptic(&scene, p, phi, f),
+        )
+        .print("reference", "inverse:mu");
+        each(
+            c,
+            samples::practical(few).map(with_ref_force),
+            |(p, _, f)| reference::inverse::angle_elliptic(&scene, p, f),
+        )
+        .print("reference", "inverse:phi");
         0
     }
 }

@@ -1,423 +1,681 @@
-//! The estimator's logic, shared by `examples/estimate/main.rs` and the tests.
+//! The estimator's logic, shared by `examples/estimate/main.rs`, the tests, the host
+//! benchmark and the fuzz target.
+//!
+//! Arguments through clap; every output row is one typed [`OutRow`] written through
+//! csv's serde support, so that the header and the values cannot drift apart; every
+//! number goes through one formatter (csv's, ryu: the shortest text that reads back to
+//! the same f64 or f32). Input is read as bytes: a bad row (wrong number of fields,
+//! non-UTF-8 or NUL bytes, an unterminated quote, a number that is not one) becomes that
+//! row's `error` and the batch goes on.
 
-use misalign::fixed::{FixedEllipticScene, FixedLineScene, Log2, exact_lsb};
-use misalign::float::{EllipticScene, LineScene};
-use misalign::reference::{self, Regime, Validity};
+use clap::{Parser, ValueEnum};
+use misalign::fixed::{FixedAuto, FixedContactDetails, FixedEllipticScene, Log2, exact_lsb};
+use misalign::float::{Auto, ContactDetails};
+use misalign::reference::{
+    self, ANGLE_LIMIT, ContactModel, Estimate, ModelChoice, PRESSURE_LIMIT, SLENDER_LIMIT, Validity,
+};
 use misalign::{Error, Scene};
+use serde::Serialize;
 use std::io::{Read, Write};
 
-pub const HELP: &str = "\
-estimate: misalignment, microslip and axial force for each row of a CSV file
+const ABOUT: &str = "Misalignment, microslip and axial force for each row of a CSV file, \
+after \"The rolling contact of misaligned elastic cylinders\".";
 
-USAGE:
-    cargo run --release --example estimate -- [--model reference|f32|fixed] [--contact elliptic|line] < in.csv > out.csv
-
-OPTIONS:
-    --model reference     the f64 reference of the whole paper (default)
-    --model f32           the f32 core that runs on a Cortex-M4F (tables, kernels)
-    --model fixed         the fixed-point core for a Cortex-M0/M3; each row's P and phi
-                          become integer counts of an LSB that holds them exactly
-                          (up to 2^30 counts; angles no finer than the tables allow)
-    --contact elliptic    the contact ellipse, sections 5-7 (default); P in N
-    --contact line        line contact, section 8; P in N/m, R2 = inf for a plane
-    -h, --help            this text
-
+const AFTER_HELP: &str = "\
 INPUT (stdin): CSV with a header naming at least R1,R2,G,nu,mu,P,phi, in any order;
-    other columns are ignored. SI units: R1, R2 in m (R2 may be inf), G in Pa, P in N
-    (N/m for line contact), phi in rad (signed). An optional column `length` (m) is the
-    rollers' contact length: the flags then say when the ellipse is longer.
+    other columns are ignored, and each needed one may appear once. SI units: R1, R2 in
+    m (R2 = inf is a plane), G in Pa, phi in rad (signed). An optional column `length`
+    (m) is the rollers' contact length. P is the total load in N; only line contact
+    without a length reads it as a load per unit length (N/m). A ';'-separated file is
+    detected and read so (said on stderr).
 
-OUTPUT (stdout): one row per input row, in order.
-    elliptic: theta,m,n,a,b,p0,s,F,phi0,regime,error,kprime,Pstar,P0star,theta0,d,model,flags
-    line:     R,b,p0,s,F,phi0,regime,error,Pstar,P0star,d,model,flags
-    s is the slip ratio d/b; regime is partial (s < 1) or gross; F has the sign of phi.
-    The cores leave empty what they do not compute (Pstar, P0star, theta0, flags other
-    than no_critical_angle).
-    Numbers are in shortest round-trip form. A row that cannot be computed has empty
-    values and a message in `error`; the batch goes on. phi0 is empty when no
-    theta <= pi/2 reaches s = 1 (flag no_critical_angle). flags lists, separated by
-    ';', where the theory is stretched: large_angle, high_pressure,
-    longer_than_rollers.
+MODEL CHOICE (--contact auto, the default; section 9 of the paper): the ellipse, or
+    line contact with P / length when the ellipse is longer than the rollers
+    (2a > length), and line contact for a plane. The same rule in every --model; the
+    `model` column says which answered. Near the switch (2a / length within 1.25 of 1)
+    the flag near_model_switch is raised: there line d/b is up to 1.22 times the
+    ellipse's (sqrt(3 / (2 E(k)))), and phi0 jumps to the other model's value.
 
-EXIT STATUS: 0, unless the input is not CSV or lacks a column (2 for bad options).
-";
+OUTPUT (stdout): one row per input row, in order, under one header:
+    theta,m,n,a,b,p0,s,F,phi0,regime,error,kprime,Pstar,P0star,theta0,d,R,model,flags
+    s is the slip ratio d/b; regime is partial (s < 1) or gross; F has the sign of phi
+    and is the total axial force (N; N/m in line contact without a length). Line rows
+    fill R,b,p0,s,F,phi0,d (and Pstar,P0star from the reference); elliptic rows the
+    ellipse's columns. The cores leave empty what they do not compute (Pstar, P0star,
+    theta0). Numbers are in shortest round-trip form. A row that cannot be computed has
+    empty values and a message in `error`; the batch goes on. phi0 is empty when no
+    theta < pi/2 reaches s = 1. flags lists, separated by ';', where the theory is
+    stretched: large_angle, high_pressure, longer_than_rollers, near_model_switch,
+    round_ellipse (a/b < 10: F under-predicted by 2 % or more), no_critical_angle.
 
-const INPUTS: [&str; 7] = ["R1", "R2", "G", "nu", "mu", "P", "phi"];
-const ELLIPTIC: [&str; 18] = [
-    "theta", "m", "n", "a", "b", "p0", "s", "F", "phi0", "regime", "error", "kprime", "Pstar",
-    "P0star", "theta0", "d", "model", "flags",
-];
-const LINE: [&str; 13] = [
-    "R", "b", "p0", "s", "F", "phi0", "regime", "error", "Pstar", "P0star", "d", "model", "flags",
-];
+EXIT STATUS: 0; 1 when the input has no header, lacks a column or repeats one, or the
+    output cannot be written; 2 for bad options.";
 
-#[derive(Clone, Copy, PartialEq, Debug)]
-pub enum Contact {
-    Elliptic,
-    Line,
+/// Command-line options.
+#[derive(Parser, Debug)]
+#[command(name = "estimate", about = ABOUT, after_help = AFTER_HELP)]
+struct Options {
+    /// Which implementation computes each row.
+    #[arg(long, value_enum, default_value_t = Model::Reference)]
+    model: Model,
+    /// Which contact model answers: section 9's choice per row, or one forced.
+    #[arg(long, value_enum, default_value_t = Contact::Auto)]
+    contact: Contact,
 }
 
-#[derive(Clone, Copy, PartialEq, Debug)]
+/// `--model`.
+#[derive(Clone, Copy, PartialEq, Debug, ValueEnum)]
 pub enum Model {
+    /// The f64 reference of the whole paper.
     Reference,
+    /// The f32 core that runs on a Cortex-M4F (tables, kernels).
     F32,
+    /// The fixed-point core for a Cortex-M0/M3; each row's P and phi become integer
+    /// counts of an LSB that holds them exactly (up to 2^30 counts).
     Fixed,
 }
 
-/// Shortest text that reads back to the same f64.
-pub fn number(x: f64) -> String {
-    let a = x.abs();
-    if x == 0.0 || !x.is_finite() || (1e-3..1e7).contains(&a) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
+/// `--contact`.
+#[derive(Clone, Copy, PartialEq, Debug, ValueEnum)]
+pub enum Contact {
+    /// Section 9 per row: line contact when the ellipse is longer than the rollers.
+    Auto,
+    /// Always the contact ellipse (sections 5-7).
+    Elliptic,
+    /// Always line contact (section 8), with P / length when a length is given.
+    Line,
+}
+
+impl Contact {
+    fn choice(self) -> ModelChoice {
+        match self {
+            Contact::Auto => ModelChoice::Section9,
+            Contact::Elliptic => ModelChoice::Elliptic,
+            Contact::Line => ModelChoice::Line,
+        }
     }
 }
 
-/// Shortest text that reads back to the same f32.
-pub fn number32(x: f32) -> String {
-    let a = x.abs();
-    if x == 0.0 || !x.is_finite() || (1e-3..1e7).contains(&a) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
+/// A number of an output row: the reference's f64 or the f32 core's own value, each
+/// written in its shortest round-trip form.
+#[derive(Clone, Copy, Debug, Serialize)]
+#[serde(untagged)]
+pub enum Num {
+    /// From the reference or the fixed-point core.
+    F64(f64),
+    /// From the f32 core.
+    F32(f32),
+}
+
+/// One output row; its field names are the header.
+#[derive(Debug, Default, Serialize)]
+pub struct OutRow<'a> {
+    theta: Option<Num>,
+    m: Option<Num>,
+    n: Option<Num>,
+    a: Option<Num>,
+    b: Option<Num>,
+    p0: Option<Num>,
+    s: Option<Num>,
+    #[serde(rename = "F")]
+    force: Option<Num>,
+    phi0: Option<Num>,
+    regime: &'a str,
+    error: &'a str,
+    kprime: Option<Num>,
+    #[serde(rename = "Pstar")]
+    pstar: Option<Num>,
+    #[serde(rename = "P0star")]
+    p0star: Option<Num>,
+    theta0: Option<Num>,
+    d: Option<Num>,
+    #[serde(rename = "R")]
+    radius: Option<Num>,
+    model: &'a str,
+    flags: &'a str,
+}
+
+const INPUTS: [&str; 7] = ["R1", "R2", "G", "nu", "mu", "P", "phi"];
+
+/// The flags column, built in a buffer reused from row to row.
+fn write_flags(out: &mut String, v: &Validity, no_critical_angle: bool) {
+    out.clear();
+    for (raised, name) in [
+        (v.large_angle, "large_angle"),
+        (v.high_pressure, "high_pressure"),
+        (v.longer_than_rollers, "longer_than_rollers"),
+        (v.near_model_switch, "near_model_switch"),
+        (v.round_ellipse, "round_ellipse"),
+        (no_critical_angle, "no_critical_angle"),
+    ] {
+        if raised {
+            if !out.is_empty() {
+                out.push(';');
+            }
+            out.push_str(name);
+        }
     }
 }
 
-fn flags(v: &Validity, no_critical_angle: bool) -> String {
-    let mut out = Vec::new();
-    if v.large_angle {
-        out.push("large_angle");
+/// The reference's validity flags for a core's answer, from its own numbers.
+fn core_validity(
+    scene: &Scene,
+    phi: f64,
+    critical_angle: Option<f64>,
+    p0: f64,
+    ellipse: Option<(f64, f64)>, // (a, k')
+    near_model_switch: bool,
+) -> Validity {
+    Validity {
+        large_angle: phi.abs() > ANGLE_LIMIT || critical_angle.is_none_or(|c| c > ANGLE_LIMIT),
+        high_pressure: p0 / scene.shear_modulus() > PRESSURE_LIMIT,
+        longer_than_rollers: ellipse
+            .zip(scene.length())
+            .is_some_and(|((a, _), l)| 2.0 * a > l),
+        near_model_switch,
+        round_ellipse: ellipse.is_some_and(|(_, k)| k * SLENDER_LIMIT > 1.0),
     }
-    if v.high_pressure {
-        out.push("high_pressure");
-    }
-    if v.longer_than_rollers {
-        out.push("longer_than_rollers");
-    }
-    if no_critical_angle {
-        out.push("no_critical_angle");
-    }
-    out.join(";")
 }
 
-/// A row's inputs, or the message for its `error` column.
+/// A core's answer: its row, and the flags from its own numbers.
+fn core_answer(
+    x: &Sample,
+    row: OutRow<'static>,
+    critical: Option<f64>,
+    p0: f64,
+    ellipse: Option<(f64, f64)>,
+    near_model_switch: bool,
+) -> Answer {
+    Answer {
+        row,
+        validity: core_validity(&x.scene, x.phi, critical, p0, ellipse, near_model_switch),
+        no_critical_angle: critical.is_none(),
+    }
+}
+
+/// A number from one input field: UTF-8, a decimal f64, and inside f64's range
+/// (1e400 is refused, not read as infinity; 1e-400 is refused, not read as 0).
+fn number(name: &str, field: &[u8]) -> Result<f64, String> {
+    let text = std::str::from_utf8(field)
+        .map_err(|_| format!("{name}: not UTF-8"))?
+        .trim();
+    let x: f64 = text
+        .parse()
+        .map_err(|_| format!("{name}: not a number: {text:?}"))?;
+    let mantissa = text.split(['e', 'E']).next().unwrap_or("");
+    let literal_inf = mantissa.to_ascii_lowercase().contains("inf");
+    if x.is_infinite() && !literal_inf {
+        return Err(format!(
+            "{name} = {text} is outside the range of f64 numbers (|x| <= 1.8e308)"
+        ));
+    }
+    if x == 0.0 && mantissa.bytes().any(|b| (b'1'..=b'9').contains(&b)) {
+        return Err(format!(
+            "{name} = {text} is below the smallest f64 number (4.9e-324)"
+        ));
+    }
+    Ok(x)
+}
+
+/// The scene and sample of a row, or the message for its `error` column.
 fn scene_and_sample(
-    values: &[Option<&str>; 7],
-    length: Option<&str>,
+    record: &csv::ByteRecord,
+    columns: &[usize; 7],
+    length: Option<usize>,
 ) -> Result<(Scene, f64, f64), String> {
     let mut x = [0.0; 7];
-    for (i, v) in values.iter().enumerate() {
-        let text = v.unwrap_or("").trim();
-        x[i] = text
-            .parse::<f64>()
-            .map_err(|_| format!("{}: not a number: {text:?}", INPUTS[i]))?;
+    for (k, &c) in columns.iter().enumerate() {
+        x[k] = number(INPUTS[k], record.get(c).unwrap_or(b""))?;
     }
-    let mut scene = Scene::new(x[0], x[1], x[2], x[3], x[4]).map_err(|e: Error| e.to_string())?;
-    if let Some(l) = length.map(str::trim).filter(|l| !l.is_empty()) {
-        let l: f64 = l
-            .parse()
-            .map_err(|_| format!("length: not a number: {l:?}"))?;
+    let mut scene = Scene::new(x[0], x[1], x[2], x[3], x[4]).map_err(|e| e.to_string())?;
+    if let Some(field) = length.and_then(|c| record.get(c))
+        && !field.iter().all(u8::is_ascii_whitespace)
+    {
+        let l = number("length", field)?;
         scene = scene.with_length(l).map_err(|e| e.to_string())?;
     }
     Ok((scene, x[5], x[6]))
 }
 
-fn elliptic_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
-    let e = reference::elliptic(scene, load, phi).map_err(|e| e.to_string())?;
-    let opt = |x: Option<f64>| x.map(number).unwrap_or_default();
-    Ok(vec![
-        number(e.shape.theta),
-        number(e.shape.m),
-        number(e.shape.n),
-        number(e.a),
-        number(e.b),
-        number(e.p0),
-        number(e.slip_ratio),
-        number(e.axial_force),
-        opt(e.critical_angle),
-        e.regime.as_str().into(),
-        String::new(),
-        number(e.shape.kprime),
-        number(e.pstar),
-        number(e.p0star),
-        opt(e.critical_theta),
-        number(e.d),
-        "elliptic".into(),
-        flags(&e.validity, e.critical_angle.is_none()),
-    ])
+/// One row's input.
+struct Sample {
+    scene: Scene,
+    load: f64,
+    phi: f64,
+    choice: ModelChoice,
 }
 
-fn no_critical(phi0: &str) -> String {
-    if phi0.is_empty() {
-        "no_critical_angle".into()
-    } else {
-        String::new()
-    }
+/// One row's answer: its values, and what its flags column says.
+struct Answer {
+    row: OutRow<'static>,
+    validity: Validity,
+    no_critical_angle: bool,
 }
 
-fn f32_elliptic_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
-    let prepared = EllipticScene::new(scene).map_err(|e| e.to_string())?;
-    let (p, a) = (load as f32, phi as f32);
-    let e = prepared.estimate(p, a).map_err(|e| e.to_string())?;
-    let d = prepared.details(p, a).map_err(|e| e.to_string())?;
-    let phi0 = e.critical_angle.map(number32).unwrap_or_default();
-    let width = if e.slip_ratio < 1.0 {
-        e.slip_ratio * d.b
-    } else {
-        d.b
-    };
-    Ok(vec![
-        number32(d.theta),
-        number32(d.m),
-        number32(d.n),
-        number32(d.a),
-        number32(d.b),
-        number32(d.p0),
-        number32(e.slip_ratio),
-        number32(e.axial_force),
-        phi0.clone(),
-        e.regime.as_str().into(),
-        String::new(),
-        number32(d.n / d.m),
-        String::new(),
-        String::new(),
-        String::new(),
-        number32(width),
-        "elliptic".into(),
-        no_critical(&phi0),
-    ])
-}
-
-fn f32_line_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
-    let prepared = LineScene::new(scene).map_err(|e| e.to_string())?;
-    let e = prepared
-        .estimate(load as f32, phi as f32)
-        .map_err(|e| e.to_string())?;
-    Ok(vec![
-        number(scene.effective_radius()),
-        String::new(),
-        String::new(),
-        number32(e.slip_ratio),
-        number32(e.axial_force),
-        e.critical_angle.map(number32).unwrap_or_default(),
-        e.regime.as_str().into(),
-        String::new(),
-        String::new(),
-        String::new(),
-        String::new(),
-        "line".into(),
-        String::new(),
-    ])
-}
-
-/// Counts for the fixed-point core: 2^30 of an LSB that holds the value exactly.
-fn counts(x: f64, min_lsb: f64) -> (f64, u32) {
-    exact_lsb(x, 1 << 30, min_lsb)
-}
-
-fn signed(x: Log2, negative: bool) -> String {
-    number(if negative { -x.to_f64() } else { x.to_f64() })
-}
-
-fn fixed_elliptic_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
-    if !(load.is_finite() && load >= 0.0) {
-        return Err(Error::Load.to_string());
-    }
-    if !phi.is_finite() || scene.is_plane() {
-        return Err(if scene.is_plane() {
-            Error::PlaneHasNoEllipse
-        } else {
-            Error::Angle
+/// The reference's answer for one row.
+fn reference_row(x: &Sample) -> Result<Answer, String> {
+    let (scene, load, phi, choice) = (&x.scene, x.load, x.phi, x.choice);
+    let est = reference::estimate_with(scene, load, phi, choice).map_err(|e| e.to_string())?;
+    let f = Some(Num::F64(est.axial_force(scene)));
+    match est {
+        Estimate::Elliptic(e) => {
+            let opt = |x: Option<f64>| x.map(Num::F64);
+            let row = OutRow {
+                theta: opt(Some(e.shape.theta)),
+                m: opt(Some(e.shape.m)),
+                n: opt(Some(e.shape.n)),
+                a: opt(Some(e.a)),
+                b: opt(Some(e.b)),
+                p0: opt(Some(e.p0)),
+                s: opt(Some(e.slip_ratio)),
+                force: f,
+                phi0: opt(e.critical_angle),
+                regime: e.regime.as_str(),
+                kprime: opt(Some(e.shape.kprime)),
+                pstar: opt(Some(e.pstar)),
+                p0star: opt(Some(e.p0star)),
+                theta0: opt(e.critical_theta),
+                d: opt(Some(e.d)),
+                model: ContactModel::Elliptic.as_str(),
+                ..OutRow::default()
+            };
+            Ok(Answer {
+                row,
+                validity: e.validity,
+                no_critical_angle: e.critical_angle.is_none(),
+            })
         }
-        .to_string());
+        Estimate::Line(l) => {
+            let row = OutRow {
+                b: Some(Num::F64(l.b)),
+                p0: Some(Num::F64(l.p0)),
+                s: Some(Num::F64(l.slip_ratio)),
+                force: f,
+                phi0: Some(Num::F64(l.critical_angle)),
+                regime: l.regime.as_str(),
+                pstar: Some(Num::F64(l.pstar)),
+                p0star: Some(Num::F64(l.p0star)),
+                d: Some(Num::F64(l.d)),
+                radius: Some(Num::F64(l.radius)),
+                model: ContactModel::Line.as_str(),
+                ..OutRow::default()
+            };
+            Ok(Answer {
+                row,
+                validity: l.validity,
+                no_critical_angle: false,
+            })
+        }
     }
-    let (load_lsb, p) = counts(load, 0.0);
-    let (angle_lsb, a) = counts(phi, FixedEllipticScene::min_angle_lsb(scene));
-    let angle = if phi < 0.0 { -(a as i64) } else { a as i64 };
-    let angle = i32::try_from(angle).map_err(|_| Error::Angle.to_string())?;
-    let prepared =
-        FixedEllipticScene::new(scene, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
-    let e = prepared.estimate(p, angle).map_err(|e| e.to_string())?;
-    let d = prepared.details(p, angle).map_err(|e| e.to_string())?;
-    let phi0 = e
-        .critical_angle
-        .map(|x| number(x.to_f64()))
-        .unwrap_or_default();
-    let width = if e.regime == Regime::Partial {
-        e.slip_ratio.to_f64() * d.b.to_f64()
-    } else {
-        d.b.to_f64()
-    };
-    Ok(vec![
-        number(d.theta.to_f64()),
-        number(d.m.to_f64()),
-        number(d.n.to_f64()),
-        number(d.a.to_f64()),
-        number(d.b.to_f64()),
-        number(d.p0.to_f64()),
-        number(e.slip_ratio.to_f64()),
-        signed(e.axial_force, e.axial_force_negative),
-        phi0.clone(),
-        e.regime.as_str().into(),
-        String::new(),
-        number(d.n.to_f64() / d.m.to_f64()),
-        String::new(),
-        String::new(),
-        String::new(),
-        number(width),
-        "elliptic".into(),
-        no_critical(&phi0),
-    ])
 }
 
-fn fixed_line_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
+/// f32's range for an input: finite, and not so small that it rounds to 0.
+fn to_f32(name: &str, unit: &str, x: f64) -> Result<f32, String> {
+    let y = x as f32;
+    if y.is_infinite() {
+        return Err(format!(
+            "f32 core: {name} = {x:e} {unit} is outside f32's range (|{name}| <= 3.4028235e38)"
+        ));
+    }
+    if y == 0.0 && x != 0.0 {
+        return Err(format!(
+            "f32 core: {name} = {x:e} {unit} is below f32's smallest number (1.4e-45)"
+        ));
+    }
+    Ok(y)
+}
+
+fn f32_error(e: Error) -> String {
+    match e {
+        Error::OutOfRange => "f32 core: a scene constant is outside f32's normal range \
+            (1.2e-38 to 3.4e38): R1, R2, G, mu or length too extreme for f32, or radii \
+            more than 1e24 apart"
+            .into(),
+        e => e.to_string(),
+    }
+}
+
+/// The f32 core's answer for one row.
+fn f32_row(x: &Sample) -> Result<Answer, String> {
+    let (scene, load, phi, choice) = (&x.scene, x.load, x.phi, x.choice);
+    let (p, a) = (to_f32("P", "N", load)?, to_f32("phi", "rad", phi)?);
+    let auto = Auto::with_choice(scene, choice).map_err(f32_error)?;
+    let e = auto.estimate(p, a).map_err(f32_error)?;
+    let est = e.estimate;
+    let critical = est.critical_angle.map(f64::from);
+    let s = est.slip_ratio;
+    let common = OutRow {
+        s: Some(Num::F32(s)),
+        force: Some(Num::F32(est.axial_force)),
+        phi0: est.critical_angle.map(Num::F32),
+        regime: est.regime.as_str(),
+        model: e.model.as_str(),
+        ..OutRow::default()
+    };
+    let near = e.near_model_switch;
+    Ok(match auto.details(p, a).map_err(f32_error)? {
+        ContactDetails::Elliptic(d) => {
+            let kprime = d.n / d.m;
+            let row = OutRow {
+                theta: Some(Num::F32(d.theta)),
+                m: Some(Num::F32(d.m)),
+                n: Some(Num::F32(d.n)),
+                a: Some(Num::F32(d.a)),
+                b: Some(Num::F32(d.b)),
+                p0: Some(Num::F32(d.p0)),
+                kprime: Some(Num::F32(kprime)),
+                d: Some(Num::F32(s.min(1.0) * d.b)),
+                ..common
+            };
+            let ellipse = Some((d.a as f64, kprime as f64));
+            core_answer(x, row, critical, d.p0 as f64, ellipse, near)
+        }
+        ContactDetails::Line(d) => {
+            let row = OutRow {
+                b: Some(Num::F32(d.b)),
+                p0: Some(Num::F32(d.p0)),
+                d: Some(Num::F32(s.min(1.0) * d.b)),
+                radius: Some(Num::F64(scene.effective_radius())),
+                ..common
+            };
+            core_answer(x, row, critical, d.p0 as f64, None, near)
+        }
+    })
+}
+
+/// The fixed-point core's messages, with the value and the range it missed.
+fn fixed_error(e: Error, what: &str) -> String {
+    match e {
+        Error::OutOfRange => format!("fixed-point core: {what}"),
+        e => e.to_string(),
+    }
+}
+
+fn signed(x: Log2, negative: bool) -> f64 {
+    if negative { -x.to_f64() } else { x.to_f64() }
+}
+
+/// The fixed-point core's answer for one row.
+fn fixed_row(x: &Sample) -> Result<Answer, String> {
+    let (scene, load, phi, choice) = (&x.scene, x.load, x.phi, x.choice);
     if !(load.is_finite() && load >= 0.0) {
         return Err(Error::Load.to_string());
     }
     if !phi.is_finite() {
         return Err(Error::Angle.to_string());
     }
-    let (load_lsb, p) = counts(load, 0.0);
-    let (angle_lsb, a) = counts(phi, 0.0);
-    let angle = if phi < 0.0 { -(a as i32) } else { a as i32 };
-    let prepared = FixedLineScene::new(scene, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
-    let e = prepared.estimate(p, angle).map_err(|e| e.to_string())?;
-    Ok(vec![
-        number(scene.effective_radius()),
-        String::new(),
-        String::new(),
-        number(e.slip_ratio.to_f64()),
-        signed(e.axial_force, e.axial_force_negative),
-        e.critical_angle
-            .map(|x| number(x.to_f64()))
-            .unwrap_or_default(),
-        e.regime.as_str().into(),
-        String::new(),
-        String::new(),
-        String::new(),
-        String::new(),
-        "line".into(),
-        String::new(),
-    ])
-}
-
-fn line_row(scene: &Scene, load: f64, phi: f64) -> Result<Vec<String>, String> {
-    let l = reference::line(scene, load, phi).map_err(|e| e.to_string())?;
-    Ok(vec![
-        number(l.radius),
-        number(l.b),
-        number(l.p0),
-        number(l.slip_ratio),
-        number(l.axial_force),
-        number(l.critical_angle),
-        l.regime.as_str().into(),
-        String::new(),
-        number(l.pstar),
-        number(l.p0star),
-        number(l.d),
-        "line".into(),
-        flags(&l.validity, false),
-    ])
-}
-
-/// Runs the estimator over `input`, writing CSV to `output` and diagnostics to `err`;
-/// returns the process exit code.
-pub fn run(args: &[String], input: impl Read, output: impl Write, err: &mut dyn Write) -> i32 {
-    let mut contact = Contact::Elliptic;
-    let mut model = Model::Reference;
-    let mut i = 0;
-    while i < args.len() {
-        let value = args.get(i + 1).map(String::as_str);
-        match (args[i].as_str(), value) {
-            ("-h" | "--help", _) => {
-                let mut output = output;
-                let _ = output.write_all(HELP.as_bytes());
-                return 0;
-            }
-            ("--model", Some("reference")) => (model, i) = (Model::Reference, i + 1),
-            ("--model", Some("f32")) => (model, i) = (Model::F32, i + 1),
-            ("--model", Some("fixed")) => (model, i) = (Model::Fixed, i + 1),
-            ("--contact", Some("elliptic")) => (contact, i) = (Contact::Elliptic, i + 1),
-            ("--contact", Some("line")) => (contact, i) = (Contact::Line, i + 1),
-            (other, v) => {
-                let _ = writeln!(
-                    err,
-                    "estimate: bad option {other} {}\n\n{HELP}",
-                    v.unwrap_or("")
-                );
-                return 2;
-            }
+    // Counts: up to 2^30 of an LSB that holds the value exactly; angles no finer than
+    // the tables allow (theta >= 2^-40 rad per count) where an ellipse may answer.
+    let min_angle = if scene.is_plane() || choice == ModelChoice::Line {
+        0.0
+    } else {
+        FixedEllipticScene::min_angle_lsb(scene)
+    };
+    let (load_lsb, p) = exact_lsb(load, 1 << 30, 0.0);
+    let (angle_lsb, a) = exact_lsb(phi, 1 << 30, min_angle);
+    let angle = i32::try_from(a).map_err(|_| Error::Angle.to_string())?;
+    let angle = if phi < 0.0 { -angle } else { angle };
+    let auto = FixedAuto::with_choice(scene, load_lsb, angle_lsb, choice).map_err(|e| {
+        if angle_lsb < min_angle {
+            fixed_error(
+                e,
+                &format!(
+                    "|phi| = {:e} rad is below its smallest angle {min_angle:e} rad for this \
+                     scene (theta = c |phi| >= 2^-40 rad, eq 4)",
+                    phi.abs()
+                ),
+            )
+        } else {
+            fixed_error(
+                e,
+                &format!(
+                    "a scene constant is outside its Q8.24 logarithms (2^-100 to 2^100): \
+                     R1, R2, G, mu, length or P = {load:e} N too extreme"
+                ),
+            )
         }
-        i += 1;
-    }
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(input);
-    let headers = match reader.headers() {
-        Ok(h) => h.clone(),
-        Err(e) => {
-            let _ = writeln!(err, "estimate: input is not CSV: {e}");
-            return 1;
+    })?;
+    let range = auto.input_range();
+    let sample_error = |e: Error| {
+        fixed_error(
+            e,
+            &format!(
+                "P = {load:e} N is below its smallest load for this scene, {:e} N (the \
+                 critical angle's table starts at theta = 2^-40 rad)",
+                range.load_min as f64 * load_lsb
+            ),
+        )
+    };
+    let e = auto.estimate(p, angle).map_err(sample_error)?;
+    let est = e.estimate;
+    let critical = est.critical_angle.map(Log2::to_f64);
+    let s = est.slip_ratio.to_f64();
+    let common = OutRow {
+        s: Some(Num::F64(s)),
+        force: Some(Num::F64(signed(est.axial_force, est.axial_force_negative))),
+        phi0: critical.map(Num::F64),
+        regime: est.regime.as_str(),
+        model: e.model.as_str(),
+        ..OutRow::default()
+    };
+    let near = e.near_model_switch;
+    Ok(match auto.details(p, angle).map_err(sample_error)? {
+        FixedContactDetails::Elliptic(d) => {
+            let (m, n, b, p0) = (d.m.to_f64(), d.n.to_f64(), d.b.to_f64(), d.p0.to_f64());
+            let kprime = n / m;
+            let row = OutRow {
+                theta: Some(Num::F64(d.theta.to_f64())),
+                m: Some(Num::F64(m)),
+                n: Some(Num::F64(n)),
+                a: Some(Num::F64(d.a.to_f64())),
+                b: Some(Num::F64(b)),
+                p0: Some(Num::F64(p0)),
+                kprime: Some(Num::F64(kprime)),
+                d: Some(Num::F64(s.min(1.0) * b)),
+                ..common
+            };
+            core_answer(x, row, critical, p0, Some((d.a.to_f64(), kprime)), near)
+        }
+        FixedContactDetails::Line(d) => {
+            let (b, p0) = (d.b.to_f64(), d.p0.to_f64());
+            let row = OutRow {
+                b: Some(Num::F64(b)),
+                p0: Some(Num::F64(p0)),
+                d: Some(Num::F64(s.min(1.0) * b)),
+                radius: Some(Num::F64(scene.effective_radius())),
+                ..common
+            };
+            core_answer(x, row, critical, p0, None, near)
+        }
+    })
+}
+
+/// Where the needed columns are: `Err` with the message when one is missing or repeated.
+fn find_columns(header: &csv::ByteRecord) -> Result<([usize; 7], Option<usize>), String> {
+    let names: Vec<&[u8]> = header.iter().collect();
+    let find = |name: &str| -> Result<Option<usize>, String> {
+        let at: Vec<usize> = (0..names.len())
+            .filter(|&i| names[i] == name.as_bytes())
+            .collect();
+        match at.as_slice() {
+            [] => Ok(None),
+            [i] => Ok(Some(*i)),
+            _ => Err(format!(
+                "column {name} appears {} times in the header (columns {}); keep one",
+                at.len(),
+                at.iter()
+                    .map(|i| (i + 1).to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
         }
     };
     let mut columns = [0usize; 7];
     for (k, name) in INPUTS.iter().enumerate() {
-        match headers.iter().position(|h| h == *name) {
-            Some(p) => columns[k] = p,
-            None => {
-                let _ = writeln!(
-                    err,
-                    "estimate: input lacks column {name} (needs {})",
-                    INPUTS.join(",")
-                );
-                return 1;
-            }
+        columns[k] = find(name)?
+            .ok_or_else(|| format!("input lacks column {name} (needs {})", INPUTS.join(",")))?;
+    }
+    Ok((columns, find("length")?))
+}
+
+/// What is wrong with a row's bytes, if anything, before its numbers are read.
+fn bad_record(record: &csv::ByteRecord, fields: usize) -> Option<String> {
+    if record.len() != fields {
+        return Some(format!(
+            "row has {} fields, the header {fields}",
+            record.len()
+        ));
+    }
+    for (k, field) in record.iter().enumerate() {
+        if field.contains(&0) {
+            return Some(format!("field {} holds a NUL byte", k + 1));
+        }
+        if std::str::from_utf8(field).is_err() {
+            return Some(format!("field {} is not UTF-8", k + 1));
         }
     }
-    let length_column = headers.iter().position(|h| h == "length");
-    let out_columns: &[&str] = if contact == Contact::Elliptic {
-        &ELLIPTIC
-    } else {
-        &LINE
+    None
+}
+
+fn reader(delimiter: u8, headers: bool, input: &[u8]) -> csv::Reader<&[u8]> {
+    csv::ReaderBuilder::new()
+        .delimiter(delimiter)
+        .has_headers(headers)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(input)
+}
+
+/// Runs the estimator over `input`, writing CSV to `output` and diagnostics to `err`;
+/// returns the process exit code.
+pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut dyn Write) -> i32 {
+    let options = match Options::try_parse_from(
+        std::iter::once("estimate".into()).chain(args.iter().cloned()),
+    ) {
+        Ok(o) => o,
+        Err(e) => {
+            let text = e.render().to_string();
+            return match e.kind() {
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => {
+                    let mut output = output;
+                    match output.write_all(text.as_bytes()) {
+                        Ok(()) => 0,
+                        Err(e) => {
+                            let _ = writeln!(err, "estimate: cannot write the output: {e}");
+                            1
+                        }
+                    }
+                }
+                _ => {
+                    let _ = write!(err, "{text}");
+                    2
+                }
+            };
+        }
     };
-    let mut writer = csv::Writer::from_writer(output);
-    let error_index = out_columns.iter().position(|c| *c == "error").unwrap_or(0);
-    if writer.write_record(out_columns).is_err() {
+    let mut data = Vec::new();
+    if let Err(e) = input.read_to_end(&mut data) {
+        let _ = writeln!(err, "estimate: cannot read the input: {e}");
         return 1;
     }
-    for (row, record) in reader.records().enumerate() {
-        let record = match record {
-            Ok(r) => r,
-            Err(e) => {
-                let _ = writer.flush();
-                let _ = writeln!(
-                    err,
-                    "estimate: input is not CSV at data row {}: {e}",
-                    row + 1
-                );
-                return 1;
-            }
-        };
-        let values = columns.map(|c| record.get(c));
-        let result = scene_and_sample(&values, length_column.and_then(|c| record.get(c))).and_then(
-            |(scene, load, phi)| match (model, contact) {
-                (Model::Reference, Contact::Elliptic) => elliptic_row(&scene, load, phi),
-                (Model::Reference, Contact::Line) => line_row(&scene, load, phi),
-                (Model::F32, Contact::Elliptic) => f32_elliptic_row(&scene, load, phi),
-                (Model::F32, Contact::Line) => f32_line_row(&scene, load, phi),
-                (Model::Fixed, Contact::Elliptic) => fixed_elliptic_row(&scene, load, phi),
-                (Model::Fixed, Contact::Line) => fixed_line_row(&scene, load, phi),
-            },
-        );
-        let fields = result.unwrap_or_else(|message| {
-            let mut empty = vec![String::new(); out_columns.len()];
-            empty[error_index] = message;
-            empty
-        });
-        if writer.write_record(&fields).is_err() {
+    // The header: the first record, ','-separated, or ';'-separated if only that
+    // gives the needed columns.
+    let mut delimiter = b',';
+    let mut rdr = reader(delimiter, true, &data);
+    let mut header = match rdr.byte_headers() {
+        Ok(h) if !h.iter().all(<[u8]>::is_empty) => h.clone(),
+        _ => {
+            let _ = writeln!(
+                err,
+                "estimate: input has no header (needs {})",
+                INPUTS.join(",")
+            );
             return 1;
         }
+    };
+    if find_columns(&header).is_err() && header.len() == 1 && header[0].contains(&b';') {
+        let mut semi = reader(b';', true, &data);
+        if let Ok(h) = semi.byte_headers()
+            && find_columns(h).is_ok()
+        {
+            let _ = writeln!(
+                err,
+                "estimate: the input is ';'-separated; reading it so (numbers need a decimal point)"
+            );
+            (delimiter, header, rdr) = (b';', h.clone(), semi);
+        }
     }
-    if writer.flush().is_err() { 1 } else { 0 }
+    let (columns, length) = match find_columns(&header) {
+        Ok(c) => c,
+        Err(message) => {
+            let _ = writeln!(err, "estimate: {message}");
+            return 1;
+        }
+    };
+    let choice = options.contact.choice();
+    let mut writer = csv::Writer::from_writer(output);
+    let mut record = csv::ByteRecord::new();
+    let (mut flags, mut message) = (String::new(), String::new());
+    let mut origin = 0; // byte offset of `rdr`'s input in `data`
+    loop {
+        let mut restart = None;
+        while let Ok(true) = rdr.read_byte_record(&mut record) {
+            let start = origin + record.position().map_or(0, |p| p.byte() as usize);
+            let mut row = OutRow::default();
+            message.clear();
+            // An unterminated quote runs to the end of the input: that row's error,
+            // and the batch goes on from the line after the row's start.
+            let rest = &data[start.min(data.len())..];
+            let to_the_end = origin + rdr.position().byte() as usize >= data.len();
+            if to_the_end && rest.iter().filter(|&&b| b == b'"').count() % 2 == 1 {
+                message.push_str("unterminated quote: the row runs to the end of the input");
+                restart = rest.iter().position(|&b| b == b'\n').map(|i| start + i + 1);
+            } else if let Some(m) = bad_record(&record, header.len()) {
+                message.push_str(&m);
+            } else {
+                let result =
+                    scene_and_sample(&record, &columns, length).and_then(|(scene, load, phi)| {
+                        let x = Sample {
+                            scene,
+                            load,
+                            phi,
+                            choice,
+                        };
+                        match options.model {
+                            Model::Reference => reference_row(&x),
+                            Model::F32 => f32_row(&x),
+                            Model::Fixed => fixed_row(&x),
+                        }
+                    });
+                match result {
+                    Ok(answer) => {
+                        write_flags(&mut flags, &answer.validity, answer.no_critical_angle);
+                        row = answer.row;
+                        row.flags = &flags;
+                    }
+                    Err(m) => message = m,
+                }
+            }
+            row.error = &message;
+            if let Err(e) = writer.serialize(&row) {
+                let _ = writeln!(err, "estimate: cannot write the output: {e}");
+                return 1;
+            }
+            if restart.is_some() {
+                break;
+            }
+        }
+        match restart {
+            Some(at) if at < data.len() => {
+                origin = at;
+                rdr = reader(delimiter, false, &data[at..]);
+            }
+            _ => break,
+        }
+    }
+    if let Err(e) = writer.flush() {
+        let _ = writeln!(err, "estimate: cannot write the output: {e}");
+        return 1;
+    }
+    0
 }

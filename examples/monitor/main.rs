@@ -10,12 +10,12 @@ mod input;
 mod plot;
 
 use clap::{Parser, ValueEnum};
-use misalign::fixed::{FixedEllipticScene, FixedLineScene};
-use misalign::float::Prepared;
+use misalign::fixed::{FixedAuto, FixedEllipticScene};
+use misalign::float::Auto;
 use misalign::monitor::{
-    Config, Event, EventKind, Monitor, RiskState, Sample, Thresholds, scenario,
+    Config, Event, EventKind, Monitor, RiskState, Sample, Thresholds, model_for_range, scenario,
 };
-use misalign::reference::ContactModel;
+use misalign::reference::ModelChoice;
 use misalign::{Estimator, Scene};
 use std::error::Error;
 use std::io::{IsTerminal, Write};
@@ -435,29 +435,18 @@ fn main() -> std::process::ExitCode {
             .map(|s| f64::from(s.load))
             .filter(|l| l.is_finite())
             .fold(scenario::LOAD_MAX, f64::max);
-        let prepared = Prepared::new(&scene, load_max, scenario::ANGLE_MIN)?;
+        // One model for the trace's operating range (section 9, decided once).
+        let choice = model_for_range(&scene, load_max, scenario::ANGLE_MIN)?;
         match args.model {
-            Model::F32 => run(prepared, &args, samples, builtin),
+            Model::F32 => run(Auto::with_choice(&scene, choice)?, &args, samples, builtin),
             Model::Fixed => {
                 // 10 mN per count; the finest angle LSB the tables allow, at least 0.1 nrad.
-                let load_lsb = 1e-2;
-                match prepared.model() {
-                    ContactModel::Elliptic => {
-                        let lsb = FixedEllipticScene::min_angle_lsb(&scene).max(1e-10);
-                        run(
-                            FixedEllipticScene::new(&scene, load_lsb, lsb)?,
-                            &args,
-                            samples,
-                            builtin,
-                        )
-                    }
-                    ContactModel::Line => run(
-                        FixedLineScene::new(&scene, load_lsb, 1e-10)?,
-                        &args,
-                        samples,
-                        builtin,
-                    ),
-                }
+                let angle_lsb = match choice {
+                    ModelChoice::Elliptic => FixedEllipticScene::min_angle_lsb(&scene).max(1e-10),
+                    _ => 1e-10,
+                };
+                let core = FixedAuto::with_choice(&scene, 1e-2, angle_lsb, choice)?;
+                run(core, &args, samples, builtin)
             }
         }
     })();

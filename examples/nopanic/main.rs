@@ -1,6 +1,7 @@
 //! The no-panic proof (`cargo xtask nopanic`): an image with every per-sample path of
 //! the estimator (the f32 core: `EllipticScene::estimate`, `details`,
-//! `LineScene::estimate`; the fixed-point core: `FixedEllipticScene::estimate`,
+//! `LineScene::estimate` and both scenes' inverses `friction_from_axial_force`,
+//! `angle_from_axial_force`; the fixed-point core: `FixedEllipticScene::estimate`,
 //! `details`, `FixedLineScene::estimate`) and the scene preparation, fed from volatile reads so that
 //! nothing is known at compile time. Its panic handler is panic-never's, which refers
 //! to a symbol that does not exist: the image links only if the optimiser (release,
@@ -39,6 +40,12 @@ mod paths {
         super::io::emit(elliptic.estimate(load, phi));
         super::io::emit(elliptic.details(load, phi));
         super::io::emit(line.estimate(load, phi));
+        // The inverses (issue 11), with a force as unknown as the sample.
+        let force = load * phi;
+        super::io::emit(elliptic.friction_from_axial_force(load, phi, force));
+        super::io::emit(elliptic.angle_from_axial_force(load, force));
+        super::io::emit(line.friction_from_axial_force(load, phi, force));
+        super::io::emit(line.angle_from_axial_force(load, force));
         Ok(())
     }
 }

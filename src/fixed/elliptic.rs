@@ -3,7 +3,8 @@
 use super::logexp::{div3, exp2_fixed, log2_u32};
 use super::uniform::{ONE, UniformTable};
 use super::{
-    FixedEstimate, InputRange, LOG2_HALF_PI, Log2, Units, constant, log_risk, margin_counts,
+    FixedEstimate, InputRange, LOG2_HALF_PI, Log2, Units, angle_max, constant, log_risk,
+    margin_counts,
 };
 use crate::estimator::DEFAULT_RISK_SLIP_RATIO;
 use crate::reference::{Regime, hertz_scale};
@@ -11,7 +12,7 @@ use crate::tables::{
     LOG_FORCE_OVER_S, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW, LOG_THETA_HIGH, LOG_THETA_LOW,
 };
 use crate::{Error, Scene, ThetaRelation};
-use core::f64::consts::{FRAC_PI_2, PI};
+use core::f64::consts::PI;
 
 /// A prepared elliptic-contact scene for the fixed-point core.
 #[derive(Debug, Clone, Copy)]
@@ -88,8 +89,8 @@ impl FixedEllipticScene {
                 } else {
                     load_min as u32
                 },
-                angle_max: libm::fmin(libm::floor(FRAC_PI_2 / (c * angle_lsb)), 2_147_483_648.0)
-                    as u32,
+                // |phi| < pi/2; then theta = c |phi| < pi/2 too (c <= 1).
+                angle_max: angle_max(angle_lsb),
             },
         })
     }
@@ -178,6 +179,29 @@ impl FixedEllipticScene {
 }
 
 impl FixedEllipticScene {
+    /// log2 of the semi-axis a = m L in m (eqs 2, 5-6) for `load` counts and |angle|
+    /// `abs_angle` counts within the input range: section 9's measure. [`Log2::ZERO`]
+    /// at zero load, [`Log2::INFINITY`] at zero angle.
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] off the m table (not reached within the input range).
+    #[inline]
+    pub(super) fn log_semi_axis(&self, load: u32, abs_angle: u32) -> Result<Log2, Error> {
+        if load == 0 {
+            return Ok(Log2::ZERO);
+        }
+        if abs_angle == 0 {
+            return Ok(Log2::INFINITY);
+        }
+        let y = self.log_theta_lsb.saturating_add(log2_u32(abs_angle));
+        let log_m = lookup(LOG_M_LOW, LOG_M_HIGH, y)?;
+        Ok(Log2(
+            log_m
+                .saturating_add(self.log_hertz)
+                .saturating_add(div3(log2_u32(load))),
+        ))
+    }
+
     /// The contact ellipse on request: theta, m, n (eqs 4-6), a, b (eqs 2-3), p0 (eq 7),
     /// all as [`Log2`]. At zero angle m = a = infinity, n = b = p0 = 0; at zero load
     /// a = b = p0 = 0.

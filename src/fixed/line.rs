@@ -2,11 +2,11 @@
 
 use super::elliptic::{zero_angle, zero_load};
 use super::logexp::{exp2_fixed, log2_u32};
-use super::{FixedEstimate, InputRange, Log2, Units, constant, log_risk, margin_counts};
+use super::{FixedEstimate, InputRange, Log2, Units, angle_max, constant, log_risk, margin_counts};
 use crate::estimator::DEFAULT_RISK_SLIP_RATIO;
 use crate::reference::Regime;
 use crate::{Error, Scene};
-use core::f64::consts::{FRAC_PI_2, PI};
+use core::f64::consts::PI;
 
 /// A prepared line-contact scene for the fixed-point core. Loads are per unit length
 /// (N/m) without a scene length, total (N) with one, as for [`crate::float::LineScene`].
@@ -23,6 +23,12 @@ pub struct FixedLineScene {
     log_force: i32,
     /// log2 of the d/b risk threshold.
     log_risk: i32,
+    /// log2 of `2 sqrt((1 - nu) R / (pi G l))` x sqrt(load LSB): log2 b = this +
+    /// log2(counts)/2 (eq 22).
+    log_width: i32,
+    /// log2 of `sqrt(G / (pi (1 - nu) R l))` x sqrt(load LSB): log2 p0 = this +
+    /// log2(counts)/2 (p0 = 2 P / (pi b l)).
+    log_pressure: i32,
     range: InputRange,
     /// What one count stands for (the estimator contract).
     pub(super) units: Units,
@@ -47,6 +53,12 @@ impl FixedLineScene {
             * scene.length().unwrap_or(1.0);
         let root = libm::sqrt(stiffness);
         let root_lsb = libm::sqrt(load_lsb);
+        // sqrt((1 - nu) R / (pi G l)), as a product of roots (no overflow).
+        let sq = libm::sqrt;
+        let length = scene.length().unwrap_or(1.0);
+        let compliance = sq((1.0 - scene.poisson_ratio()) / PI)
+            * (sq(scene.effective_radius()) / sq(scene.shear_modulus()))
+            / sq(length);
         Ok(FixedLineScene {
             log_slip: constant(root / (2.0 * mu) * angle_lsb / root_lsb)?,
             log_critical: constant(2.0 * mu / root * root_lsb)?,
@@ -54,9 +66,11 @@ impl FixedLineScene {
             log_force: constant(mu * load_lsb)?,
             log_risk: constant(DEFAULT_RISK_SLIP_RATIO as f64)?,
             units: Units::new(load_lsb, angle_lsb)?,
+            log_width: constant(2.0 * compliance * root_lsb)?,
+            log_pressure: constant(root_lsb / (PI * compliance * length))?,
             range: InputRange {
                 load_min: 1,
-                angle_max: libm::fmin(libm::floor(FRAC_PI_2 / angle_lsb), 2_147_483_648.0) as u32,
+                angle_max: angle_max(angle_lsb), // |phi| < pi/2
             },
         })
     }
@@ -127,4 +141,37 @@ impl FixedLineScene {
             microslip_risk: ls >= self.log_risk,
         })
     }
+
+    /// The contact strip on request, as base-2 logarithms: half-width b (m, eq 22) and
+    /// peak pressure p0 (Pa), from the load per unit length (counts / l). Zero load
+    /// gives b = p0 = 0.
+    ///
+    /// # Errors
+    /// [`Error::Angle`] above the scene's angle range.
+    pub fn details(&self, load: u32, angle: i32) -> Result<FixedLineDetails, Error> {
+        if angle.unsigned_abs() > self.range.angle_max {
+            return Err(Error::Angle);
+        }
+        if load == 0 {
+            return Ok(FixedLineDetails {
+                b: Log2::ZERO,
+                p0: Log2::ZERO,
+            });
+        }
+        let half_lp = log2_u32(load) >> 1;
+        Ok(FixedLineDetails {
+            b: Log2(self.log_width.saturating_add(half_lp)),
+            p0: Log2(self.log_pressure.saturating_add(half_lp)),
+        })
+    }
+}
+
+/// The contact strip of one sample in the fixed-point core, as base-2 logarithms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FixedLineDetails {
+    /// Half-width of the strip b (m), eq (22).
+    pub b: Log2,
+    /// Peak pressure p0 (Pa).
+    pub p0: Log2,
 }

@@ -11,6 +11,9 @@
 //! Each prepared scene states the input range it accepts ([`InputRange`]); outside it
 //! the answer is a typed error, never a wrapped value.
 //!
+//! Inverse estimates (mu or phi from a measured axial force) exist in the reference and
+//! the f32 core only; [`crate::float::inverse`] says why not here.
+//!
 //! The `fixed` crate was weighed and not used: its types fix the binary point at compile
 //! time, while these quantities span ten decades per scene and need a per-value
 //! exponent; a Q8.24 logarithm is one.
@@ -18,11 +21,13 @@
 pub mod logexp;
 pub mod uniform;
 
+mod auto;
 mod elliptic;
 mod line;
 
+pub use auto::{FixedAuto, FixedAutoEstimate, FixedContactDetails};
 pub use elliptic::{FixedDetails, FixedEllipticScene};
-pub use line::FixedLineScene;
+pub use line::{FixedLineDetails, FixedLineScene};
 
 use crate::Error;
 use crate::reference::Regime;
@@ -101,7 +106,7 @@ pub struct InputRange {
     /// Smallest non-zero load in counts (0 is accepted too); below it the critical
     /// angle would fall under the tables (theta0 < 2^-40).
     pub load_min: u32,
-    /// Largest |angle| in counts: theta <= pi/2 (eq 4).
+    /// Largest |angle| in counts: |phi| < pi/2 (so theta < pi/2, eq 4).
     pub angle_max: u32,
 }
 
@@ -242,6 +247,13 @@ pub fn exact_lsb(x: f64, max_counts: u32, min_lsb: f64) -> (f64, u32) {
     }
     let counts = libm::fmin(libm::fmax(libm::floor(x / min_lsb), 1.0), max_counts as f64);
     (x / counts, counts as u32)
+}
+
+/// Largest angle count with counts x `angle_lsb` < pi/2 (the angle between two axes
+/// is below a right angle), at most 2^31.
+fn angle_max(angle_lsb: f64) -> u32 {
+    let n = libm::ceil(core::f64::consts::FRAC_PI_2 / angle_lsb) - 1.0;
+    libm::fmin(libm::fmax(n, 0.0), 2_147_483_648.0) as u32
 }
 
 /// log2(pi/2) in Q8.24: g and theta above it have no table (eq 18 has no solution).

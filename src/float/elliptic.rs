@@ -45,15 +45,15 @@ impl Tables<'static> {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct EllipticScene<'t> {
     /// `c = 2 sqrt(R1 R2) / (R1 + R2)` (eq 4): theta = c |phi|.
-    radius_factor: f32,
+    pub(super) radius_factor: f32,
     /// `1 / c`.
-    inv_radius_factor: f32,
+    pub(super) inv_radius_factor: f32,
     /// `A = pi G V^(2/3) / (3 mu c)`: d/b = A g(theta) P^(-1/3) (eq 16), V = L^3/P.
-    slip_gain: f32,
+    pub(super) slip_gain: f32,
     /// `1 / A`: at d/b = 1, g(theta0) = P^(1/3) / A (eq 18).
-    critical_gain: f32,
+    pub(super) critical_gain: f32,
     /// Friction coefficient mu.
-    friction: f32,
+    pub(super) friction: f32,
     /// `V^(1/3)`: L = V^(1/3) P^(1/3) (eqs 2, 3).
     hertz_gain: f32,
     /// d/b at and above which the risk flag is raised.
@@ -133,17 +133,18 @@ impl<'t> EllipticScene<'t> {
     ///
     /// # Errors
     /// [`Error::Load`] for a NaN, infinite or negative load; [`Error::Angle`] for a
-    /// non-finite angle or theta above pi/2; [`Error::OutOfRange`] for a theta below
+    /// non-finite angle or |phi| >= pi/2; [`Error::OutOfRange`] for a theta below
     /// narrowed tables.
     #[inline]
     pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
         let abs_phi = phi.abs();
-        let theta = self.radius_factor * abs_phi;
-        // On the bits (theta >= 0): above pi/2, and also inf and NaN, whose patterns lie
-        // above; so a non-finite phi is refused here too.
-        if theta.to_bits() > FRAC_PI_2.to_bits() {
+        // On the bits (|phi| >= 0): f32's FRAC_PI_2 lies above pi/2, so at and above
+        // it, and also inf and NaN, whose patterns lie above; so a non-finite phi is
+        // refused here too. theta = c |phi| <= |phi| (c <= 1) stays on the tables.
+        if abs_phi.to_bits() >= FRAC_PI_2.to_bits() {
             return Err(Error::Angle);
         }
+        let theta = self.radius_factor * abs_phi;
         // One unsigned compare on the bits: load outside [2^-120, 2^120] (0, negative,
         // NaN and inf included) goes to the cold path, which sorts them out.
         let cbrt_load = if load.to_bits().wrapping_sub(LIGHT_LOAD_BITS) > NORMAL_LOAD_SPAN {
@@ -196,7 +197,7 @@ impl<'t> EllipticScene<'t> {
     }
 
     #[inline(always)]
-    fn g_of_theta(&self, theta: f32) -> Result<f32, Error> {
+    pub(super) fn g_of_theta(&self, theta: f32) -> Result<f32, Error> {
         match self.tables.g.eval(theta) {
             Some(g) => Ok(g),
             None => self.g_outside(theta),
@@ -217,7 +218,7 @@ impl<'t> EllipticScene<'t> {
 
     /// theta0 with g(theta0) = g; `Ok(None)` above g(pi/2) = pi/2 (no critical angle).
     #[inline(always)]
-    fn theta_of_g(&self, g: f32) -> Result<Option<f32>, Error> {
+    pub(super) fn theta_of_g(&self, g: f32) -> Result<Option<f32>, Error> {
         if g.to_bits() > FRAC_PI_2.to_bits() {
             return Ok(None);
         }
@@ -239,16 +240,35 @@ impl<'t> EllipticScene<'t> {
         }
     }
 
+    /// 2a / length for a checked sample (load finite and >= 0, |phi| < pi/2), with
+    /// `two_over_length` = 2 / length (1/m): section 9's measure, from a = m L (eqs 2,
+    /// 5-6) with 1/m from its table. 0 at zero load, +inf at zero angle.
+    #[inline]
+    pub(super) fn length_ratio(&self, load: f32, phi: f32, two_over_length: f32) -> f32 {
+        if load == 0.0 {
+            return 0.0;
+        }
+        let theta = self.radius_factor * phi.abs();
+        let inv_m = match tables::INV_M_OF_THETA.eval(theta) {
+            Some(x) => x,
+            None if theta == 0.0 => return f32::INFINITY, // the strip limit: a = inf
+            None if theta < SMALL_THETA => small_theta::inv_m_small(theta),
+            None => 1.0, // not reached: the table covers theta up to pi/2
+        };
+        // 2 m V^(1/3) P^(1/3) / length; inf / 0 cannot occur (P > 0).
+        two_over_length * self.hertz_gain * cbrt(load) / inv_m
+    }
+
     /// The contact ellipse on request: m, n (eqs 5-6), a, b (eqs 2-3), p0 (eq 7).
     ///
     /// # Errors
     /// As [`EllipticScene::estimate`].
     pub fn details(&self, load: f32, phi: f32) -> Result<Details, Error> {
         check(load, phi)?;
-        let theta = self.radius_factor * phi.abs();
-        if theta > FRAC_PI_2 {
+        if phi.abs() >= FRAC_PI_2 {
             return Err(Error::Angle);
         }
+        let theta = self.radius_factor * phi.abs();
         if theta == 0.0 {
             // The strip limit: an infinitely long ellipse of zero width.
             return Ok(Details {

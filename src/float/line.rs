@@ -16,11 +16,15 @@ use core::f32::consts::FRAC_PI_2;
 pub struct LineScene {
     /// `sqrt(pi (1 - nu) G R l) / (2 mu)`: d/b = this |phi| / sqrt(P) (eq 23), l the
     /// length (1 without one).
-    slip_gain: f32,
+    pub(super) slip_gain: f32,
     /// `2 mu / sqrt(pi G (1 - nu) R l)`: phi0 = this sqrt(P) (eq 28).
-    critical_gain: f32,
+    pub(super) critical_gain: f32,
     /// Friction coefficient mu.
-    friction: f32,
+    pub(super) friction: f32,
+    /// `sqrt(4 (1 - nu) R / (pi G l))`: b = this sqrt(P) (eq 22).
+    width_gain: f32,
+    /// `sqrt(G / (pi (1 - nu) R l))`: p0 = 2 P / (pi b l) = this sqrt(P) (eq 22).
+    pressure_gain: f32,
     /// d/b at and above which the risk flag is raised.
     risk_slip_ratio: f32,
 }
@@ -38,8 +42,20 @@ impl LineScene {
             * scene.effective_radius()
             * scene.length().unwrap_or(1.0);
         let root = libm::sqrt(stiffness);
-        let constants = [root / (2.0 * mu), 2.0 * mu / root, mu];
-        let mut f = [0.0f32; 3];
+        // sqrt((1 - nu) R / (pi G l)), as a product of roots (no overflow).
+        let sq = libm::sqrt;
+        let compliance = sq((1.0 - scene.poisson_ratio()) / core::f64::consts::PI)
+            * (sq(scene.effective_radius()) / sq(scene.shear_modulus()))
+            / sq(scene.length().unwrap_or(1.0));
+        let constants = [
+            root / (2.0 * mu),
+            2.0 * mu / root,
+            mu,
+            2.0 * compliance, // eq (22)
+            // p0 = 2 P / (pi b l) = sqrt(P) / (pi compliance l)
+            1.0 / (core::f64::consts::PI * compliance * scene.length().unwrap_or(1.0)),
+        ];
+        let mut f = [0.0f32; 5];
         for (out, x) in f.iter_mut().zip(constants) {
             *out = x as f32;
             if !(out.is_normal() && *out > 0.0) {
@@ -50,6 +66,8 @@ impl LineScene {
             slip_gain: f[0],
             critical_gain: f[1],
             friction: f[2],
+            width_gain: f[3],
+            pressure_gain: f[4],
             risk_slip_ratio: DEFAULT_RISK_SLIP_RATIO,
         })
     }
@@ -73,12 +91,13 @@ impl LineScene {
     ///
     /// # Errors
     /// [`Error::Load`] for a NaN, infinite or negative load; [`Error::Angle`] for a
-    /// non-finite angle or |phi| above pi/2.
+    /// non-finite angle or |phi| >= pi/2.
     #[inline]
     pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
         check(load, phi)?;
         let abs_phi = phi.abs();
-        if abs_phi > FRAC_PI_2 {
+        // f32's FRAC_PI_2 lies above pi/2: refused with everything above it.
+        if abs_phi >= FRAC_PI_2 {
             return Err(Error::Angle);
         }
         if load == 0.0 {
@@ -104,4 +123,35 @@ impl LineScene {
             self.risk_slip_ratio,
         ))
     }
+
+    /// The contact strip on request: half-width b (m, eq 22) and peak pressure p0
+    /// (Pa), from the load per unit length P / l (l = 1 m without a length).
+    ///
+    /// # Errors
+    /// As [`LineScene::estimate`].
+    pub fn details(&self, load: f32, phi: f32) -> Result<LineDetails, Error> {
+        check(load, phi)?;
+        if phi.abs() >= FRAC_PI_2 {
+            return Err(Error::Angle);
+        }
+        let root = if load == 0.0 {
+            0.0
+        } else {
+            load * inv_sqrt(load)
+        }; // sqrt(P)
+        Ok(LineDetails {
+            b: self.width_gain * root,
+            p0: self.pressure_gain * root,
+        })
+    }
+}
+
+/// The contact strip of one sample, on request ([`LineScene::details`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LineDetails {
+    /// Half-width of the strip b (m), eq (22).
+    pub b: f32,
+    /// Peak pressure p0 = 2 P / (pi b) (Pa), P per unit length.
+    pub p0: f32,
 }

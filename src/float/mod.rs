@@ -8,13 +8,18 @@
 //! The elliptic path (sections 5-7) is `theta = c |phi|` (eq 4), `g(theta) = m n theta`
 //! from a table, `d/b = A g P^(-1/3)` (eq 16), F from eq (21) by a kernel, and
 //! `phi0 = theta(B P^(1/3)) / c` (eq 18 at d/b = 1) from the inverse table; the line
-//! path (section 8) needs no table at all. Each type links only what it uses.
+//! path (section 8) needs no table at all. Each type links only what it uses:
+//! [`EllipticScene`] and [`LineScene`] are one model each and never switch;
+//! [`Auto`] applies section 9's model choice per sample, as `reference::estimate` does.
 
+mod auto;
 mod elliptic;
+pub mod inverse;
 mod line;
 
+pub use auto::{Auto, AutoEstimate, ContactDetails};
 pub use elliptic::{Details, EllipticScene, Tables};
-pub use line::LineScene;
+pub use line::{LineDetails, LineScene};
 
 use crate::estimator::Estimator;
 #[doc(no_inline)]
@@ -62,90 +67,6 @@ fn check(load: f32, phi: f32) -> Result<(), crate::Error> {
     Ok(())
 }
 
-/// The scene's model choice (section 9) for the f32 core: line contact for a plane, or
-/// when the rollers have a length and the ellipse is longer than them anywhere in the
-/// declared operating range (at its heaviest load and smallest misalignment, where the
-/// ellipse is longest); the elliptic contact otherwise. Made once, when the scene is
-/// prepared; a firmware that knows its model uses [`EllipticScene`] or [`LineScene`]
-/// directly and links only that one.
-#[derive(Debug, Clone, Copy)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Prepared {
-    /// The contact ellipse fits on the rollers.
-    Elliptic(EllipticScene<'static>),
-    /// Line contact: load per unit length without a scene length, total load with one.
-    Line(LineScene),
-}
-
-impl Prepared {
-    /// Chooses and prepares the model for loads up to `load_max` (N) and misalignments
-    /// down to `angle_min` (rad, > 0).
-    ///
-    /// # Errors
-    /// As the scenes' `new`; [`crate::Error::Load`] or [`crate::Error::Angle`] for an
-    /// operating range that is not positive and finite.
-    pub fn new(scene: &crate::Scene, load_max: f64, angle_min: f64) -> Result<Self, crate::Error> {
-        if !(load_max.is_finite() && load_max > 0.0) {
-            return Err(crate::Error::Load);
-        }
-        if !(angle_min.is_finite() && angle_min > 0.0) {
-            return Err(crate::Error::Angle);
-        }
-        let line = match scene.length() {
-            _ if scene.is_plane() => true,
-            None => false,
-            Some(_) => {
-                crate::reference::elliptic(scene, load_max, angle_min)?
-                    .validity
-                    .longer_than_rollers
-            }
-        };
-        if line {
-            Ok(Prepared::Line(LineScene::new(scene)?))
-        } else {
-            Ok(Prepared::Elliptic(EllipticScene::new(scene)?))
-        }
-    }
-
-    /// Which model was chosen.
-    pub fn model(&self) -> crate::reference::ContactModel {
-        match self {
-            Prepared::Elliptic(_) => crate::reference::ContactModel::Elliptic,
-            Prepared::Line(_) => crate::reference::ContactModel::Line,
-        }
-    }
-
-    /// The d/b threshold of [`Estimate::microslip_risk`].
-    pub fn risk_slip_ratio(&self) -> f32 {
-        match self {
-            Prepared::Elliptic(e) => e.risk_slip_ratio(),
-            Prepared::Line(l) => l.risk_slip_ratio(),
-        }
-    }
-
-    /// The same scene with another d/b threshold for [`Estimate::microslip_risk`].
-    ///
-    /// # Errors
-    /// [`crate::Error::OutOfRange`] for a threshold that is not positive and finite.
-    pub fn with_risk_slip_ratio(self, slip_ratio: f32) -> Result<Self, crate::Error> {
-        Ok(match self {
-            Prepared::Elliptic(e) => Prepared::Elliptic(e.with_risk_slip_ratio(slip_ratio)?),
-            Prepared::Line(l) => Prepared::Line(l.with_risk_slip_ratio(slip_ratio)?),
-        })
-    }
-
-    /// The estimate of the chosen model (load in N; see [`LineScene`] for its units).
-    ///
-    /// # Errors
-    /// As the chosen scene's `estimate`.
-    pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, crate::Error> {
-        match self {
-            Prepared::Elliptic(e) => e.estimate(load, phi),
-            Prepared::Line(l) => l.estimate(load, phi),
-        }
-    }
-}
-
 /// The estimator contract for the f32 scenes: SI values in and out, so that
 /// [`Estimator::input`] and [`Estimator::to_estimate`] are the identity.
 macro_rules! f32_estimator {
@@ -176,4 +97,4 @@ macro_rules! f32_estimator {
     )*};
 }
 
-f32_estimator!(EllipticScene<'_>, LineScene, Prepared);
+f32_estimator!(EllipticScene<'_>, LineScene);

@@ -4,6 +4,7 @@
 //! No kernel calls a library routine; each costs a handful of instructions.
 
 pub mod axial_force;
+pub mod axial_force_inverse;
 pub mod cbrt;
 pub mod octave;
 pub mod small_theta;

@@ -14,20 +14,25 @@
 //! **Model choice (section 9).** The elliptic and the line-contact solutions differ
 //! by up to 22 % in d/b where the ellipse reaches the rollers' ends; switching per
 //! sample would make the states chatter there. The monitor *fixes the model for the
-//! scene's operating range*: it is generic over one prepared [`Estimator`], and
-//! [`float::Prepared`](crate::float::Prepared) chooses the model once, from the
-//! declared highest load and smallest misalignment. d/b is then continuous in the
-//! samples, and the deadband handles the noise.
+//! scene's operating range*: it is generic over one prepared [`Estimator`], to be
+//! given a scene with one model: [`model_for_range`] chooses it once, from the
+//! declared highest load and smallest misalignment, for
+//! [`float::Auto::with_choice`](crate::float::Auto::with_choice) or
+//! [`fixed::FixedAuto::with_choice`](crate::fixed::FixedAuto::with_choice) (or an
+//! elliptic or line scene directly). d/b is then continuous in the samples, and the
+//! deadband handles the noise. (An `Auto` scene left at `ModelChoice::Section9` would
+//! switch per sample: not for a monitor.)
 //!
 //! **Sensor faults are never slip.** A faulted sample is not estimated; its
 //! candidate state is `SensorFault`, and leaving that state waits the off-delay.
 //!
 //! ```
-//! use misalign::monitor::{Config, Monitor, RiskState, Sample};
-//! use misalign::{Scene, float::Prepared};
+//! use misalign::monitor::{Config, Monitor, RiskState, Sample, model_for_range};
+//! use misalign::{Scene, float::Auto};
 //!
 //! let scene = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3)?;
-//! let core = Prepared::new(&scene, 5e3, 1e-5)?;
+//! // One model for loads up to 5 kN and misalignments from 10 urad.
+//! let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5)?)?;
 //! let mut monitor = Monitor::new(core, Config::default()).expect("the defaults are valid");
 //! for i in 0..300u32 {
 //!     // About 2 kN and 0.1 mrad with some noise (a value exactly constant for two
@@ -47,6 +52,7 @@
 mod condition;
 mod config;
 mod events;
+mod model;
 mod risk;
 mod sample;
 pub mod scenario;
@@ -61,6 +67,7 @@ pub use config::{
     TrendConfig,
 };
 pub use events::{EVENT_CAPACITY, Event, EventKind, FaultCause, Reading};
+pub use model::model_for_range;
 pub use risk::{Alarm, RiskState};
 pub use sample::{Channel, Clock, Sample};
 pub use state::{MonitorState, STATE_BUDGET_BYTES, Saved, Status};

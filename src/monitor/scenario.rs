@@ -27,7 +27,7 @@ pub const SAMPLE_PERIOD_MS: u32 = 1000;
 pub const START_TIME_MS: u32 = u32::MAX - 3_600_000 + 1;
 /// The demo scene: R1, R2 (m), G (Pa), nu, mu.
 pub const SCENE: [f64; 5] = [0.05, 0.05, 79.3e9, 0.3, 0.3];
-/// The highest load of the scenario (N), for [`Prepared::new`](crate::float::Prepared::new).
+/// The highest load of the scenario (N), for [`model_for_range`](super::model_for_range).
 pub const LOAD_MAX: f64 = 5e3;
 /// The smallest misalignment worth a model choice (rad).
 pub const ANGLE_MIN: f64 = 1e-5;

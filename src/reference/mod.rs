@@ -6,6 +6,7 @@
 
 mod carlson;
 mod chain;
+pub mod inverse;
 pub mod line;
 pub mod normal;
 mod solve;
@@ -25,6 +26,20 @@ pub const ANGLE_LIMIT: f64 = 0.1;
 /// (its example has 0.005; the reference data stop at 0.05).
 pub const PRESSURE_LIMIT: f64 = 0.05;
 
+/// Section 9's switch is flagged ([`Validity::near_model_switch`]) while the ellipse's
+/// length 2a is within this factor of the rollers' length: 2a / length in
+/// [1/1.25, 1.25]. There the two models disagree by a jump, not by rounding: at
+/// 2a = length the line model's d/b is `sqrt(3 / (2 E(k)))` times the elliptic one
+/// (1.22 for a slender ellipse, E(k) -> 1), because P / length is the mean load per
+/// length while the ellipse's centre carries 1.5 times that (eq 7 against eq 22); F
+/// moves by a few per cent and phi0 jumps to the other model's value.
+pub const MODEL_SWITCH_BAND: f64 = 1.25;
+/// Below this axis ratio a/b the ellipse is too round for the slender theory
+/// ([`Validity::round_ellipse`]): the paper's line integrals under-predict F against
+/// Kalker's exact three-dimensional theory by about 2 % at a/b = 10 (1 % at 17.6),
+/// the error growing like (b/a)^1.5 to 33 % at a/b = 1 (tests/data/physics-error.md).
+pub const SLENDER_LIMIT: f64 = 10.0;
+
 /// Which solution produced a result.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -33,6 +48,37 @@ pub enum ContactModel {
     Elliptic,
     /// The contact strip, section 8 (load per unit length).
     Line,
+}
+
+/// How the contact model of a sample is chosen, the same in the reference and in both
+/// cores. P is the total load (N) whenever the scene has a length; without one, line
+/// contact reads it as a load per unit length (N/m).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ModelChoice {
+    /// Section 9, per sample: line contact with P / length when the ellipse is longer
+    /// than the rollers (2a > length), and always for a plane; the ellipse otherwise.
+    #[default]
+    Section9,
+    /// Always the ellipse (sections 5-7), e.g. a firmware that must not switch; the
+    /// flags still say when the ellipse is longer than the rollers.
+    Elliptic,
+    /// Always line contact (section 8), with P / length when the scene has a length.
+    Line,
+}
+
+impl ModelChoice {
+    /// The model for a sample with an ellipse (not a plane) that is, or is not, longer
+    /// than the rollers (2a > length).
+    #[inline]
+    pub fn model(self, longer_than_rollers: bool) -> ContactModel {
+        match self {
+            ModelChoice::Elliptic => ContactModel::Elliptic,
+            ModelChoice::Line => ContactModel::Line,
+            ModelChoice::Section9 if longer_than_rollers => ContactModel::Line,
+            ModelChoice::Section9 => ContactModel::Elliptic,
+        }
+    }
 }
 
 impl ContactModel {
@@ -56,12 +102,22 @@ pub struct Validity {
     pub high_pressure: bool,
     /// The ellipse (2a) is longer than the rollers' contact length.
     pub longer_than_rollers: bool,
+    /// 2a / length within [`MODEL_SWITCH_BAND`] of 1: the model choice of section 9
+    /// could go either way, and the two models differ there by a jump.
+    pub near_model_switch: bool,
+    /// a/b below [`SLENDER_LIMIT`]: the slender-ellipse theory under-predicts F by
+    /// more than about 2 %.
+    pub round_ellipse: bool,
 }
 
 impl Validity {
     /// True when no flag is raised.
     pub fn is_valid(&self) -> bool {
-        !(self.large_angle || self.high_pressure || self.longer_than_rollers)
+        !(self.large_angle
+            || self.high_pressure
+            || self.longer_than_rollers
+            || self.near_model_switch
+            || self.round_ellipse)
     }
 }
 
@@ -125,7 +181,9 @@ pub struct Line {
     pub p0star: f64,
     /// Slip ratio d/b (eq 23).
     pub slip_ratio: f64,
-    /// Width of the microslip strip d = (d/b) b (m), capped at b in gross slip.
+    /// Half the width of the microslip strip (m): the strip runs from the leading edge
+    /// y = -b to y = 2d - b (eq 26), so it is 2d wide; d = (d/b) b, capped at b in
+    /// gross slip.
     pub d: f64,
     /// Partial or gross slip.
     pub regime: Regime,
@@ -168,11 +226,28 @@ impl Estimate {
     pub fn regime(&self) -> Regime {
         Regime::of(self.slip_ratio())
     }
-    /// Total axial force F (N): per unit length times the length for line contact.
+    /// Total axial force F (N): per unit length times the length for line contact
+    /// (N/m for line contact without a length).
     pub fn axial_force(&self, scene: &Scene) -> f64 {
         match self {
             Estimate::Elliptic(e) => e.axial_force,
             Estimate::Line(l) => l.axial_force * scene.length().unwrap_or(1.0),
+        }
+    }
+    /// Rolling resistance `F phi / 2` (N) on each cylinder (section 7): the line
+    /// model's per unit length times the length (section 9), or N/m without a length.
+    pub fn rolling_resistance(&self, scene: &Scene) -> f64 {
+        match self {
+            Estimate::Elliptic(e) => e.rolling_resistance(),
+            Estimate::Line(l) => l.rolling_resistance() * scene.length().unwrap_or(1.0),
+        }
+    }
+    /// Power `F phi V` (W) dissipated by microslip at rolling speed `speed` (m/s),
+    /// section 7; for line contact per unit length times the length (W/m without one).
+    pub fn dissipated_power(&self, scene: &Scene, speed: f64) -> f64 {
+        match self {
+            Estimate::Elliptic(e) => e.dissipated_power(speed),
+            Estimate::Line(l) => l.dissipated_power(speed) * scene.length().unwrap_or(1.0),
         }
     }
     /// Critical angle phi0 (rad), if any.
@@ -195,10 +270,33 @@ fn check_sample(load: f64, phi: f64) -> Result<(), Error> {
     if !(load.is_finite() && load >= 0.0) {
         return Err(Error::Load);
     }
-    if !phi.is_finite() {
+    // The angle between two axes is below a right angle (NaN fails the compare).
+    if phi.is_nan() || libm::fabs(phi) >= FRAC_PI_2 {
         return Err(Error::Angle);
     }
     Ok(())
+}
+
+/// The ellipse's length over the rollers', 2a / length (section 9); `None` without a
+/// length.
+fn length_ratio(scene: &Scene, a: f64) -> Option<f64> {
+    scene.length().map(|l| 2.0 * (a / l))
+}
+
+/// Whether line contact can answer any sample of `scene` under `choice`: forced, or
+/// section 9's rule with a plane or a length. (A prepared core scene needs its line
+/// constants only then.)
+pub fn line_may_answer(scene: &Scene, choice: ModelChoice) -> bool {
+    match choice {
+        ModelChoice::Elliptic => false,
+        ModelChoice::Line => true,
+        ModelChoice::Section9 => scene.is_plane() || scene.length().is_some(),
+    }
+}
+
+/// Whether `ratio` = 2a / length lies within [`MODEL_SWITCH_BAND`] of 1.
+pub fn near_model_switch(ratio: f64) -> bool {
+    (1.0 / MODEL_SWITCH_BAND..=MODEL_SWITCH_BAND).contains(&ratio)
 }
 
 /// `L^3 / P = 3 (1 - nu) R1 R2 / (2 G (R1 + R2))` (eqs 2-3 with the erratum).
@@ -231,13 +329,20 @@ fn phi_of_theta(scene: &Scene, theta: f64) -> f64 {
 /// `phi0 = 2 mu p0 / G` with p0 at phi0). Returns `(phi0, theta0)`, or `None` when
 /// d/b stays below 1 up to theta = pi/2 (or, for the exact relation, phi = pi/2).
 pub fn critical_angle(scene: &Scene, load: f64) -> Option<(f64, f64)> {
+    angle_at_slip_ratio(scene, load, 1.0)
+}
+
+/// The phi >= 0 (and its theta) at which eq (16) gives the slip ratio `slip_ratio`
+/// (> 0) at `load`; [`critical_angle`] is the case d/b = 1, the inverses of
+/// [`inverse`] use the others. `None` when no theta <= pi/2 reaches it.
+fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64, f64)> {
     if load == 0.0 {
         return Some((0.0, 0.0));
     }
     let v = hertz_scale(scene);
-    // d/b = 1  <=>  m n |phi| = 3 mu P^(1/3) / (pi G v^2).
+    // d/b = s  <=>  m n |phi| = 3 mu s P^(1/3) / (pi G v^2)  (eq 15).
     let target = chain::chain(
-        &[3.0, scene.friction(), libm::cbrt(load)],
+        &[3.0, scene.friction(), slip_ratio, libm::cbrt(load)],
         &[PI, scene.shear_modulus(), v, v],
     );
     let c = scene.radius_factor();
@@ -274,8 +379,8 @@ pub fn critical_angle(scene: &Scene, load: f64) -> Option<(f64, f64)> {
 /// zero load gives a = b = p0 = F = 0, d/b = inf (gross slip), phi0 = 0.
 ///
 /// # Errors
-/// [`Error::Load`], [`Error::Angle`] for undefined input, [`Error::PlaneHasNoEllipse`]
-/// for a plane.
+/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| >= pi/2,
+/// [`Error::PlaneHasNoEllipse`] for a plane.
 pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
     check_sample(load, phi)?;
     // c = 0: a plane, or radii so unequal that c underflows; the contact is a strip.
@@ -315,10 +420,14 @@ pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
     );
     let axial_force = libm::copysign(mu * (load * tangential::axial_force_ratio(s)), phi);
     let critical = critical_angle(scene, load);
+    let ratio = length_ratio(scene, a);
     let validity = Validity {
         large_angle: libm::fabs(phi) > ANGLE_LIMIT || critical.is_none_or(|(p, _)| p > ANGLE_LIMIT),
         high_pressure: p0 / g_mod > PRESSURE_LIMIT,
-        longer_than_rollers: scene.length().is_some_and(|l| 2.0 * a > l),
+        longer_than_rollers: ratio.is_some_and(|r| r > 1.0),
+        near_model_switch: ratio.is_some_and(near_model_switch),
+        // a/b = 1/k' (eqs 5-6).
+        round_ellipse: shape.kprime * SLENDER_LIMIT > 1.0,
     };
     Ok(Elliptic {
         phi,
@@ -375,12 +484,9 @@ impl Elliptic {
 /// Zero angle: d/b = 0, F = 0. Zero load: b = p0 = F = phi0 = 0, d/b = inf.
 ///
 /// # Errors
-/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| above pi/2.
+/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| >= pi/2.
 pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
     check_sample(load, phi)?;
-    if libm::fabs(phi) > FRAC_PI_2 {
-        return Err(Error::Angle); // the angle between two axes is at most pi/2
-    }
     let (g_mod, nu, mu) = (
         scene.shear_modulus(),
         scene.poisson_ratio(),
@@ -414,6 +520,8 @@ pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
             large_angle: libm::fabs(phi) > ANGLE_LIMIT || critical_angle > ANGLE_LIMIT,
             high_pressure: p0 / g_mod > PRESSURE_LIMIT,
             longer_than_rollers: false,
+            near_model_switch: false,
+            round_ellipse: false,
         },
     })
 }
@@ -428,6 +536,16 @@ impl Line {
             y,
         )
     }
+    /// Component `F phi / 2` (N/m) of the axial force per unit length opposing the
+    /// rolling of each cylinder (section 7, applied to the strip of section 8).
+    pub fn rolling_resistance(&self) -> f64 {
+        0.5 * self.axial_force * self.phi
+    }
+    /// Power `F phi V` per unit length (W/m) dissipated by microslip at rolling speed
+    /// `speed` (m/s), section 7 applied to the strip of section 8.
+    pub fn dissipated_power(&self, speed: f64) -> f64 {
+        self.axial_force * self.phi * speed
+    }
     /// Stick zone `(y_min, y_max) = (2d - b, b)`, or `None` in gross slip.
     pub fn stick_zone(&self) -> Option<(f64, f64)> {
         if self.b > self.d {
@@ -438,24 +556,51 @@ impl Line {
     }
 }
 
-/// The paper's model choice (section 9): the elliptic solution, unless the scene has a
-/// contact length and the ellipse is longer than it (or body 2 is a plane), in which
-/// case the line solution with the load per unit length `P / length`.
+/// The paper's model choice (section 9), per sample: the elliptic solution, unless
+/// body 2 is a plane or the scene has a contact length and the ellipse is longer than
+/// it (2a > length), in which case the line solution with the load per unit length
+/// `P / length`. P is the total load (N) when the scene has a length; a plane without
+/// a length reads P as N/m. The result's flags say when 2a / length is near 1
+/// ([`MODEL_SWITCH_BAND`]), where the two models differ by a jump.
 ///
 /// # Errors
-/// As [`elliptic`] and [`line()`]; [`Error::PlaneHasNoEllipse`] for a plane without length.
+/// As [`elliptic`] and [`line()`].
 pub fn estimate(scene: &Scene, load: f64, phi: f64) -> Result<Estimate, Error> {
+    estimate_with(scene, load, phi, ModelChoice::Section9)
+}
+
+/// [`estimate`] with the model chosen by `choice`: section 9's rule, or one model
+/// forced, with the same meaning of P (total load with a length; per unit length in
+/// line contact without one).
+///
+/// # Errors
+/// As [`elliptic`] and [`line()`]; [`Error::PlaneHasNoEllipse`] for a plane forced to
+/// the ellipse.
+pub fn estimate_with(
+    scene: &Scene,
+    load: f64,
+    phi: f64,
+    choice: ModelChoice,
+) -> Result<Estimate, Error> {
     check_sample(load, phi)?;
-    match scene.length() {
-        None => elliptic(scene, load, phi).map(Estimate::Elliptic),
-        Some(length) => {
-            if !scene.is_plane() {
-                let e = elliptic(scene, load, phi)?;
-                if !e.validity.longer_than_rollers {
-                    return Ok(Estimate::Elliptic(e));
-                }
-            }
-            line(scene, load / length, phi).map(Estimate::Line)
-        }
+    if choice == ModelChoice::Elliptic {
+        return elliptic(scene, load, phi).map(Estimate::Elliptic);
     }
+    // A plane, or radii so unequal that c underflows, has a strip for every phi (no
+    // ellipse); forced line contact without a length needs no ellipse either.
+    let ellipse = if choice == ModelChoice::Line && scene.length().is_none() {
+        None
+    } else {
+        elliptic(scene, load, phi).ok()
+    };
+    if let Some(e) = ellipse
+        && choice == ModelChoice::Section9
+        && !e.validity.longer_than_rollers
+    {
+        return Ok(Estimate::Elliptic(e));
+    }
+    let per_length = load / scene.length().unwrap_or(1.0);
+    let mut l = line(scene, per_length, phi)?;
+    l.validity.near_model_switch = ellipse.is_some_and(|e| e.validity.near_model_switch);
+    Ok(Estimate::Line(l))
 }

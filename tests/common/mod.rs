@@ -1,5 +1,5 @@
 //! Shared helpers for the integration tests: the independent reference data in
-//! `../shared/reference/` (or `$MISALIGN_REFERENCE_DIR`) and error measures.
+//! `tests/data/` (or `$MISALIGN_REFERENCE_DIR`) and error measures.
 #![allow(dead_code)]
 
 use std::collections::HashMap;
@@ -9,7 +9,7 @@ use std::path::PathBuf;
 pub fn reference_dir() -> PathBuf {
     match std::env::var_os("MISALIGN_REFERENCE_DIR") {
         Some(d) => PathBuf::from(d),
-        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/reference"),
+        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data"),
     }
 }
 

@@ -3,8 +3,8 @@
 //! Speed: the benchmark image (examples/bench) on the Cortex-M0, M3, M4F and M7 in
 //! QEMU with `-icount` (instructions per call, mean and maximum over the practical
 //! samples of benches/common/samples.rs). Error: the same code on the host against the
-//! independent reference data (../shared/reference/vectors_scene.csv and
-//! vectors_line.csv). Writes docs/bench.csv, docs/speed-vs-error.svg and the README's
+//! independent reference data (tests/data/vectors_scene.csv and
+//! vectors_line.csv, or `$MISALIGN_REFERENCE_DIR`). Writes docs/bench.csv, docs/speed-vs-error.svg and the README's
 //! "Accuracy and cost" table; `--csv` prints the CSV, else a readable table.
 
 #[path = "../../benches/common/hamrock_brewe.rs"]
@@ -74,7 +74,11 @@ fn rel(got: f64, want: f64) -> f64 {
 type Rows = Vec<HashMap<String, String>>;
 
 fn read(name: &str) -> Result<Rows, String> {
-    let path = crate::root().join("../shared/reference").join(name);
+    let dir = std::env::var_os("MISALIGN_REFERENCE_DIR").map_or_else(
+        || crate::root().join("tests/data"),
+        std::path::PathBuf::from,
+    );
+    let path = dir.join(name);
     let mut r = csv::Reader::from_path(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     let headers = r.headers().map_err(|e| e.to_string())?.clone();
     r.records()
@@ -130,6 +134,20 @@ fn fixed3(x: &misalign::fixed::FixedEstimate) -> (f64, f64, f64) {
     )
 }
 
+/// Error of an inverse's answer against the true value: relative, divided by
+/// max(1, sensitivity) (issue 11's measure), counted where the sensitivity is below
+/// 1e3; 0 for a lower bound (tested elsewhere), +inf for a wrong `inconsistent`.
+fn inverse_error(answer: reference::inverse::Inverse<f64>, want: f64) -> f64 {
+    use reference::inverse::Inverse;
+    match answer {
+        Inverse::Exact { value, sensitivity } if sensitivity < 1e3 => {
+            rel(value, want) / sensitivity.max(1.0)
+        }
+        Inverse::Exact { .. } | Inverse::AtLeast { .. } => 0.0,
+        Inverse::Inconsistent(_) => f64::INFINITY,
+    }
+}
+
 /// Errors of every (model, operation) on the host, over the reference files.
 pub fn errors() -> Result<HashMap<(String, String), f64>, String> {
     let scenes = read("vectors_scene.csv")?;
@@ -165,6 +183,33 @@ pub fn errors() -> Result<HashMap<(String, String), f64>, String> {
             f.critical_angle.map_or(f64::NAN, f64::from),
         );
         put("f32", "estimate", worst3(f3, row));
+        let mu = s.friction();
+        let inv = reference::inverse::friction_elliptic(&s, p, phi, r.axial_force);
+        put(
+            "reference",
+            "inverse:mu",
+            inv.map_or(f64::NAN, |a| inverse_error(a, mu)),
+        );
+        let inv = reference::inverse::angle_elliptic(&s, p, r.axial_force);
+        put(
+            "reference",
+            "inverse:phi",
+            inv.map_or(f64::NAN, |a| inverse_error(a, phi)),
+        );
+        let core = EllipticScene::new(&s).map_err(|e| e.to_string())?;
+        let (p32, phi32, f32_force) = (p as f32, phi as f32, f.axial_force);
+        let inv = core.friction_from_axial_force(p32, phi32, f32_force);
+        put(
+            "f32",
+            "inverse:mu",
+            inv.map_or(f64::NAN, |a| inverse_error(a.map(f64::from), mu)),
+        );
+        let inv = core.angle_from_axial_force(p32, f32_force);
+        put(
+            "f32",
+            "inverse:phi",
+            inv.map_or(f64::NAN, |a| inverse_error(a.map(f64::from), phi)),
+        );
         let (load_lsb, pc) = exact_lsb(p, 1 << 30, 0.0);
         let (angle_lsb, ac) = exact_lsb(phi, 1 << 30, FixedEllipticScene::min_angle_lsb(&s));
         let x = FixedEllipticScene::new(&s, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
@@ -284,6 +329,25 @@ pub fn errors() -> Result<HashMap<(String, String), f64>, String> {
             f.critical_angle.map_or(f64::NAN, f64::from),
         );
         put("f32", "estimate:line", worst3(f3, row));
+        let (mu, core) = (s.friction(), LineScene::new(&s).map_err(|e| e.to_string())?);
+        let inv = reference::inverse::friction_line(&s, p, phi, r.axial_force);
+        put(
+            "reference",
+            "inverse:mu:line",
+            inv.map_or(f64::NAN, |a| inverse_error(a, mu)),
+        );
+        let inv = reference::inverse::angle_line(&s, p, r.axial_force);
+        put(
+            "reference",
+            "inverse:phi:line",
+            inv.map_or(f64::NAN, |a| inverse_error(a, phi)),
+        );
+        let inv = core.friction_from_axial_force(p as f32, phi as f32, f.axial_force);
+        let e = inv.map_or(f64::NAN, |a| inverse_error(a.map(f64::from), mu));
+        put("f32", "inverse:mu:line", e);
+        let inv = core.angle_from_axial_force(p as f32, f.axial_force);
+        let e = inv.map_or(f64::NAN, |a| inverse_error(a.map(f64::from), phi));
+        put("f32", "inverse:phi:line", e);
         let ((load_lsb, pc), (angle_lsb, ac)) =
             (exact_lsb(p, 1 << 30, 0.0), exact_lsb(phi, 1 << 30, 0.0));
         let x = FixedLineScene::new(&s, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
@@ -419,6 +483,9 @@ fn table_bytes(model: &str, operation: &str) -> Option<usize> {
         ("f32", "table:theta_of_g") => size(&t::THETA_OF_G_ROWS),
         ("f32", "kernel:axial_force") => force,
         ("f32", "estimate:line" | "kernel:cbrt" | "kernel:inv_sqrt") => 0,
+        ("f32", "inverse:mu") => size(&t::G_OF_THETA_ROWS) + force,
+        ("f32", "inverse:phi") => size(&t::G_OF_THETA_ROWS) + size(&t::THETA_OF_G_ROWS) + force,
+        ("f32", "inverse:mu:line" | "inverse:phi:line") => 0,
         ("fixed", "estimate") => log_exp + log_g + log_theta + size(t::LOG_FORCE_OVER_S.values),
         ("fixed", "estimate:line") => log_exp,
         ("fixed", "kernel:log2") => size(t::LOG2_MANTISSA.values),
@@ -518,7 +585,9 @@ pub fn run(csv: bool, short: bool) -> ExitCode {
             .iter()
             .filter(|r| {
                 r.operation == "estimate"
-                    || (r.model == "f32" && r.cpu == "cortex-m4f" && r.operation != "estimate:line")
+                    || (r.model == "f32"
+                        && r.cpu == "cortex-m4f"
+                        && !r.operation.ends_with(":line"))
                     || (r.model == "fixed"
                         && r.cpu == "cortex-m0"
                         && r.operation != "estimate:line")

@@ -222,7 +222,9 @@ pub(crate) fn preflight() -> Result<(), String> {
         return Err("qemu-system-arm not found: apt-get install -y qemu-system-arm".into());
     }
     if !cross::have("defmt-print") {
-        println!(
+        // On stderr, with the install's own output: `cargo xtask bench --csv` keeps
+        // stdout for its CSV.
+        eprintln!(
             "defmt-print not found: cargo install defmt-print {}",
             cross::DEFMT_PRINT_VERSION
         );
@@ -235,6 +237,7 @@ pub(crate) fn preflight() -> Result<(), String> {
                     "--version",
                     cross::DEFMT_PRINT_VERSION,
                 ])
+                .stdout(std::io::stderr())
                 .status()
                 .map_err(|e| format!("cannot run cargo install: {e}"))?;
         if !status.success() || !cross::have("defmt-print") {

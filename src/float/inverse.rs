@@ -1,0 +1,373 @@
+//! Inverse estimates in f32, per sample: the friction coefficient mu from a measured
+//! axial force F at known load P and misalignment phi, and the misalignment from F at
+//! known P and mu. Same answers as the reference ([`crate::reference::inverse`], whose
+//! docs give the shape of the forward map), from the same prepared scene as the forward
+//! estimate and no further tables:
+//!
+//! - mu: `K = mu d/b` from the forward path (`g(theta)` table, eq 16), then s from
+//!   `f(s)/s = F/(K P)` by Newton steps on the axial-force kernel's polynomials
+//!   ([`crate::kernels::axial_force_inverse`]), `mu = K / s`; line contact in closed
+//!   form (`mu = K / (2 - F/(K P))`, eqs 23, 27).
+//! - phi: s from `f(s) = F/(mu P)` by the same kernel inverse, then eq (16) solved for
+//!   `g = s P^(1/3) / A` and theta from the inverse table `theta(g)` that the critical
+//!   angle already uses (eq 18); line contact `phi = s phi0` (eqs 23, 27, 28).
+//!
+//! Newton steps on the existing tables rather than new inverse tables: the kernel
+//! inverse is within 2e-7 of the f64 inverse (times its conditioning) with no new table
+//! bytes, and `theta(g)` is the table the forward path links anyway; new tables were
+//! not built, as this leaves nothing for them to gain in accuracy. Cost (`cargo xtask
+//! bench --short`, instructions per call, mean / max over the practical samples):
+//! mu 184 / 373 and phi 211 / 364 on the Cortex-M4F (the forward estimate: 148 / 174),
+//! line contact 88 / 101 and 72 / 92.
+//!
+//! Error bound (tested in tests/inverse.rs over the public reference scenes, inputs
+//! rounded to f32, forward in f32 then inverse in f32): mu and phi within 2e-6 relative
+//! of the true values, times the sensitivity where it exceeds 1, wherever the
+//! sensitivity is below 1e3; measured 4.3e-7. The phi-inverse's sensitivity agrees
+//! with the reference's to 1e-4 times max(1, S) (measured 2.0e-5; it takes
+//! `d ln g / d ln theta` by a difference of the g table, and S ~ 1/f'(s) is steep in s
+//! near gross slip).
+//!
+//! Section 9: [`Auto`] chooses the model per sample. mu's inverse is the chosen
+//! model's (phi is known); phi's solves both models and keeps each answer only where
+//! the choice takes its model.
+//!
+//! The fixed-point core ([`crate::fixed`]) has no inverse yet. In its logarithmic
+//! number system the inverse needs new log-domain tables (log s of log r, and of
+//! log(f/s)), generated and drift-tested like its forward tables, and the differences
+//! `1 - r`, `2 - q` near saturation, which that number system forms only through a
+//! difference (Gauss-logarithm) table whose error grows as they cancel; that is more
+//! than this budget. An FPU-less node (Cortex-M0, M3) can call these f32
+//! inverses in software floating point.
+
+use super::{Auto, EllipticScene, LineScene, check};
+use crate::Error;
+use crate::kernels::axial_force_inverse::{
+    force_over_slip_limit, force_ratio_slope, slip_ratio_of_force_over_slip,
+    slip_ratio_of_force_ratio,
+};
+use crate::kernels::cbrt::cbrt;
+use crate::kernels::sqrt::{inv_sqrt, sqrt};
+use crate::reference::ContactModel;
+use crate::reference::inverse::{Inconsistency, Inverse, angle_trivial, friction_trivial};
+use core::f32::consts::FRAC_PI_2;
+
+/// Relative distance below the no-slip limit of F(mu) within which F counts as the
+/// limit (the f32 forward map's rounding there): the answer is then only `AtLeast`.
+const SATURATION_ULPS: f32 = 8.0 * f32::EPSILON;
+
+/// An F up to this far (relative) above mu P counts as mu P (the rounding of mu P
+/// and of F from inputs rounded to f32); further above, F is inconsistent.
+pub const ROUNDING_ABOVE_SATURATION: f32 = 4.0 * f32::EPSILON;
+
+/// Relative step of the difference that gives `d ln g / d ln theta`.
+const LOG_STEP: f32 = 1.0 / 64.0;
+
+/// Input checks of the inverses: the forward checks, and F finite.
+#[inline(always)]
+fn check_force(load: f32, phi: f32, force: f32) -> Result<(), Error> {
+    check(load, phi)?;
+    if !force.is_finite() {
+        return Err(Error::Force);
+    }
+    Ok(())
+}
+
+/// The cases decided before the model (F = 0, P = 0, phi = 0, signs), as the reference.
+#[inline(always)]
+fn friction_decided(load: f32, phi: f32, force: f32) -> Option<Inverse<f32>> {
+    friction_trivial(load, phi, force)
+}
+
+#[inline(always)]
+fn angle_decided(load: f32, force: f32, zero_angle_sensitivity: f32) -> Option<Inverse<f32>> {
+    angle_trivial(load, force, zero_angle_sensitivity)
+}
+
+/// mu from `r = F / P` and `K = mu d/b`, given s from `q = r / K` and the slope of
+/// `f(s)/s`'s numerator; `limit` is `f(s)/s` at s = 0.
+#[inline(always)]
+fn friction_from_ratio(
+    r: f32,
+    k: f32,
+    limit: f32,
+    slip_of: impl Fn(f32) -> f32,
+    slope: impl Fn(f32) -> f32,
+) -> Inverse<f32> {
+    if r <= k {
+        // Gross slip: F = mu P (eqs 21, 29, 27).
+        return bounded(r, 1.0);
+    }
+    let q = r / k;
+    if q.is_nan() || q > limit * (1.0 + SATURATION_ULPS) {
+        return Inverse::Inconsistent(Inconsistency::AboveModel);
+    }
+    let saturation = limit * (1.0 - SATURATION_ULPS);
+    if q >= saturation {
+        return Inverse::AtLeast {
+            value: (k / slip_of(saturation)).min(f32::MAX),
+        };
+    }
+    let s = slip_of(q);
+    // S = 1 / (1 - s f'/f) = h / (h - f'), h = f/s = q.
+    bounded(k / s, q / (q - slope(s)))
+}
+
+/// An exact mu, or `AtLeast` the largest f32 where mu overflows.
+#[inline(always)]
+fn bounded(mu: f32, sensitivity: f32) -> Inverse<f32> {
+    if mu.is_finite() {
+        Inverse::Exact {
+            value: mu,
+            sensitivity,
+        }
+    } else {
+        Inverse::AtLeast { value: f32::MAX }
+    }
+}
+
+/// `answer` with its value signed like `force`.
+#[inline(always)]
+fn signed(answer: Inverse<f32>, force: f32) -> Inverse<f32> {
+    match answer {
+        Inverse::Exact { value, sensitivity } => Inverse::Exact {
+            value: value.copysign(force),
+            sensitivity,
+        },
+        Inverse::AtLeast { value } => Inverse::AtLeast {
+            value: value.copysign(force),
+        },
+        other => other,
+    }
+}
+
+impl EllipticScene<'_> {
+    /// The friction coefficient mu from load `load` (N), misalignment `phi` (rad,
+    /// signed) and measured axial force `force` (N), elliptic contact (eqs 15, 16, 21).
+    /// The friction the scene was prepared with is not read.
+    ///
+    /// # Errors
+    /// As [`EllipticScene::estimate`], and [`Error::Force`] for a NaN or infinite F.
+    pub fn friction_from_axial_force(
+        &self,
+        load: f32,
+        phi: f32,
+        force: f32,
+    ) -> Result<Inverse<f32>, Error> {
+        check_force(load, phi, force)?;
+        let theta = self.radius_factor * phi.abs();
+        if theta > FRAC_PI_2 {
+            return Err(Error::Angle);
+        }
+        if let Some(answer) = friction_decided(load, phi, force) {
+            return Ok(answer);
+        }
+        let g = self.g_of_theta(theta)?;
+        // K = mu d/b = (A mu) g P^(-1/3) (eq 16), A mu independent of mu.
+        let k = self.slip_gain * self.friction * g / cbrt(load);
+        Ok(friction_from_ratio(
+            force.abs() / load,
+            k,
+            force_over_slip_limit(),
+            slip_ratio_of_force_over_slip,
+            force_ratio_slope,
+        ))
+    }
+
+    /// The misalignment phi (rad, signed like F) from load `load` (N) and measured
+    /// axial force `force` (N), with the scene's mu, elliptic contact.
+    ///
+    /// # Errors
+    /// [`Error::Load`], [`Error::Force`]; [`Error::OutOfRange`] for a theta outside
+    /// narrowed tables.
+    pub fn angle_from_axial_force(&self, load: f32, force: f32) -> Result<Inverse<f32>, Error> {
+        check_force(load, 0.0, force)?;
+        if let Some(answer) = angle_decided(load, force, 1.5) {
+            return Ok(answer);
+        }
+        let saturated = self.friction * (load * 1.0); // mu P, formed as the forward path
+        let abs_force = force.abs();
+        if abs_force > saturated * (1.0 + ROUNDING_ABOVE_SATURATION) {
+            return Ok(Inverse::Inconsistent(Inconsistency::AboveModel));
+        }
+        let g_per_slip = self.critical_gain * cbrt(load); // eq (16): g = s P^(1/3) / A
+        let answer = if abs_force >= saturated {
+            // Gross slip: only |phi| >= phi0 (eq 18 at d/b = 1).
+            match self.theta_of_g(g_per_slip)? {
+                Some(theta0) => Inverse::AtLeast {
+                    value: theta0 * self.inv_radius_factor,
+                },
+                None => Inverse::Inconsistent(Inconsistency::AboveModel),
+            }
+        } else {
+            let r = abs_force / saturated;
+            let s = slip_ratio_of_force_ratio(r);
+            if s == 0.0 {
+                // F/(mu P) underflows f32: phi too (it falls like F^(3/2)), as at F = 0.
+                return Ok(signed(
+                    Inverse::Exact {
+                        value: 0.0,
+                        sensitivity: 1.5,
+                    },
+                    force,
+                ));
+            }
+            match self.theta_of_g(g_per_slip * s)? {
+                Some(theta) => Inverse::Exact {
+                    value: theta * self.inv_radius_factor,
+                    // S = f / (s f' E), E = d ln g / d ln theta (eq 16).
+                    sensitivity: r / (s * force_ratio_slope(s) * self.log_slope_of_g(theta)),
+                },
+                None => Inverse::Inconsistent(Inconsistency::AboveModel),
+            }
+        };
+        Ok(signed(answer, force))
+    }
+
+    /// `d ln g / d ln theta` from the g table by a central difference; 2/3 (the
+    /// small-theta limit) where the table does not reach.
+    fn log_slope_of_g(&self, theta: f32) -> f32 {
+        let up = self.g_of_theta(theta * (1.0 + LOG_STEP));
+        let down = self.g_of_theta(theta * (1.0 - LOG_STEP));
+        match (up, down, self.g_of_theta(theta)) {
+            (Ok(a), Ok(b), Ok(g)) if g > 0.0 => (a - b) / (2.0 * LOG_STEP * g),
+            _ => 2.0 / 3.0,
+        }
+    }
+}
+
+impl LineScene {
+    /// The friction coefficient mu from load `load` (N/m, or N with a length),
+    /// misalignment `phi` (rad, signed) and axial force `force` (same unit per length as
+    /// the load), line contact: `mu = F/P` in gross slip, else `K / (2 - F/(K P))`,
+    /// `K = mu d/b` (eqs 23, 27). The friction the scene was prepared with is not read.
+    ///
+    /// # Errors
+    /// As [`LineScene::estimate`], and [`Error::Force`] for a NaN or infinite F.
+    pub fn friction_from_axial_force(
+        &self,
+        load: f32,
+        phi: f32,
+        force: f32,
+    ) -> Result<Inverse<f32>, Error> {
+        check_force(load, phi, force)?;
+        if phi.abs() > FRAC_PI_2 {
+            return Err(Error::Angle);
+        }
+        if let Some(answer) = friction_decided(load, phi, force) {
+            return Ok(answer);
+        }
+        let k = self.slip_gain * self.friction * phi.abs() * inv_sqrt(load); // eq (23)
+        Ok(friction_from_ratio(
+            force.abs() / load,
+            k,
+            2.0,
+            |q| 2.0 - q,                                   // eq (27) over s: 2 - s = q
+            |s| if s < 1.0 { 2.0 - 2.0 * s } else { 0.0 }, // d(2 s - s^2)/ds
+        ))
+    }
+
+    /// The misalignment phi (rad, signed like F) from load `load` (N/m, or N with a
+    /// length) and axial force `force`, with the scene's mu: `s = r / (1 + sqrt(1 - r))`,
+    /// `r = F/(mu P)` (eq 27), `phi = s phi0` (eqs 23, 28).
+    ///
+    /// # Errors
+    /// [`Error::Load`], [`Error::Force`].
+    pub fn angle_from_axial_force(&self, load: f32, force: f32) -> Result<Inverse<f32>, Error> {
+        check_force(load, 0.0, force)?;
+        if let Some(answer) = angle_decided(load, force, 1.0) {
+            return Ok(answer);
+        }
+        let saturated = self.friction * (load * 1.0);
+        let abs_force = force.abs();
+        if abs_force > saturated * (1.0 + ROUNDING_ABOVE_SATURATION) {
+            return Ok(Inverse::Inconsistent(Inconsistency::AboveModel));
+        }
+        let phi0 = self.critical_gain * (load * inv_sqrt(load)); // eq (28)
+        let answer = if abs_force >= saturated {
+            Inverse::AtLeast { value: phi0 }
+        } else {
+            let r = abs_force / saturated;
+            let s = r / (1.0 + sqrt(1.0 - r));
+            let phi = s * phi0;
+            if phi > FRAC_PI_2 {
+                Inverse::Inconsistent(Inconsistency::AboveModel)
+            } else {
+                Inverse::Exact {
+                    value: phi,
+                    sensitivity: (2.0 - s) / (2.0 * (1.0 - s)),
+                }
+            }
+        };
+        Ok(signed(answer, force))
+    }
+}
+
+impl Auto {
+    /// mu from (P, phi, F) by the model section 9 (or the scene's forced choice) takes
+    /// for this sample (see [`EllipticScene`] and [`LineScene`] for units); suits a
+    /// monitor that tracks mu per sample.
+    ///
+    /// # Errors
+    /// As the chosen scene's `friction_from_axial_force`.
+    pub fn friction_from_axial_force(
+        &self,
+        load: f32,
+        phi: f32,
+        force: f32,
+    ) -> Result<Inverse<f32>, Error> {
+        Auto::checked(load, phi)?;
+        match (self.choose(load, phi).0, &self.elliptic, &self.line) {
+            (ContactModel::Elliptic, Some(e), _) => e.friction_from_axial_force(load, phi, force),
+            (_, _, Some(l)) => l.friction_from_axial_force(load, phi, force),
+            _ => Err(Error::OutOfRange), // not reached: see `Auto::estimate`
+        }
+    }
+
+    /// phi from (P, F). The model depends on the unknown phi, so both are solved and
+    /// each answer counts only where the choice would take its model, as
+    /// `reference::inverse::angle_estimate`: both count gives `at_least` the smaller,
+    /// neither `inconsistent` (the switch jumps over F).
+    ///
+    /// # Errors
+    /// As the scenes' `angle_from_axial_force`.
+    pub fn angle_from_axial_force(&self, load: f32, force: f32) -> Result<Inverse<f32>, Error> {
+        let elliptic = match &self.elliptic {
+            Some(e) => Some(e.angle_from_axial_force(load, force)?),
+            None => None,
+        };
+        let line = match &self.line {
+            Some(l) => Some(l.angle_from_axial_force(load, force)?),
+            None => None,
+        };
+        let picks = |answer: &Option<Inverse<f32>>, model: ContactModel| match answer {
+            Some(Inverse::Exact { value, .. } | Inverse::AtLeast { value }) => {
+                self.choose(load, *value).0 == model
+            }
+            _ => false,
+        };
+        Ok(
+            match (
+                picks(&elliptic, ContactModel::Elliptic),
+                picks(&line, ContactModel::Line),
+            ) {
+                (true, false) => {
+                    elliptic.unwrap_or(Inverse::Inconsistent(Inconsistency::AboveModel))
+                }
+                (false, true) => line.unwrap_or(Inverse::Inconsistent(Inconsistency::AboveModel)),
+                (true, true) => {
+                    let e = elliptic.and_then(|a| a.value()).unwrap_or(0.0);
+                    let l = line.and_then(|a| a.value()).unwrap_or(0.0);
+                    Inverse::AtLeast {
+                        value: if e.abs() < l.abs() { e } else { l },
+                    }
+                }
+                (false, false) => match (elliptic, line) {
+                    (Some(a @ Inverse::Inconsistent(_)), None | Some(Inverse::Inconsistent(_)))
+                    | (None, Some(a @ Inverse::Inconsistent(_))) => a,
+                    _ => Inverse::Inconsistent(Inconsistency::BetweenModels),
+                },
+            },
+        )
+    }
+}

@@ -1,0 +1,390 @@
+//! The record format: a fixed header, the payload a [`Checkpoint`] type writes, and a
+//! CRC-32 over both. Pure functions on byte slices; no flash here.
+//!
+//! | bytes | field | value |
+//! | --- | --- | --- |
+//! | 0..4 | magic | `b"MSLG"` |
+//! | 4 | kind | [`Checkpoint::KIND`] |
+//! | 5 | framing | [`FRAMING`] (this table's version) |
+//! | 6..8 | format version | [`Checkpoint::VERSION`] of the writer, u16 LE |
+//! | 8..10 | payload length | bytes, u16 LE |
+//! | 10..12 | reserved | 0 |
+//! | 12..16 | sequence | checkpoint number, u32 LE |
+//! | 16..16+n | payload | [`Checkpoint::encode`] |
+//! | 16+n..20+n | CRC-32 | IEEE (zlib's), over bytes 0..16+n, u32 LE |
+
+use core::fmt;
+
+use super::Checkpoint;
+
+/// The magic bytes at the start of every record: a record of another program fails here.
+pub const MAGIC: [u8; 4] = *b"MSLG";
+/// The version of the framing (the header layout above), not of any payload.
+pub const FRAMING: u8 = 1;
+/// Header bytes before the payload.
+pub const HEADER_LEN: usize = 16;
+/// Bytes a record adds to its payload: the header and the CRC.
+pub const OVERHEAD: usize = HEADER_LEN + 4;
+
+/// Bytes of the record of a payload of `payload` bytes.
+#[must_use]
+pub const fn record_len(payload: usize) -> usize {
+    payload + OVERHEAD
+}
+
+/// Why bytes could not be encoded or decoded as a record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum CodecError {
+    /// The output buffer is shorter than the record (`needed` bytes).
+    BufferTooSmall {
+        /// Bytes the record needs.
+        needed: usize,
+    },
+    /// A read or write went past the end of the payload.
+    Truncated,
+    /// The payload had bytes left over after decoding, or `encode` wrote fewer bytes
+    /// than [`Checkpoint::SIZE`].
+    TrailingBytes,
+    /// The bytes do not start with [`MAGIC`] and this framing: not one of our records.
+    Foreign,
+    /// A record of ours, of another kind (another [`Checkpoint`] type).
+    WrongKind {
+        /// The kind found.
+        found: u8,
+    },
+    /// The CRC does not match: the record is damaged.
+    Checksum,
+    /// The header's length disagrees with the record's size, or the payload is longer
+    /// than a record can say (65 535 bytes).
+    Length,
+    /// A format version this firmware cannot read (newer, or older without a
+    /// [`Checkpoint::migrate`] arm for it).
+    UnsupportedVersion {
+        /// The version found.
+        version: u16,
+    },
+    /// The payload decoded, but a field holds a value the type refuses.
+    InvalidValue,
+}
+
+impl fmt::Display for CodecError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CodecError::BufferTooSmall { needed } => {
+                write!(f, "buffer too small for the record ({needed} bytes)")
+            }
+            CodecError::Truncated => f.write_str("read or write past the end of the payload"),
+            CodecError::TrailingBytes => f.write_str("payload size differs from the type's"),
+            CodecError::Foreign => f.write_str("not a misalign record (magic or framing)"),
+            CodecError::WrongKind { found } => write!(f, "record of another kind ({found})"),
+            CodecError::Checksum => f.write_str("record checksum mismatch"),
+            CodecError::Length => f.write_str("record length field mismatch"),
+            CodecError::UnsupportedVersion { version } => {
+                write!(f, "unsupported format version {version}")
+            }
+            CodecError::InvalidValue => f.write_str("a field holds a value the type refuses"),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for CodecError {}
+
+/// CRC-32 (IEEE 802.3, reflected, as zlib's `crc32`), bit by bit: no table in flash.
+#[must_use]
+pub fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &byte in bytes {
+        crc ^= u32::from(byte);
+        for _ in 0..8 {
+            let mask = (crc & 1).wrapping_neg();
+            crc = (crc >> 1) ^ (0xEDB8_8320 & mask);
+        }
+    }
+    !crc
+}
+
+/// Writes little-endian fields into a payload, never past its end.
+#[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Writer<'a> {
+    out: &'a mut [u8],
+    at: usize,
+}
+
+impl<'a> Writer<'a> {
+    /// A writer filling `out` from its start.
+    pub fn new(out: &'a mut [u8]) -> Self {
+        Writer { out, at: 0 }
+    }
+
+    /// Bytes written so far.
+    #[must_use]
+    pub fn written(&self) -> usize {
+        self.at
+    }
+
+    /// Writes raw bytes.
+    pub fn bytes(&mut self, bytes: &[u8]) -> Result<(), CodecError> {
+        let end = self
+            .at
+            .checked_add(bytes.len())
+            .ok_or(CodecError::Truncated)?;
+        let dst = self
+            .out
+            .get_mut(self.at..end)
+            .ok_or(CodecError::Truncated)?;
+        dst.copy_from_slice(bytes);
+        self.at = end;
+        Ok(())
+    }
+
+    /// Writes a `u8`.
+    pub fn u8(&mut self, v: u8) -> Result<(), CodecError> {
+        self.bytes(&[v])
+    }
+
+    /// Writes a `u16`, little-endian.
+    pub fn u16(&mut self, v: u16) -> Result<(), CodecError> {
+        self.bytes(&v.to_le_bytes())
+    }
+
+    /// Writes a `u32`, little-endian.
+    pub fn u32(&mut self, v: u32) -> Result<(), CodecError> {
+        self.bytes(&v.to_le_bytes())
+    }
+
+    /// Writes a `u64`, little-endian.
+    pub fn u64(&mut self, v: u64) -> Result<(), CodecError> {
+        self.bytes(&v.to_le_bytes())
+    }
+
+    /// Writes an `i32`, little-endian.
+    pub fn i32(&mut self, v: i32) -> Result<(), CodecError> {
+        self.bytes(&v.to_le_bytes())
+    }
+
+    /// Writes an `f32` (its IEEE bits), little-endian: restored bit for bit.
+    pub fn f32(&mut self, v: f32) -> Result<(), CodecError> {
+        self.u32(v.to_bits())
+    }
+
+    /// Writes an `f64` (its IEEE bits), little-endian: restored bit for bit.
+    pub fn f64(&mut self, v: f64) -> Result<(), CodecError> {
+        self.u64(v.to_bits())
+    }
+
+    /// Writes a `bool` as one byte, 0 or 1.
+    pub fn bool(&mut self, v: bool) -> Result<(), CodecError> {
+        self.u8(u8::from(v))
+    }
+
+    /// Writes every item of `items` with `field` (e.g. `w.each(&energies, |w, e| w.f64(*e))`).
+    pub fn each<T>(
+        &mut self,
+        items: &[T],
+        mut field: impl FnMut(&mut Self, &T) -> Result<(), CodecError>,
+    ) -> Result<(), CodecError> {
+        items.iter().try_for_each(|item| field(self, item))
+    }
+}
+
+/// Reads little-endian fields from a payload, never past its end.
+#[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    /// A reader of `bytes` from their start.
+    #[must_use]
+    pub fn new(bytes: &'a [u8]) -> Self {
+        Reader { bytes, at: 0 }
+    }
+
+    /// Bytes not read yet.
+    #[must_use]
+    pub fn remaining(&self) -> usize {
+        self.bytes.len().saturating_sub(self.at)
+    }
+
+    /// Reads `N` raw bytes.
+    pub fn array<const N: usize>(&mut self) -> Result<[u8; N], CodecError> {
+        let end = self.at.checked_add(N).ok_or(CodecError::Truncated)?;
+        let src = self.bytes.get(self.at..end).ok_or(CodecError::Truncated)?;
+        let mut out = [0u8; N];
+        out.copy_from_slice(src);
+        self.at = end;
+        Ok(out)
+    }
+
+    /// Reads a `u8`.
+    pub fn u8(&mut self) -> Result<u8, CodecError> {
+        self.array::<1>().map(|[b]| b)
+    }
+
+    /// Reads a little-endian `u16`.
+    pub fn u16(&mut self) -> Result<u16, CodecError> {
+        self.array().map(u16::from_le_bytes)
+    }
+
+    /// Reads a little-endian `u32`.
+    pub fn u32(&mut self) -> Result<u32, CodecError> {
+        self.array().map(u32::from_le_bytes)
+    }
+
+    /// Reads a little-endian `u64`.
+    pub fn u64(&mut self) -> Result<u64, CodecError> {
+        self.array().map(u64::from_le_bytes)
+    }
+
+    /// Reads a little-endian `i32`.
+    pub fn i32(&mut self) -> Result<i32, CodecError> {
+        self.array().map(i32::from_le_bytes)
+    }
+
+    /// Reads an `f32` from its little-endian IEEE bits (any bits, NaN included:
+    /// the type's `decode` refuses what it must).
+    pub fn f32(&mut self) -> Result<f32, CodecError> {
+        self.u32().map(f32::from_bits)
+    }
+
+    /// Reads an `f64` from its little-endian IEEE bits (any bits, NaN included).
+    pub fn f64(&mut self) -> Result<f64, CodecError> {
+        self.u64().map(f64::from_bits)
+    }
+
+    /// Reads a `bool`: 0 or 1, anything else is [`CodecError::InvalidValue`].
+    pub fn bool(&mut self) -> Result<bool, CodecError> {
+        match self.u8()? {
+            0 => Ok(false),
+            1 => Ok(true),
+            _ => Err(CodecError::InvalidValue),
+        }
+    }
+
+    /// Reads `N` items with `field`, into an array (e.g. `r.array_of(|r| r.f64())`).
+    pub fn array_of<T: Copy + Default, const N: usize>(
+        &mut self,
+        mut field: impl FnMut(&mut Self) -> Result<T, CodecError>,
+    ) -> Result<[T; N], CodecError> {
+        let mut out = [T::default(); N];
+        for item in &mut out {
+            *item = field(self)?;
+        }
+        Ok(out)
+    }
+
+    /// Succeeds if every byte was read: a payload of another size is refused.
+    pub fn finish(&self) -> Result<(), CodecError> {
+        if self.remaining() == 0 {
+            Ok(())
+        } else {
+            Err(CodecError::TrailingBytes)
+        }
+    }
+}
+
+/// A record decoded: the value, its checkpoint number and the format version it was
+/// stored in (older than [`Checkpoint::VERSION`] when it was migrated).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Decoded<T> {
+    /// The value, in the current version's type.
+    pub value: T,
+    /// The checkpoint number the record was written with.
+    pub sequence: u32,
+    /// The format version the record was written in.
+    pub version: u16,
+}
+
+/// Encodes `value` as a record numbered `sequence` into the start of `out`; returns the
+/// record's length, [`record_len`]`(T::SIZE)`.
+pub fn encode<T: Checkpoint>(
+    value: &T,
+    sequence: u32,
+    out: &mut [u8],
+) -> Result<usize, CodecError> {
+    let len = record_len(T::SIZE);
+    let payload_len = u16::try_from(T::SIZE).map_err(|_| CodecError::Length)?;
+    let out = out
+        .get_mut(..len)
+        .ok_or(CodecError::BufferTooSmall { needed: len })?;
+    let (body, crc_bytes) = out
+        .split_at_mut_checked(len - 4)
+        .ok_or(CodecError::Length)?;
+    let (header, payload) = body
+        .split_at_mut_checked(HEADER_LEN)
+        .ok_or(CodecError::Length)?;
+    let mut w = Writer::new(header);
+    w.bytes(&MAGIC)?;
+    w.u8(T::KIND)?;
+    w.u8(FRAMING)?;
+    w.u16(T::VERSION)?;
+    w.u16(payload_len)?;
+    w.u16(0)?;
+    w.u32(sequence)?;
+    let mut w = Writer::new(payload);
+    value.encode(&mut w)?;
+    if w.written() != T::SIZE {
+        return Err(CodecError::TrailingBytes);
+    }
+    let crc = crc32(body);
+    crc_bytes.copy_from_slice(&crc.to_le_bytes());
+    Ok(len)
+}
+
+/// Decodes a record of `T` (or of an older version of it, through
+/// [`Checkpoint::migrate`]). Every check comes before the payload is read: a damaged,
+/// foreign or unknown record is an error, never a value.
+pub fn decode<T: Checkpoint>(record: &[u8]) -> Result<Decoded<T>, CodecError> {
+    let mut r = Reader::new(record);
+    if r.array::<4>().map_err(|_| CodecError::Foreign)? != MAGIC {
+        return Err(CodecError::Foreign);
+    }
+    // The magic matched: from here on the header is ours.
+    let kind = r.u8()?;
+    let framing = r.u8()?;
+    if framing != FRAMING {
+        return Err(CodecError::Foreign);
+    }
+    let version = r.u16()?;
+    let payload_len = usize::from(r.u16()?);
+    let _reserved = r.u16()?;
+    let sequence = r.u32()?;
+    if record.len() != record_len(payload_len) {
+        return Err(CodecError::Length);
+    }
+    let (body, crc_bytes) = record
+        .split_at_checked(record.len().saturating_sub(4))
+        .ok_or(CodecError::Length)?;
+    let mut crc = Reader::new(crc_bytes);
+    if crc.u32()? != crc32(body) {
+        return Err(CodecError::Checksum);
+    }
+    if kind != T::KIND {
+        return Err(CodecError::WrongKind { found: kind });
+    }
+    let payload = body.get(HEADER_LEN..).ok_or(CodecError::Length)?;
+    let mut r = Reader::new(payload);
+    let value = if version == T::VERSION {
+        if payload_len != T::SIZE {
+            return Err(CodecError::Length);
+        }
+        T::decode(&mut r)?
+    } else if version < T::VERSION {
+        T::migrate(version, &mut r)?
+    } else {
+        return Err(CodecError::UnsupportedVersion { version });
+    };
+    r.finish()?;
+    Ok(Decoded {
+        value,
+        sequence,
+        version,
+    })
+}
