@@ -132,3 +132,102 @@ fn axial_force_ratio_never_exceeds_one() {
         assert!(f <= 1.0 && f > 0.999_999_999, "{s}: {f}");
     }
 }
+
+// Issue 14: an adversarial probe's crafted inputs (extreme but accepted scenes, LSBs
+// that leave no angle but 0, loads whose mu P leaves the number format).
+
+use misalign::Error;
+
+/// Every f64 field of an elliptic result is a number (infinities where documented).
+fn assert_no_nan_elliptic(e: &reference::Elliptic) {
+    let s = e.shape;
+    let fields = [
+        s.theta,
+        s.kprime,
+        s.m,
+        s.n,
+        e.a,
+        e.b,
+        e.p0,
+        e.pstar,
+        e.p0star,
+        e.slip_ratio,
+        e.d,
+        e.axial_force,
+        e.critical_load,
+        e.critical_angle.unwrap_or(0.0),
+        e.critical_theta.unwrap_or(0.0),
+    ];
+    assert!(fields.iter().all(|x| !x.is_nan()), "{e:?}");
+}
+
+/// Every f64 field of a line result is a number.
+fn assert_no_nan_line(l: &reference::Line) {
+    let fields = [
+        l.radius,
+        l.b,
+        l.p0,
+        l.pstar,
+        l.p0star,
+        l.slip_ratio,
+        l.d,
+        l.axial_force,
+        l.critical_angle,
+        l.critical_load,
+    ];
+    assert!(fields.iter().all(|x| !x.is_nan()), "{l:?}");
+}
+
+/// Issue 14 (3): R1 = R2 = 5e-324 m gave an effective radius of 0 (R1 R2/(R1 + R2)
+/// is 2.5e-324, not an f64), and from it NaN in p0, phi0, P*, a. Such radii are refused;
+/// twice the smallest subnormal still works, without NaN.
+#[test]
+fn effective_radius_that_underflows_is_refused() {
+    let tiny = f64::from_bits(1);
+    assert_eq!(
+        Scene::new(tiny, tiny, 79.3e9, 0.3, 0.3).err(),
+        Some(Error::Radius)
+    );
+    let s = Scene::new(2.0 * tiny, 2.0 * tiny, 79.3e9, 0.3, 0.3).unwrap();
+    assert_eq!(s.effective_radius(), tiny);
+    for phi in [0.0, 1e-3, 1.0] {
+        for load in [0.0, 1e-300, 1.0, 1e300] {
+            assert_no_nan_line(&reference::line(&s, load, phi).unwrap());
+            assert_no_nan_elliptic(&reference::elliptic(&s, load, phi).unwrap());
+        }
+    }
+}
+
+/// Issue 14 (3): R = 1e308 m on a plane with G = 5e-324 Pa: the half-width b
+/// overflows, and d = (d/b) b was 0 x inf = NaN at phi = 0.
+#[test]
+fn line_slip_width_of_an_overflowing_strip() {
+    let s = Scene::new(1e308, f64::INFINITY, f64::from_bits(1), 0.3, 0.3).unwrap();
+    for phi in [0.0, 1e-300, 1e-3, 1.0] {
+        for load in [0.0, 1e-300, 1.0, 1e300] {
+            assert_no_nan_line(&reference::line(&s, load, phi).unwrap());
+        }
+    }
+}
+
+/// Issue 14 (3): R1 = R2 = f64::MAX, G = 5e-324 Pa, mu = f64::MAX, P = 0: R1 + R2
+/// overflowed and the critical load was 0 x inf = NaN; P* lost its value the same way.
+#[test]
+fn critical_load_with_radii_whose_sum_overflows() {
+    let s = Scene::new(f64::MAX, f64::MAX, f64::from_bits(1), 0.3, f64::MAX).unwrap();
+    for phi in [0.0, 1e-3, 1.0] {
+        for load in [0.0, 1.0, 1e300] {
+            let e = reference::elliptic(&s, load, phi).unwrap();
+            assert_no_nan_elliptic(&e);
+            assert_no_nan_line(&reference::line(&s, load, phi).unwrap());
+        }
+    }
+    // P* = 2 P / ((1 - nu)^2 G (R1 + R2) sqrt(R1 R2)) is a normal number here.
+    let e = reference::elliptic(&s, 1.0, 1e-3).unwrap();
+    let want = 1.0 / (0.49 * (f64::from_bits(1) * f64::MAX) * f64::MAX);
+    assert!(
+        want > 1e-294 && (e.pstar / want - 1.0).abs() < 1e-12,
+        "{} {want}",
+        e.pstar
+    );
+}
