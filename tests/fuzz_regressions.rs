@@ -1,7 +1,9 @@
 //! Inputs that `cargo xtask fuzz` found, kept as regression tests.
 
+use misalign::fixed::{FixedEllipticScene, FixedEstimate, FixedLineScene, Log2, exact_lsb};
 use misalign::float::EllipticScene;
-use misalign::{Scene, reference};
+use misalign::reference::Regime;
+use misalign::{Error, Scene, reference};
 
 /// Fuzz (reference): an absurd but valid scene (G = 1e-308 Pa, mu = 1e-312, R ~ 1e-311 m)
 /// made line contact's d/b inf * 0 = NaN; products now carry their exponents apart.
@@ -136,8 +138,6 @@ fn axial_force_ratio_never_exceeds_one() {
 // Issue 14: an adversarial probe's crafted inputs (extreme but accepted scenes, LSBs
 // that leave no angle but 0, loads whose mu P leaves the number format).
 
-use misalign::Error;
-
 /// Every f64 field of an elliptic result is a number (infinities where documented).
 fn assert_no_nan_elliptic(e: &reference::Elliptic) {
     let s = e.shape;
@@ -230,4 +230,151 @@ fn critical_load_with_radii_whose_sum_overflows() {
         "{} {want}",
         e.pstar
     );
+}
+
+/// Issue 14 (1): an angle LSB with c x LSB above pi/2 left no angle count but 0
+/// (angle_max = 0), and `log2 theta0 - log2(c LSB)` overflowed i32: with overflow
+/// checks a panic, without them a margin of i32::MAX counts where the true one is 0.
+/// Such an LSB is now refused when the scene is prepared.
+#[test]
+fn fixed_angle_lsb_above_a_right_angle_is_refused() {
+    let s = Scene::new(1e10, 1e10, 1.0, 1e-300, 0.3).unwrap();
+    match FixedEllipticScene::new(&s, 1e-6, 1e30) {
+        Err(e) => assert_eq!(e, Error::OutOfRange),
+        Ok(core) => panic!(
+            "accepted with {:?}: {:?}",
+            core.input_range(),
+            core.estimate(1000, 0)
+        ),
+    }
+    assert_eq!(
+        FixedLineScene::new(&s, 1e-6, 1e30).err(),
+        Some(Error::OutOfRange)
+    );
+    // The largest LSB that still has an angle count of 1 in range is accepted.
+    let core = FixedEllipticScene::new(&s, 1e-6, 1.5).unwrap();
+    assert_eq!(core.input_range().angle_max, 1);
+    let e = core.estimate(1000, 1).unwrap();
+    assert!(e.margin.is_none_or(|m| m.abs() <= 2), "{e:?}");
+}
+
+/// Issue 14 (4): in the fixed-point core mu P above 2^127 N saturated F to
+/// `Log2::INFINITY`. A scene whose largest load count would do so is refused.
+#[test]
+fn fixed_axial_force_beyond_the_log2_range_is_refused() {
+    let s = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
+    // mu x load LSB x 2^32 = 2^128 N.
+    let lsb = 2f64.powi(96) / 0.3;
+    for core in [
+        FixedEllipticScene::new(&s, lsb, 1e-6).map(|c| c.estimate(u32::MAX, 1000)),
+        FixedLineScene::new(&s, lsb, 1e-6).map(|c| c.estimate(u32::MAX, 1000)),
+    ] {
+        match core {
+            Err(e) => assert_eq!(e, Error::OutOfRange),
+            Ok(Err(e)) => assert_eq!(e, Error::OutOfRange),
+            Ok(Ok(e)) => assert!(e.axial_force != Log2::INFINITY, "{e:?}"),
+        }
+    }
+}
+
+/// Issue 14 (5): in gross slip the fixed-point F exceeded mu P by up to 3.8e-8
+/// relative (a quarter of realistic rows; this one gave 300.0000050 N for mu P = 300 N).
+#[test]
+fn fixed_axial_force_never_exceeds_mu_p() {
+    let s = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
+    let mu = s.friction();
+    let (load_lsb, p) = exact_lsb(1000.0, 1 << 30, 0.0);
+    let (angle_lsb, a) = exact_lsb(1.0, 1 << 30, FixedEllipticScene::min_angle_lsb(&s));
+    let core = FixedEllipticScene::new(&s, load_lsb, angle_lsb).unwrap();
+    let e = core.estimate(p, a as i32).unwrap();
+    assert_eq!(e.regime, Regime::Gross);
+    let f = e.axial_force.to_f64();
+    assert!(f <= mu * 1000.0 && f > mu * 1000.0 * (1.0 - 1e-6), "{f}");
+    // Every load count's octave and fraction, both models, partial and gross slip.
+    let line = FixedLineScene::new(&s, 1.0, 1e-7).unwrap();
+    let elliptic = FixedEllipticScene::new(&s, 1.0, 1e-7).unwrap();
+    let mut worst: f64 = 0.0;
+    for k in 0..32 {
+        for frac in [0u32, 1, 0x1234_5678, 0x7fff_ffff, 0xffff_ffff] {
+            let load = (1u32 << k) | (frac >> (32 - k.max(1)));
+            for angle in [1, 1000, 100_000, 10_000_000, -15_000_000] {
+                for est in [line.estimate(load, angle), elliptic.estimate(load, angle)] {
+                    let Ok(est) = est else { continue };
+                    let ratio = est.axial_force.to_f64() / (mu * load as f64);
+                    worst = worst.max(ratio);
+                }
+            }
+        }
+    }
+    assert!(worst <= 1.0, "F / (mu P) up to {worst}");
+}
+
+/// One fixed-point scene's estimator.
+type Estimator = Box<dyn Fn(u32, i32) -> Result<FixedEstimate, Error>>;
+
+/// Issue 14 (1, 4): over extreme but accepted scenes and LSBs, every fixed-point answer
+/// at a load above 0 holds its values: no d/b, F or phi0 saturated to the values that
+/// stand for 0 or infinity (F was 2^-128 = `Log2::ZERO` at a misalignment for mu = 1e-10,
+/// G = 1e-38 Pa), and no sum wraps (the tests build with overflow checks).
+#[test]
+fn fixed_results_fit_over_extreme_scenes() {
+    let extremes = [1e-30, 0.05, 1e30, 1e300];
+    let mut accepted = 0;
+    for r in extremes {
+        for g in [1e-38, 79.3e9, 1e38, 1e300] {
+            for mu in [1e-10, 0.3, 1e10, 1e30] {
+                let s = Scene::new(r, r, g, 0.3, mu).unwrap();
+                for (lp, la) in (-100..=99)
+                    .step_by(20)
+                    .flat_map(|lp| [-60, -40, -20, 0, 1].map(|la| (lp, la)))
+                {
+                    let (load_lsb, angle_lsb) = (2f64.powi(lp), 2f64.powi(la));
+                    let elliptic = FixedEllipticScene::new(&s, load_lsb, angle_lsb);
+                    let line = FixedLineScene::new(&s, load_lsb, angle_lsb);
+                    for (model, range, estimate) in [
+                        elliptic.map(|c| (c.input_range(), c)).ok().map(|(r, c)| {
+                            (
+                                "elliptic",
+                                r,
+                                Box::new(move |p, a| c.estimate(p, a)) as Estimator,
+                            )
+                        }),
+                        line.map(|c| (c.input_range(), c)).ok().map(|(r, c)| {
+                            (
+                                "line",
+                                r,
+                                Box::new(move |p, a| c.estimate(p, a)) as Estimator,
+                            )
+                        }),
+                    ]
+                    .into_iter()
+                    .flatten()
+                    {
+                        accepted += 1;
+                        let angle_max = range.angle_max.min(i32::MAX as u32) as i32;
+                        for load in [range.load_min.max(1), 1000, u32::MAX] {
+                            for angle in [0, 1, -1, angle_max / 2, angle_max] {
+                                let Ok(e) = estimate(load, angle) else {
+                                    continue;
+                                };
+                                let what = format!(
+                                    "{model} R {r} G {g} mu {mu} LSBs 2^{lp} 2^{la} P {load} a {angle}: {e:?}"
+                                );
+                                let special = [Log2::ZERO, Log2::INFINITY];
+                                assert!(
+                                    !special.contains(&e.critical_angle.unwrap_or(Log2(0))),
+                                    "{what}"
+                                );
+                                if angle != 0 {
+                                    assert!(!special.contains(&e.slip_ratio), "{what}");
+                                    assert!(!special.contains(&e.axial_force), "{what}");
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(accepted > 100, "{accepted}");
 }
