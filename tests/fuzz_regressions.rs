@@ -1,7 +1,7 @@
 //! Inputs that `cargo xtask fuzz` found, kept as regression tests.
 
 use misalign::fixed::{FixedEllipticScene, FixedEstimate, FixedLineScene, Log2, exact_lsb};
-use misalign::float::EllipticScene;
+use misalign::float::{EllipticScene, LineScene};
 use misalign::reference::Regime;
 use misalign::{Error, Scene, reference};
 
@@ -377,4 +377,115 @@ fn fixed_results_fit_over_extreme_scenes() {
         }
     }
     assert!(accepted > 100, "{accepted}");
+}
+
+/// Issue 14 (4): mu = 1e10 and P = 1e38 N gave F = inf in the f32 core (rollers of
+/// 1e15 m, where d/b is not small); it is refused with a typed error where mu P does
+/// not fit f32 (scene or sample), never an infinity.
+#[test]
+fn f32_axial_force_that_overflows_is_refused() {
+    let s = Scene::new(1e15, 1e15, 79.3e9, 0.3, 1e10).unwrap();
+    if let Ok(core) = EllipticScene::new(&s) {
+        let got = core.estimate(1e38, 1.0);
+        assert!(
+            got.is_err_and(|e| e == Error::OutOfRange)
+                || got.is_ok_and(|e| e.axial_force.is_finite()),
+            "{got:?}"
+        );
+    }
+    if let Ok(core) = LineScene::new(&s) {
+        let got = core.estimate(1e38, 1e-3);
+        assert!(
+            got.is_err_and(|e| e == Error::OutOfRange)
+                || got.is_ok_and(|e| e.axial_force.is_finite()),
+            "{got:?}"
+        );
+    }
+}
+
+/// Issue 14 (4): G = 1e-38 Pa and P = 1e38 N/m gave a line-contact phi0 = inf in f32
+/// (a roller of 0.1 mm on a plane).
+#[test]
+fn f32_line_critical_angle_that_overflows_is_refused() {
+    let s = Scene::new(1e-4, f64::INFINITY, 1e-38, 0.3, 0.3).unwrap();
+    if let Ok(core) = LineScene::new(&s) {
+        let got = core.estimate(1e38, 1e-3);
+        assert!(
+            got.is_err_and(|e| e == Error::OutOfRange)
+                || got.is_ok_and(|e| e.critical_angle.is_some_and(f32::is_finite)),
+            "{got:?}"
+        );
+    }
+}
+
+/// Issue 14 (4): phi0 underflowed to 0 at a load above 0 in the f32 cores (a light load
+/// with a small critical gain); 0 is the answer for zero load only.
+#[test]
+fn f32_critical_angle_never_underflows_to_zero_at_a_load() {
+    for mu in [1e-30, 1e-12, 1e-6, 0.3] {
+        let s = Scene::new(0.05, 0.05, 79.3e9, 0.3, mu).unwrap();
+        for load in [f32::from_bits(1), 1e-40, 1e-30, 1e-20, 1.0] {
+            for phi in [0.0, 1e-3] {
+                if let Ok(core) = EllipticScene::new(&s)
+                    && let Ok(e) = core.estimate(load, phi)
+                {
+                    assert!(
+                        e.critical_angle.is_none_or(|c| c > 0.0 && c.is_finite()),
+                        "elliptic mu {mu} P {load}: {e:?}"
+                    );
+                }
+                if let Ok(core) = LineScene::new(&s)
+                    && let Ok(e) = core.estimate(load, phi)
+                {
+                    assert!(
+                        e.critical_angle.is_some_and(|c| c > 0.0 && c.is_finite()),
+                        "line mu {mu} P {load}: {e:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Issue 14 (4): over extreme but accepted scenes, every f32 answer at a load above 0
+/// is finite, with |F| <= mu P and a normal phi0 (line phi0 was inf for R = 1e-30 m,
+/// G = 1e-38 Pa, mu = 1e-10, P = 1e38 N/m).
+#[test]
+fn f32_results_fit_over_extreme_scenes() {
+    let mut accepted = 0;
+    for r in [1e-30, 0.05, 1e30, 1e300] {
+        for g in [1e-38, 79.3e9, 1e38, 1e300] {
+            for mu in [1e-30, 1e-10, 0.3, 100.0, 1e10, 1e30] {
+                let s = Scene::new(r, r, g, 0.3, mu).unwrap();
+                let (e, l) = (EllipticScene::new(&s), LineScene::new(&s));
+                accepted += e.is_ok() as usize + l.is_ok() as usize;
+                for p in [f32::from_bits(1), 1e-38, 1e-3, 1e20, 1e38, f32::MAX] {
+                    for phi in [1e-30f32, 1e-3, -1.0, 1.5] {
+                        let answers = [
+                            e.as_ref().ok().map(|c| ("elliptic", c.estimate(p, phi))),
+                            l.as_ref().ok().map(|c| ("line", c.estimate(p, phi))),
+                        ];
+                        for (model, answer) in answers.into_iter().flatten() {
+                            let Ok(x) = answer else { continue };
+                            let what =
+                                format!("{model} R {r} G {g} mu {mu} P {p} phi {phi}: {x:?}");
+                            assert!(x.slip_ratio.is_finite() && x.slip_ratio >= 0.0, "{what}");
+                            let mu_p = s.friction() * p as f64;
+                            assert!(
+                                (x.axial_force.abs() as f64) <= mu_p * (1.0 + 1e-6),
+                                "{what}"
+                            );
+                            assert!(x.critical_angle.is_none_or(|c| c.is_normal()), "{what}");
+                            assert!(x.margin.is_none_or(f32::is_finite), "{what}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(accepted > 50, "{accepted}");
+    // A realistic scene accepts every positive f32 load.
+    let steel = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
+    let range = LineScene::new(&steel).unwrap().load_range();
+    assert_eq!(range, (f32::from_bits(1), f32::MAX));
 }
