@@ -106,21 +106,21 @@ impl FixedEllipticScene {
     /// table values (|log2| < 42) to constants (|log2| < 100) and counts (< 32) and stay
     /// inside i32 by construction.
     fn check_sums(&self) -> Result<(), Error> {
-        let one = ONE as i64;
-        let lp_min = log2_u32(self.range.load_min) as i64; // load_min >= 1
-        let lp_max = 32 * one;
+        let one = ONE as f64;
+        let lp_min = log2_u32(self.range.load_min) as f64; // load_min >= 1
+        let lp_max = 32.0 * one;
         // g from one angle count up to g(pi/2) = pi/2; one octave for the tables' error.
-        let g_min = lookup(LOG_G_LOW, LOG_G_HIGH, self.log_theta_lsb)? as i64 - one;
-        let g_max = LOG2_HALF_PI as i64 + one;
-        let slip = self.log_slip as i64;
-        let slip_min = slip + g_min - lp_max / 3;
-        let slip_max = slip + g_max - lp_min / 3;
+        let g_min = lookup(LOG_G_LOW, LOG_G_HIGH, self.log_theta_lsb)? as f64 - one;
+        let g_max = LOG2_HALF_PI as f64 + one;
+        let slip = self.log_slip as f64;
+        let slip_min = slip + g_min - lp_max / 3.0;
+        let slip_max = slip + g_max - lp_min / 3.0;
         output_range(slip_min, slip_max)?;
         // F / (mu P) = s r(s), log2 r in [0, 1.25] (eq 21), one octave for the table:
         // F grows like P^(2/3) in partial slip and like P in gross slip.
-        let force = self.log_force as i64;
-        let partial_min = force + slip + g_min + lp_min - lp_min / 3 - one;
-        output_range(i64::min(partial_min, force + lp_min), force + lp_max)
+        let force = self.log_force as f64;
+        let partial_min = force + slip + g_min + lp_min - lp_min / 3.0 - one;
+        output_range(f64::min(partial_min, force + lp_min), force + lp_max)
     }
 
     /// The finest angle LSB (rad) this scene accepts: one count must give theta >= 2^-40,
@@ -243,16 +243,19 @@ impl FixedEllipticScene {
         let (log_a, log_b, log_p0) = if load == 0 {
             (Log2::ZERO, Log2::ZERO, Log2::ZERO)
         } else {
-            // a, b and p0 may leave the Q8.24 range where d/b and F do not: in i64,
-            // then a typed error for a result that does not fit.
-            let lp = log2_u32(load) as i64;
-            let log_l = self.log_hertz as i64 + div3(lp as i32) as i64;
-            let (la, lb) = (log_m as i64 + log_l, log_n as i64 + log_l);
-            (
-                log2_result(la)?,
-                log2_result(lb)?,
-                log2_result(self.log_pressure as i64 + lp - la - lb)?,
-            )
+            // a, b and p0 may leave the Q8.24 range where d/b and F do not: in i64
+            // (sums of five i32 at most: no wrap), then a typed error for a result
+            // that does not fit.
+            let lp = log2_u32(load);
+            let wide = |x: i32| x as i64;
+            let log_l = wide(self.log_hertz).wrapping_add(wide(div3(lp)));
+            let la = wide(log_m).wrapping_add(log_l);
+            let lb = wide(log_n).wrapping_add(log_l);
+            let lp0 = wide(self.log_pressure)
+                .wrapping_add(wide(lp))
+                .wrapping_sub(la)
+                .wrapping_sub(lb);
+            (log2_result(la)?, log2_result(lb)?, log2_result(lp0)?)
         };
         Ok(FixedDetails {
             theta: Log2(y),

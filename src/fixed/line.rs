@@ -70,18 +70,18 @@ impl FixedLineScene {
     /// Bounds every per-sample sum of [`FixedLineScene::estimate`] over the declared
     /// range (loads of 1 to 2^32 counts, angles of 1 to `angle_max` counts), in i64.
     fn check_sums(&self) -> Result<(), Error> {
-        let one = ONE as i64;
-        let half_lp_max = 16 * one;
-        let la_max = log2_u32(self.range.angle_max) as i64 + one;
+        let one = ONE as f64;
+        let half_lp_max = 16.0 * one;
+        let la_max = log2_u32(self.range.angle_max) as f64 + one;
         // phi0 in counts (eq 28), what the margin is formed from.
-        let critical = self.log_critical as i64 - self.log_angle_lsb as i64;
+        let critical = self.log_critical as f64 - self.log_angle_lsb as f64;
         output_range(critical, critical + half_lp_max)?;
         // d/b (eq 23): |phi| / sqrt(P).
-        let slip = self.log_slip as i64;
+        let slip = self.log_slip as f64;
         output_range(slip - half_lp_max, slip + la_max)?;
         // F = mu P s (2 - s) grows like sqrt(P) in partial slip (eq 27), like P beyond.
-        let force = self.log_force as i64;
-        output_range(i64::min(force + slip, force), force + 32 * one)
+        let force = self.log_force as f64;
+        output_range(f64::min(force + slip, force), force + 32.0 * one)
     }
 
     /// The same scene with another d/b threshold (> 0) for the risk flag.
@@ -127,9 +127,10 @@ impl FixedLineScene {
             .wrapping_sub(half_lp); // eq (23)
         // F / (mu P) = s (2 - s) below s = 1 (eq 27), 1 above (eq 29); never above 1.
         let (regime, log_ratio) = if ls < 0 {
-            let s = exp2_fixed(ls, 24); // Q0.24, below 2^24
-            // log2(2 - s) in [0, 1]: (2 - s) in Q0.24 is 2^24 .. 2^25.
-            let log_two_minus_s = log2_u32((2 << 24) - s).wrapping_sub(24 << 24);
+            let s = exp2_fixed(ls, 24); // Q0.24, below 2^24 (ls < 0)
+            // log2(2 - s) in [0, 1]: (2 - s) in Q0.24 is 2^24 .. 2^25, no wrap.
+            let two_minus_s = (2u32 << 24).wrapping_sub(s);
+            let log_two_minus_s = log2_u32(two_minus_s).wrapping_sub(24 << 24);
             (Regime::Partial, ls.wrapping_add(log_two_minus_s).min(0))
         } else {
             (Regime::Gross, 0)

@@ -28,22 +28,25 @@ pub fn log2_u32(x: u32) -> i32 {
     let lz = x.leading_zeros();
     // The bits below the leading one, as a Q0.32 fraction, then Q8.24.
     let fraction = ((x << lz) << 1) >> 8;
-    // The table covers [0, 1): the default is never taken.
+    // The table covers [0, 1): the default is never taken. The octave (lz <= 31 for
+    // x > 0) plus a mantissa in [0, 2^24] stays below 2^29: no wrap.
     let mantissa = LOG2_MANTISSA.eval(fraction as i32).unwrap_or_default();
-    ((31 - lz as i32) << 24) + mantissa
+    ((31 - lz as i32) << 24).wrapping_add(mantissa)
 }
 
 /// `x / 3` for non-negative x, exactly, by shifts (a Cortex-M0 has no divider).
 #[inline(always)]
 pub fn div3(x: i32) -> i32 {
     let x = x as u32;
-    // Hacker's Delight divu3: q ~ x * 0.010101...b, then one correction.
-    let mut q = (x >> 2) + (x >> 4);
-    q += q >> 4;
-    q += q >> 8;
-    q += q >> 16;
-    let r = x - q * 3;
-    (q + ((11 * r) >> 5)) as i32
+    // Hacker's Delight divu3: q ~ x * 0.010101...b, then one correction. The partial
+    // sums only truncate, so q <= x / 3 and r = x - 3q is small and non-negative: no
+    // operation wraps (the wrapping forms only drop the overflow checks).
+    let mut q = (x >> 2).wrapping_add(x >> 4);
+    q = q.wrapping_add(q >> 4);
+    q = q.wrapping_add(q >> 8);
+    q = q.wrapping_add(q >> 16);
+    let r = x.wrapping_sub(q.wrapping_mul(3));
+    q.wrapping_add(r.wrapping_mul(11) >> 5) as i32
 }
 
 /// `2^l` (l in Q8.24) as an unsigned fixed-point number with `frac_bits` fraction
@@ -58,7 +61,8 @@ pub fn exp2_fixed(l: i32, frac_bits: u32) -> u32 {
         Some(v) => v as u32, // 2^f in Q8.24, in [2^24, 2^25)
         None => ONE as u32,  // unreachable: the table covers [0, 1)
     };
-    let shift = k + frac_bits as i32 - 24;
+    // k in [-128, 127]; frac_bits beyond 2^8 saturates like any large shift.
+    let shift = k.wrapping_add(frac_bits.min(256) as i32).wrapping_sub(24);
     if shift >= 7 {
         u32::MAX
     } else if shift >= 0 {

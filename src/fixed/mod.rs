@@ -146,27 +146,33 @@ fn constant(x: f64) -> Result<i32, Error> {
 fn constant_below(x: f64) -> Result<i32, Error> {
     constant(x)?;
     let l = libm::floor(libm::log2(x) * ONE as f64) as i32;
-    Ok(l - 1)
+    Ok(l.saturating_sub(1))
 }
 
 /// The largest |log2| (Q8.24) of a per-sample result: one octave inside what
 /// [`Log2::from_f64`] accepts, and far from the values that stand for 0 and infinity.
 const LOG2_RESULT_LIMIT: i64 = 126 << 24;
 
-/// [`Error::OutOfRange`] unless the bounds `lo..=hi` of a per-sample log2 (worked
-/// out in i64 when a scene is prepared) lie within [`LOG2_RESULT_LIMIT`]. A scene that
-/// passes adds its per-sample logarithms with wrapping (never wrapping) arithmetic,
-/// and none of its results stands for 0 or infinity at a load above 0.
-fn output_range(lo: i64, hi: i64) -> Result<(), Error> {
-    if -LOG2_RESULT_LIMIT <= lo && hi <= LOG2_RESULT_LIMIT {
+/// [`Error::OutOfRange`] unless the bounds `lo..=hi` of a per-sample log2 (Q8.24, worked
+/// out in f64, exact for these integers, when a scene is prepared) lie within
+/// [`LOG2_RESULT_LIMIT`]. A scene that passes adds its per-sample logarithms with
+/// wrapping (never wrapping) arithmetic, and none of its results stands for 0 or
+/// infinity at a load above 0.
+fn output_range(lo: f64, hi: f64) -> Result<(), Error> {
+    let limit = LOG2_RESULT_LIMIT as f64;
+    if -limit <= lo && hi <= limit {
         Ok(())
     } else {
         Err(Error::OutOfRange)
     }
 }
 
-/// A log2 in i64 (the `details` sums) as [`Log2`], within [`LOG2_RESULT_LIMIT`].
+/// A log2 in i64 (the `details` sums of a few i32, which cannot wrap i64) as [`Log2`],
+/// within [`LOG2_RESULT_LIMIT`].
 fn log2_result(x: i64) -> Result<Log2, Error> {
-    output_range(x, x)?;
-    Ok(Log2(x as i32))
+    if x.unsigned_abs() <= LOG2_RESULT_LIMIT as u64 {
+        Ok(Log2(x as i32))
+    } else {
+        Err(Error::OutOfRange)
+    }
 }

@@ -160,7 +160,7 @@ fn square(x: f64) -> f64 {
 fn f32_above(x: f64) -> f32 {
     let y = x as f32;
     if (y as f64) < x {
-        f32::from_bits(y.to_bits() + 1)
+        y.next_up()
     } else if y.is_infinite() {
         f32::MAX
     } else {
@@ -174,7 +174,7 @@ fn f32_below(x: f64) -> f32 {
     if y.is_infinite() {
         f32::MAX
     } else if (y as f64) > x {
-        f32::from_bits(y.to_bits() - 1)
+        y.next_down()
     } else {
         y
     }
