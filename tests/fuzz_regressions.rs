@@ -259,15 +259,17 @@ fn fixed_angle_lsb_above_a_right_angle_is_refused() {
 }
 
 /// Issue 14 (4): in the fixed-point core mu P above 2^127 N saturated F to
-/// `Log2::INFINITY`. A scene whose largest load count would do so is refused.
+/// `Log2::INFINITY` (here in gross slip of line contact: R = 1e-30 m, G = 1e90 Pa,
+/// mu = 1e-10, mu x load LSB x 2^32 = 2^130 N). A scene whose largest load count would
+/// do so is refused.
 #[test]
 fn fixed_axial_force_beyond_the_log2_range_is_refused() {
-    let s = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
-    // mu x load LSB x 2^32 = 2^128 N.
-    let lsb = 2f64.powi(96) / 0.3;
+    let s = Scene::new(1e-30, 1e-30, 1e90, 0.3, 1e-10).unwrap();
+    let lsb = 2f64.powi(98) / 1e-10;
+    let angle_lsb = 2f64.powi(-40);
     for core in [
-        FixedEllipticScene::new(&s, lsb, 1e-6).map(|c| c.estimate(u32::MAX, 1000)),
-        FixedLineScene::new(&s, lsb, 1e-6).map(|c| c.estimate(u32::MAX, 1000)),
+        FixedEllipticScene::new(&s, lsb, angle_lsb).map(|c| c.estimate(u32::MAX, 1)),
+        FixedLineScene::new(&s, lsb, angle_lsb).map(|c| c.estimate(u32::MAX, 1)),
     ] {
         match core {
             Err(e) => assert_eq!(e, Error::OutOfRange),
@@ -488,4 +490,19 @@ fn f32_results_fit_over_extreme_scenes() {
     let steel = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
     let range = LineScene::new(&steel).unwrap().load_range();
     assert_eq!(range, (f32::from_bits(1), f32::MAX));
+}
+
+/// Issue 14 (8), the structured fuzzer from an empty corpus: `Log2::to_fixed` with a
+/// fraction-bit count above 2^31 overflowed i32 (a panic with overflow checks). It
+/// saturates like any other result beyond u32.
+#[test]
+fn log2_to_fixed_with_a_huge_fraction_bit_count() {
+    for bits in [40, 1 << 31, u32::MAX] {
+        assert_eq!(Log2(0).to_fixed(bits), u32::MAX, "{bits}");
+    }
+    // 2^-120 with 2^31 fraction bits is still far beyond u32; with 40 it is 0.
+    assert_eq!(Log2(-(120 << 24)).to_fixed(1 << 31), u32::MAX);
+    assert_eq!(Log2(-(120 << 24)).to_fixed(40), 0);
+    assert_eq!(Log2::ZERO.to_fixed(u32::MAX), 0);
+    assert_eq!(Log2(0).to_fixed(0), 1);
 }
