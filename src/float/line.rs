@@ -80,7 +80,7 @@ impl LineScene {
 
     /// The loads (N/m, or N with a length) [`LineScene::estimate`] accepts besides 0:
     /// those at which d/b, F and phi0 are finite and phi0 is a normal f32. For a
-    /// realistic scene, every positive f32 load but the subnormal ones.
+    /// realistic scene, every positive f32 load, subnormal ones included.
     pub fn load_range(&self) -> (f32, f32) {
         (
             f32::from_bits(self.load_min_bits),
