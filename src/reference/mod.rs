@@ -260,6 +260,15 @@ impl Estimate {
     }
 }
 
+/// `d = min(d/b, 1) b` (m): 0 without slip even where b overflowed (0 x inf).
+fn slip_width(slip_ratio: f64, b: f64) -> f64 {
+    if slip_ratio == 0.0 {
+        0.0
+    } else {
+        libm::fmin(slip_ratio, 1.0) * b
+    }
+}
+
 fn check_sample(load: f64, phi: f64) -> Result<(), Error> {
     if !(load.is_finite() && load >= 0.0) {
         return Err(Error::Load);
@@ -406,11 +415,11 @@ pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
             1.0 - nu,
             1.0 - nu,
             g_mod,
-            r1 + r2,
+            tangential::half_sum(r1, r2),
             libm::sqrt(r1),
             libm::sqrt(r2),
         ],
-        &[2.0],
+        &[],
     );
     let axial_force = libm::copysign(mu * (load * tangential::axial_force_ratio(s)), phi);
     let critical = critical_angle(scene, load);
@@ -433,7 +442,7 @@ pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
         pstar,
         p0star,
         slip_ratio: s,
-        d: libm::fmin(s, 1.0) * b,
+        d: slip_width(s, b),
         regime: Regime::of(s),
         axial_force,
         critical_angle: critical.map(|c| c.0),
@@ -505,7 +514,7 @@ pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
         pstar: line::nondimensional_load(load, nu, g_mod, radius),
         p0star,
         slip_ratio: s,
-        d: libm::fmin(s, 1.0) * b,
+        d: slip_width(s, b),
         regime: Regime::of(s),
         axial_force: libm::copysign(mu * (load * line::axial_force_ratio(s)), phi),
         critical_angle,

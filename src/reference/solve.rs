@@ -21,7 +21,7 @@ pub(crate) fn increasing_root(
         hi_limit
     };
     let mut f_hi = f(hi);
-    let mut evaluations = 1;
+    let mut evaluations: usize = 1;
     // Grow upwards until f(hi) >= 0.
     while f_hi < 0.0 {
         if hi >= hi_limit {
@@ -29,7 +29,7 @@ pub(crate) fn increasing_root(
         }
         hi = libm::fmin(2.0 * hi, hi_limit);
         f_hi = f(hi);
-        evaluations += 1;
+        evaluations = evaluations.saturating_add(1); // at most ~2100 doublings of a double
     }
     if f_hi == 0.0 {
         return Some(hi);
@@ -45,7 +45,7 @@ pub(crate) fn increasing_root(
             return None;
         }
         f_lo = f(lo);
-        evaluations += 1;
+        evaluations = evaluations.saturating_add(1);
     }
     if f_lo.is_nan() || f_hi.is_nan() {
         return None;
