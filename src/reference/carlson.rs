@@ -73,16 +73,20 @@ fn series(dx: f64, dy: f64, scale: f64, a: f64) -> f64 {
 pub(crate) fn carlson_rd_pair(y: f64) -> (f64, f64) {
     #[cfg(test)]
     super::cost::count_rd_pair();
-    let (mut x, mut yv, mut z) = (0.0f64, y, 1.0f64);
     let a10 = (y + 3.0) / 5.0; // A0 of R_D(0, y, 1)
     let a20 = (1.0 + 3.0 * y) / 5.0; // A0 of R_D(0, 1, y)
-    let (mut a1, mut a2) = (a10, a20);
     let spread1 = libm::fmax(libm::fmax(a10, libm::fabs(a10 - y)), libm::fabs(a10 - 1.0));
     let spread2 = libm::fmax(libm::fmax(a20, libm::fabs(a20 - y)), libm::fabs(a20 - 1.0));
-    let (mut sum1, mut sum2) = (0.0, 0.0);
-    let mut scale = 1.0; // 4^-m
+    // The first duplication (always needed: the spreads are at least 0.4), at
+    // (0, y, 1): lambda = sqrt(y).
+    let sy = libm::sqrt(y);
+    let mut sum1 = 1.0 / (1.0 + sy);
+    let mut sum2 = 1.0 / (sy * (y + sy));
+    let mut scale = 0.25; // 4^-m
+    let (mut x, mut yv, mut z) = (sy * 0.25, (y + sy) * 0.25, (1.0 + sy) * 0.25);
+    let (mut a1, mut a2) = ((a10 + sy) * 0.25, (a20 + sy) * 0.25);
     // 40 duplications shrink any spread by 4^40; the cap only guards NaN input.
-    for _ in 0..40 {
+    for _ in 1..40 {
         if spread1 * scale < libm::fabs(a1) / 512.0 && spread2 * scale < libm::fabs(a2) / 512.0 {
             break;
         }

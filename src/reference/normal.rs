@@ -147,12 +147,23 @@ impl Point {
 /// `ln(x / target)` with the slope and error bound of `ln x`, as the solver wants it.
 fn log_ratio_sample<T>(x: f64, target: f64, slope: (f64, f64), at: T) -> Option<Sample<T>> {
     Some(Sample {
-        value: libm::log(x / target),
+        value: ln_ratio(x / target),
         slope: slope.0,
         slope_error: slope.1,
         curvature: 1.0,
         at,
     })
+}
+
+/// `ln r`; near the root, `r = 1 + u` with `|u| < 1e-3`, by its series to `u^4`
+/// (relative error below `u^4 / 5 < 2e-13`: it scales a Newton step, not the root).
+fn ln_ratio(r: f64) -> f64 {
+    let u = r - 1.0;
+    if libm::fabs(u) < 1e-3 {
+        u * (1.0 - u * (0.5 - u * (1.0 / 3.0 - 0.25 * u)))
+    } else {
+        libm::log(r)
+    }
 }
 
 /// The coefficient `c` of `tan^2(theta/2) = k'^2 Lam (1 + c k'^2)` at small k', with
@@ -165,8 +176,9 @@ fn small_kprime_c(lam: f64) -> f64 {
 
 /// Newton on `h(Lam) = Lam - a ln(Lam) - b(Lam) - m = 0` for `Lam = ln(4/k') - 1 > 1`
 /// (the small-k' expansions below), `b` a small correction whose slope is neglected;
-/// from `Lam ~ m + a ln m`, until the step is below 1e-7 (the next would be below
-/// 1e-14). `None` where `m` is too small for the expansions (k' > 0.3).
+/// from `Lam ~ m + a ln m`, until a step is below 1e-5: the error left is then about
+/// `(a / (2 Lam^2)) 1e-10 < 3e-12` (two steps from the start, each one logarithm).
+/// `None` where `m` is too small for the expansions (k' > 0.3).
 fn solve_lambda(a: f64, m: f64, b: impl Fn(f64) -> f64) -> Option<f64> {
     if m.is_nan() || m <= 1.5 {
         return None;
@@ -178,7 +190,7 @@ fn solve_lambda(a: f64, m: f64, b: impl Fn(f64) -> f64) -> Option<f64> {
         if lam.is_nan() || lam <= 1.0 {
             return None;
         }
-        if libm::fabs(step) < 1e-7 * lam {
+        if libm::fabs(step) < 1e-5 {
             break;
         }
     }
@@ -192,18 +204,29 @@ fn solve_lambda(a: f64, m: f64, b: impl Fn(f64) -> f64) -> Option<f64> {
 fn seed_for_tan_half_squared(t2: f64) -> f64 {
     let m = 2.0 * LN_2 - 1.0 - 0.5 * libm::log(t2);
     let correction = |lam: f64| t2 / lam * small_kprime_c(lam);
-    match solve_lambda(0.5, m, |lam| 0.5 * libm::log1p(correction(lam))) {
+    // ln(1 + x) by its series below 1e-3 (error below x^4/4 < 3e-13).
+    let log1p = |x: f64| {
+        if x < 1e-3 {
+            x * (1.0 - x * (0.5 - x / 3.0))
+        } else {
+            libm::log1p(x)
+        }
+    };
+    match solve_lambda(0.5, m, |lam| 0.5 * log1p(correction(lam))) {
         Some(lam) => libm::sqrt(t2 / (lam * (1.0 + correction(lam)))),
         None => libm::fmin(libm::sqrt(t2 / libm::fmax(m, 0.25)), 1.0),
     }
 }
+
+/// `(32 / pi^2)^(1/3)`, held by a test.
+const CBRT_32_OVER_PI_SQUARED: f64 = 1.480_073_936_614_712_4;
 
 /// A seed `k'` for `g = m n theta` (eqs 5-6): with E and tan(theta/2) to order k'^2,
 /// `ln g = ln c0 + (2/3) w + ln(Lam)/2 + k'^2 ((2/3)(L/2 - 1/4) + c/2 - Lam/3)`,
 /// `w = ln k' = ln 4 - 1 - Lam`, `c0 = (32/pi^2)^(1/3)`: solved for Lam with the
 /// correction's `k'^2` at leading order, `k' = (g / (c0 sqrt(Lam)))^(3/2)`.
 pub(crate) fn seed_for_g(g: f64) -> f64 {
-    let c0 = libm::cbrt(32.0 / (PI * PI));
+    let c0 = CBRT_32_OVER_PI_SQUARED;
     let leading = |lam: f64| {
         let q = g / (c0 * libm::sqrt(lam));
         q * q * q
@@ -241,7 +264,7 @@ pub(crate) fn kprime_for_mn_phi(
             let (ph, ph_slope, curvature) = phi(theta);
             let (theta_slope, error) = p.theta_slope(theta);
             Some(Sample {
-                value: libm::log(p.mn() * ph / target),
+                value: ln_ratio(p.mn() * ph / target),
                 slope: p.mn_slope() + ph_slope * theta_slope,
                 slope_error: error,
                 curvature,
@@ -368,8 +391,8 @@ pub fn ellipse_shape(theta: f64) -> Option<EllipseShape> {
             (r.x, p.rd1 + p.kprime * p.kprime * p.d * r.dw)
         },
     );
-    let s = libm::sin(0.5 * theta);
-    let m = libm::cbrt(2.0 * rd1 / (3.0 * PI * s * s));
+    // m from eq (5) with sin^2(theta/2) = t^2 / (1 + t^2).
+    let m = libm::cbrt(2.0 * rd1 * (1.0 + target) / (3.0 * PI * target));
     Some(EllipseShape {
         theta,
         kprime,
@@ -511,8 +534,9 @@ mod tests {
             let t = libm::tan(0.5 * theta);
             let by_t = seed_for_tan_half_squared(t * t) / exact.kprime - 1.0;
             let by_g = seed_for_g(exact.g()) / exact.kprime - 1.0;
-            // The neglected terms are O(k'^4 L^2), k' ~ theta / (2 sqrt(L - 1)).
-            let bound = 1e-14 + libm::pow(theta, 4.0);
+            // The neglected terms are O(k'^4 L^2), k' ~ theta / (2 sqrt(L - 1)); the
+            // iteration for Lam stops within 3e-12.
+            let bound = 1e-11 + libm::pow(theta, 4.0);
             assert!(by_t.abs() < bound, "theta={theta}: {by_t}");
             assert!(by_g.abs() < bound, "theta={theta}: {by_g}");
         }

@@ -97,8 +97,10 @@ pub(crate) fn log_newton<T: Copy>(
             f64::NAN
         };
         let next = x + x * libm::expm1(newton);
+        // The slope's and F's own relative errors (F's series, `ln_ratio`, 2e-13) scale
+        // the step alike.
         let predicted =
-            libm::fabs(newton) * (s.curvature * libm::fabs(newton) + s.slope_error + f64::EPSILON);
+            libm::fabs(newton) * (s.curvature * libm::fabs(newton) + s.slope_error + 2e-13);
         if predicted < ACCEPT || next == x {
             // The step's error is far below an ulp (or the step is): a root found at
             // `x` by noise in F may round `next` onto or past the bracket's end.
