@@ -37,6 +37,20 @@ fn scaled(num: &[f64], den: &[f64]) -> f64 {
     libm::ldexp(m, e)
 }
 
+/// `(num[0] ... / (den[0] ...))^(1/3)`, the product formed as [`chain`] forms it and its
+/// exponent divided by 3 exactly, so that a product beyond the f64 range whose cube
+/// root is inside it gives that root.
+pub(crate) fn chain_cbrt(num: &[f64], den: &[f64]) -> f64 {
+    match plain(num, den) {
+        Some(p) => libm::cbrt(p),
+        None => {
+            let (m, e) = parts(num, den);
+            let (q, r) = (e.div_euclid(3), e.rem_euclid(3));
+            libm::ldexp(libm::cbrt(libm::ldexp(m, r)), q)
+        }
+    }
+}
+
 /// The product as a mantissa in [0.5, 1) (or 0, inf, NaN) and a binary exponent.
 fn parts(num: &[f64], den: &[f64]) -> (f64, i32) {
     let mut m = 1.0f64;
@@ -93,5 +107,17 @@ mod tests {
             super::plain(&[1e200, tiny], &[7.0]),
             Some(super::scaled(&[1e200, tiny], &[7.0]))
         );
+    }
+
+    #[test]
+    fn cube_root_of_a_chain() {
+        // (1e300)^3 / 1 is beyond f64; its cube root is not.
+        let r = super::chain_cbrt(&[1e300, 1e300, 1e300], &[1.0]);
+        assert!((r / 1e300 - 1.0).abs() < 4e-16);
+        let r = super::chain_cbrt(&[1e-300, 1e-300], &[1e300, 8.0]);
+        assert!((r / 5e-301 - 1.0).abs() < 4e-16, "{r}");
+        assert_eq!(super::chain_cbrt(&[0.0, 2.0], &[1.0]), 0.0);
+        let r = super::chain_cbrt(&[3.0, 9.0], &[1.0]);
+        assert_eq!(r, libm::cbrt(27.0));
     }
 }

@@ -231,11 +231,17 @@ pub fn critical_angle(scene: &Scene, load: f64) -> Option<(f64, f64)> {
     if load == 0.0 {
         return Some((0.0, 0.0));
     }
-    let v = hertz_scale(scene);
-    // d/b = 1  <=>  m n |phi| = 3 mu P^(1/3) / (pi G v^2).
+    // d/b = 1  <=>  m n |phi| = 3 mu P^(1/3) / (pi G v^2), with G v^2 from hertz_scale:
+    // 3 mu / pi (P / (G h^2 R^2))^(1/3), h = 1.5 (1 - nu), one cube root.
+    let h = 1.5 * (1.0 - scene.poisson_ratio());
+    let r = scene.effective_radius();
     let target = chain::chain(
-        &[3.0, scene.friction(), libm::cbrt(load)],
-        &[PI, scene.shear_modulus(), v, v],
+        &[
+            3.0,
+            scene.friction(),
+            chain::chain_cbrt(&[load], &[scene.shear_modulus(), h, h, r, r]),
+        ],
+        &[PI],
     );
     let c = scene.radius_factor();
     if c == 0.0 {

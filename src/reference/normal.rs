@@ -137,6 +137,19 @@ impl Point {
         self.kprime * m * m
     }
 
+    /// `ln(m n q)`, by the cube `(m n q)^3 = (k' M)^2 (k' q^3)`, `M = m^3`, which needs
+    /// no cube root (its two factors stay in range for k' down to 1e-102 and
+    /// `q ~ 1/(m n)`), or by [`Point::mn`] where the cube leaves the normal range.
+    pub fn ln_mn_ratio(&self, q: f64) -> f64 {
+        let km = self.kprime * (2.0 * (self.rd1 + self.rd2) / (3.0 * PI));
+        let cube = km * km * (self.kprime * (q * q * q));
+        if cube.is_normal() {
+            ln_ratio(cube) / 3.0
+        } else {
+            ln_ratio(self.mn() * q)
+        }
+    }
+
     /// `d ln(m n) / d ln k' = 1 - (2/3)(R_D1 + 2 R_D2) / (R_D1 + R_D2)`: from the slopes
     /// above, `k' d(R_D1 + R_D2)/dk' = -k^2 D - 3 R_D2 = -(R_D1 + 2 R_D2)`.
     pub fn mn_slope(&self) -> f64 {
@@ -264,7 +277,7 @@ pub(crate) fn kprime_for_mn_phi(
             let (ph, ph_slope, curvature) = phi(theta);
             let (theta_slope, error) = p.theta_slope(theta);
             Some(Sample {
-                value: ln_ratio(p.mn() * ph / target),
+                value: p.ln_mn_ratio(ph / target),
                 slope: p.mn_slope() + ph_slope * theta_slope,
                 slope_error: error,
                 curvature,
