@@ -75,8 +75,9 @@ pub(crate) fn carlson_rd_pair(y: f64) -> (f64, f64) {
     super::cost::count_rd_pair();
     let a10 = (y + 3.0) / 5.0; // A0 of R_D(0, y, 1)
     let a20 = (1.0 + 3.0 * y) / 5.0; // A0 of R_D(0, 1, y)
-    let spread1 = libm::fmax(libm::fmax(a10, libm::fabs(a10 - y)), libm::fabs(a10 - 1.0));
-    let spread2 = libm::fmax(libm::fmax(a20, libm::fabs(a20 - y)), libm::fabs(a20 - 1.0));
+    // max |A0 - x0|: for y in (0, 1], A0 itself and max(A0, 1 - A0).
+    let spread1 = a10.max((a10 - y).abs()).max((a10 - 1.0).abs());
+    let spread2 = a20.max((a20 - y).abs()).max((a20 - 1.0).abs());
     // The first duplication (always needed: the spreads are at least 0.4), at
     // (0, y, 1): lambda = sqrt(y).
     let sy = libm::sqrt(y);
@@ -87,7 +88,7 @@ pub(crate) fn carlson_rd_pair(y: f64) -> (f64, f64) {
     let (mut a1, mut a2) = ((a10 + sy) * 0.25, (a20 + sy) * 0.25);
     // 40 duplications shrink any spread by 4^40; the cap only guards NaN input.
     for _ in 1..40 {
-        if spread1 * scale < libm::fabs(a1) / 512.0 && spread2 * scale < libm::fabs(a2) / 512.0 {
+        if spread1 * scale < a1.abs() / 512.0 && spread2 * scale < a2.abs() / 512.0 {
             break;
         }
         let (sx, sy, sz) = (libm::sqrt(x), libm::sqrt(yv), libm::sqrt(z));
