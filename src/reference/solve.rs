@@ -12,8 +12,8 @@
 //! carries its quantities over the step to first order (their second-order error is
 //! below `|dw|^2 < 1e-18`).
 
-/// Largest number of evaluations of one solve: a bisection of the bracket in `ln x`
-/// over the whole f64 range takes about 12; Newton from the seeds takes 1 to 4.
+/// Largest number of evaluations of one solve: bisecting `ln x` over the whole f64
+/// range down to an ulp takes about 64; Newton from the seeds takes 1 to 4.
 const MAX_EVALUATIONS: usize = 200;
 
 /// A step is taken without a further evaluation when its predicted error is below this.
@@ -103,9 +103,10 @@ pub(crate) fn log_newton<T: Copy>(
             libm::fabs(newton) * (s.curvature * libm::fabs(newton) + s.slope_error + 2e-13);
         if predicted < ACCEPT || next == x {
             // The step's error is far below an ulp (or the step is): a root found at
-            // `x` by noise in F may round `next` onto or past the bracket's end.
+            // `x` by noise in F may round `next` onto or past the bracket's end, kept
+            // at its upper end (k' <= 1).
             return Some(Root {
-                x: next,
+                x: next.min(hi),
                 dw: newton,
                 sample: s,
             });
