@@ -6,6 +6,8 @@
 
 mod carlson;
 mod chain;
+#[cfg(test)]
+mod cost;
 pub mod inverse;
 pub mod line;
 pub mod normal;
@@ -342,11 +344,19 @@ fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64
     if load == 0.0 {
         return Some((0.0, 0.0));
     }
-    let v = hertz_scale(scene);
-    // d/b = s  <=>  m n |phi| = 3 mu s P^(1/3) / (pi G v^2)  (eq 15).
+    // d/b = s  <=>  m n |phi| = 3 mu s P^(1/3) / (pi G v^2) (eq 15), with G v^2 from
+    // hertz_scale:
+    // 3 mu / pi (P / (G h^2 R^2))^(1/3), h = 1.5 (1 - nu), one cube root.
+    let h = 1.5 * (1.0 - scene.poisson_ratio());
+    let r = scene.effective_radius();
     let target = chain::chain(
-        &[3.0, scene.friction(), slip_ratio, libm::cbrt(load)],
-        &[PI, scene.shear_modulus(), v, v],
+        &[
+            3.0,
+            scene.friction(),
+            slip_ratio,
+            chain::chain_cbrt(&[load], &[scene.shear_modulus(), h, h, r, r]),
+        ],
+        &[PI],
     );
     let c = scene.radius_factor();
     if c == 0.0 {
@@ -361,19 +371,25 @@ fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64
         ThetaRelation::SmallAngle => FRAC_PI_2,
         ThetaRelation::Exact => libm::asin(c),
     };
-    let kprime_max = normal::ellipse_shape(theta_max)?.kprime;
-    let guess = normal::theta_for_g(libm::fmin(target * scene.radius_factor(), FRAC_PI_2))
-        .map_or(kprime_max, |s| libm::fmax(s.kprime, f64::MIN_POSITIVE));
-    let kprime = solve::increasing_root(
-        |k| {
-            let s = normal::shape_from_kprime(k);
-            s.mn() * phi_of_theta(scene, s.theta) - target
-        },
-        libm::fmin(guess, kprime_max),
-        0.0,
-        kprime_max,
-    )?;
-    let theta0 = libm::fmin(normal::shape_from_kprime(kprime).theta, theta_max);
+    // theta = pi/2 is k' = 1 (tan^2(theta/2) = 1, eqs 5-6).
+    let kprime_max = match scene.theta_relation() {
+        ThetaRelation::SmallAngle => 1.0,
+        ThetaRelation::Exact => normal::ellipse_shape(theta_max)?.kprime,
+    };
+    // d ln phi / d ln theta, and the curvature it adds (large where phi nears pi/2).
+    let phi = |theta: f64| match scene.theta_relation() {
+        ThetaRelation::SmallAngle => (theta / c, 1.0, 1.0),
+        ThetaRelation::Exact => {
+            let phi = phi_of_theta(scene, theta);
+            let cos_phi = libm::cos(phi);
+            let slope = theta * libm::cos(theta) / (c * cos_phi * phi);
+            (phi, slope, 1.0 + 1.0 / (cos_phi * cos_phi))
+        }
+    };
+    let seed = normal::seed_for_g(libm::fmin(target * c, FRAC_PI_2));
+    let (_, theta0) =
+        normal::kprime_for_mn_phi(target, phi, libm::fmin(seed, kprime_max), kprime_max)?;
+    let theta0 = libm::fmin(theta0, theta_max);
     Some((phi_of_theta(scene, theta0), theta0))
 }
 
