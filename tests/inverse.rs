@@ -479,6 +479,51 @@ fn float_bad_input() {
     );
 }
 
+/// Section 9 on a plane (issue 16's rule): line contact at every phi, P and F per unit
+/// length without a length, totals with one; both inverses through the model choice
+/// are the line inverses at the per-length values, and round-trip the forward answer.
+#[test]
+fn plane_estimates_are_line_contact() {
+    let plane = Scene::new(0.05, f64::INFINITY, 79.3e9, 0.3, 0.3).unwrap();
+    let placeholder_plane = placeholder(&plane);
+    for length in [None, Some(0.02)] {
+        let s = length.map_or(plane, |l| plane.with_length(l).unwrap());
+        let p = length.map_or(placeholder_plane, |l| {
+            placeholder_plane.with_length(l).unwrap()
+        });
+        let per = length.unwrap_or(1.0);
+        for (load, phi) in [(1e3, 1e-5), (1e3, 1e-4), (1e3, 1e-2), (1e5, 3e-4)] {
+            let est = reference::estimate(&s, load, phi).unwrap();
+            assert_eq!(est.model(), ContactModel::Line, "{length:?} {load} {phi}");
+            let force = est.axial_force(&s);
+            let mu = inverse::friction_estimate(&p, load, phi, force).unwrap();
+            assert_eq!(
+                mu,
+                inverse::friction_line(&p, load / per, phi, force / per).unwrap()
+            );
+            let Inverse::Exact { value, sensitivity } = mu else {
+                panic!("{length:?} {load} {phi}: {mu:?}");
+            };
+            assert!(rel_err(value, 0.3) <= REFERENCE_BOUND * sensitivity.max(1.0));
+            let angle = inverse::angle_estimate(&s, load, force).unwrap();
+            assert_eq!(
+                angle,
+                inverse::angle_line(&s, load / per, force / per).unwrap()
+            );
+            if est.slip_ratio() >= 1.0 {
+                let phi0 = est.critical_angle().unwrap();
+                assert_eq!(angle, Inverse::AtLeast { value: phi0 });
+                assert!(phi0 <= phi, "{angle:?}");
+            } else {
+                let Inverse::Exact { value, sensitivity } = angle else {
+                    panic!("{length:?} {load} {phi}: {angle:?}");
+                };
+                assert!(rel_err(value, phi) <= REFERENCE_BOUND * sensitivity.max(1.0));
+            }
+        }
+    }
+}
+
 #[test]
 fn bad_input() {
     let s = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();

@@ -551,15 +551,15 @@ fn angle_line_below(
 /// at that phi picks that model; see the module docs for two answers or none.
 ///
 /// # Errors
-/// As [`angle_elliptic`] and [`angle_line`]; [`Error::PlaneHasNoEllipse`] for a plane
-/// without length.
+/// As [`angle_elliptic`] and [`angle_line`].
 pub fn angle_estimate(scene: &Scene, load: f64, force: f64) -> Result<Inverse<f64>, Error> {
     check(load, 0.0, force)?;
-    let Some(length) = scene.length() else {
-        return angle_elliptic(scene, load, force);
-    };
-    let per_length = load / length;
-    if scene.is_plane() {
+    // A plane, or radii so unequal that c underflows, has a strip at every phi: line
+    // contact (section 8), P and F per unit length without a length, as
+    // [`super::estimate`] reads them.
+    if scene.is_plane() || scene.radius_factor() == 0.0 {
+        let length = scene.length().unwrap_or(1.0);
+        let per_length = load / length;
         let saturated = scene.friction() * (per_length * 1.0);
         if let Some(answer) = angle_trivial(load, force, 1.0) {
             return Ok(answer);
@@ -569,6 +569,11 @@ pub fn angle_estimate(scene: &Scene, load: f64, force: f64) -> Result<Inverse<f6
             force,
         ));
     }
+    // Without a length section 9 always takes the ellipse.
+    let Some(length) = scene.length() else {
+        return angle_elliptic(scene, load, force);
+    };
+    let per_length = load / length;
     if let Some(answer) = angle_trivial(load, force, 1.5) {
         // F = 0: phi = 0, where the ellipse is infinitely long: line contact, S = 1.
         return Ok(match answer {
