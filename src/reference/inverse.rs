@@ -596,11 +596,16 @@ pub fn angle_estimate(scene: &Scene, load: f64, force: f64) -> Result<Inverse<f6
     let picks = |phi: f64, model: ContactModel| {
         super::estimate(scene, load, phi).is_ok_and(|e| e.model() == model)
     };
-    // The largest phi (theta = pi/2, or phi = pi/2 for the exact relation): the ellipse
-    // is shortest there, so the elliptic model is chosen somewhere iff it is there.
+    // The largest phi the forward solution takes: below pi/2 (|phi| >= pi/2 is refused)
+    // and, for eq (4), at most theta = pi/2. The ellipse is shortest there, so the
+    // elliptic model is chosen somewhere iff it is there.
+    let below_right_angle = FRAC_PI_2 * (1.0 - f64::EPSILON);
     let phi_max = match scene.theta_relation() {
-        ThetaRelation::SmallAngle => FRAC_PI_2 / scene.radius_factor() * (1.0 - 4.0 * f64::EPSILON),
-        ThetaRelation::Exact => FRAC_PI_2,
+        ThetaRelation::SmallAngle => libm::fmin(
+            FRAC_PI_2 / scene.radius_factor() * (1.0 - 4.0 * f64::EPSILON),
+            below_right_angle,
+        ),
+        ThetaRelation::Exact => below_right_angle,
     };
     let line_ok = match line_answer {
         Inverse::Exact { value, .. } | Inverse::AtLeast { value } => {
