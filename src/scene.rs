@@ -39,7 +39,9 @@ impl Scene {
     /// # Errors
     /// A typed [`Error`] for non-finite or non-positive radii or modulus, nu outside
     /// [0, 0.5] (only 1 - nu enters the paper's equations, so incompressible rollers,
-    /// nu = 0.5, are fine), or mu not finite and positive.
+    /// nu = 0.5, are fine), or mu not finite and positive; [`Error::Radius`] also for radii
+    /// whose effective radius R1 R2 / (R1 + R2) (eq 31) is below the smallest f64 (both
+    /// radii under 1e-323 m), where every model would divide by 0.
     pub fn new(
         r1: f64,
         r2: f64,
@@ -48,6 +50,18 @@ impl Scene {
         friction: f64,
     ) -> Result<Self, Error> {
         if !(r1.is_finite() && r1 > 0.0) || r2.is_nan() || r2 <= 0.0 {
+            return Err(Error::Radius);
+        }
+        let scene = Self {
+            r1,
+            r2,
+            length: None,
+            shear_modulus,
+            poisson_ratio,
+            friction,
+            theta_relation: ThetaRelation::SmallAngle,
+        };
+        if scene.effective_radius() == 0.0 {
             return Err(Error::Radius);
         }
         if !(shear_modulus.is_finite() && shear_modulus > 0.0) {
@@ -59,15 +73,7 @@ impl Scene {
         if !(friction.is_finite() && friction > 0.0) {
             return Err(Error::Friction);
         }
-        Ok(Self {
-            r1,
-            r2,
-            length: None,
-            shear_modulus,
-            poisson_ratio,
-            friction,
-            theta_relation: ThetaRelation::SmallAngle,
-        })
+        Ok(scene)
     }
 
     /// The same scene with the rollers' contact length (m), which lets the model
@@ -123,7 +129,8 @@ impl Scene {
     }
 
     /// Effective radius `R = R1 R2 / (R1 + R2)` (eq 31); R1 for a plane. Formed as
-    /// `small / (1 + small/large)`, which neither overflows nor underflows.
+    /// `small / (1 + small/large)`, which does not overflow; it is never 0, since
+    /// [`Scene::new`] refuses radii whose R is below the smallest subnormal f64.
     pub fn effective_radius(&self) -> f64 {
         let (small, large) = if self.r1 <= self.r2 {
             (self.r1, self.r2)

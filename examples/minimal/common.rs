@@ -17,7 +17,8 @@ pub const LOAD_LSB: f64 = 1e-3;
 /// The fixed-point core's angle LSB in the minimal images (rad per count).
 pub const ANGLE_LSB: f64 = 1e-11;
 
-fn read<T: Copy>(x: &T) -> T {
+/// `*x` through a volatile read: the optimiser cannot know the value.
+pub fn read<T: Copy>(x: &T) -> T {
     // SAFETY: a reference is valid for a read.
     unsafe { core::ptr::read_volatile(x) }
 }

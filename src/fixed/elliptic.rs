@@ -3,8 +3,8 @@
 use super::logexp::{div3, exp2_fixed, log2_u32};
 use super::uniform::{ONE, UniformTable};
 use super::{
-    FixedEstimate, InputRange, LOG2_HALF_PI, Log2, Units, angle_max, constant, log_risk,
-    margin_counts,
+    FixedEstimate, InputRange, LOG2_HALF_PI, Log2, Units, angle_max, constant, constant_below,
+    log_risk, log2_result, margin_counts, output_range,
 };
 use crate::estimator::DEFAULT_RISK_SLIP_RATIO;
 use crate::reference::{Regime, hertz_scale};
@@ -46,7 +46,9 @@ impl FixedEllipticScene {
     /// # Errors
     /// [`Error::PlaneHasNoEllipse`], [`Error::Unsupported`] (exact theta relation), and
     /// [`Error::OutOfRange`] when the LSBs put the inputs outside the tables (an angle LSB
-    /// with c x LSB below 2^-40 rad, or a constant beyond the Q8.24 range).
+    /// with c x LSB below 2^-40 rad or above pi/2, which leaves no angle count but 0), a
+    /// constant beyond the Q8.24 range, or a sample in the declared range whose d/b or F
+    /// would lie outside 2^-126 .. 2^126 (d/b, N), where a Q8.24 log2 cannot hold it.
     pub fn new(scene: &Scene, load_lsb: f64, angle_lsb: f64) -> Result<Self, Error> {
         if scene.is_plane() {
             return Err(Error::PlaneHasNoEllipse);
@@ -61,6 +63,12 @@ impl FixedEllipticScene {
         let v = hertz_scale(scene);
         let slip_gain = PI * scene.shear_modulus() * v * v / (3.0 * scene.friction() * c);
         let cbrt_lsb = libm::cbrt(load_lsb);
+        // One count must give a theta on the tables: from 2^-40 up to pi/2 (eq 4), and
+        // a |phi| below pi/2.
+        let angle_counts = angle_max(angle_lsb);
+        if angle_counts == 0 {
+            return Err(Error::OutOfRange);
+        }
         let log_theta_lsb = constant(c * angle_lsb)?;
         if log_theta_lsb < LOG_G_LOW.start {
             return Err(Error::OutOfRange);
@@ -73,26 +81,52 @@ impl FixedEllipticScene {
         } else {
             libm::ceil(libm::exp2(3.0 * deficit))
         };
-        Ok(FixedEllipticScene {
+        let load_min = if load_min > u32::MAX as f64 {
+            u32::MAX
+        } else {
+            load_min as u32
+        };
+        let scene = FixedEllipticScene {
             log_theta_lsb,
             log_slip: constant(slip_gain / cbrt_lsb)?,
             log_critical,
             log_radius_factor: constant(c)?,
-            log_force: constant(scene.friction() * load_lsb)?,
+            log_force: constant_below(scene.friction() * load_lsb)?,
             log_risk: constant(DEFAULT_RISK_SLIP_RATIO as f64)?,
             log_hertz: constant(v * cbrt_lsb)?,
             log_pressure: constant(3.0 * load_lsb / (2.0 * PI))?,
             units: Units::new(load_lsb, angle_lsb)?,
             range: InputRange {
-                load_min: if load_min > u32::MAX as f64 {
-                    u32::MAX
-                } else {
-                    load_min as u32
-                },
+                load_min,
                 // |phi| < pi/2; then theta = c |phi| < pi/2 too (c <= 1).
-                angle_max: angle_max(angle_lsb),
+                angle_max: angle_counts,
             },
-        })
+        };
+        scene.check_sums()?;
+        Ok(scene)
+    }
+
+    /// Bounds every per-sample sum of [`FixedEllipticScene::estimate`] over the declared
+    /// range, in i64: d/b (eq 16) and F (eqs 21, 29) must lie within
+    /// [`super::LOG2_RESULT_LIMIT`]; the other sums (z, y, theta0 - theta LSB, phi0) add
+    /// table values (|log2| < 42) to constants (|log2| < 100) and counts (< 32) and stay
+    /// inside i32 by construction.
+    fn check_sums(&self) -> Result<(), Error> {
+        let one = ONE as f64;
+        let lp_min = log2_u32(self.range.load_min) as f64; // load_min >= 1
+        let lp_max = 32.0 * one;
+        // g from one angle count up to g(pi/2) = pi/2; one octave for the tables' error.
+        let g_min = lookup(LOG_G_LOW, LOG_G_HIGH, self.log_theta_lsb)? as f64 - one;
+        let g_max = LOG2_HALF_PI as f64 + one;
+        let slip = self.log_slip as f64;
+        let slip_min = slip + g_min - lp_max / 3.0;
+        let slip_max = slip + g_max - lp_min / 3.0;
+        output_range(slip_min, slip_max)?;
+        // F / (mu P) = s r(s), log2 r in [0, 1.25] (eq 21), one octave for the table:
+        // F grows like P^(2/3) in partial slip and like P in gross slip.
+        let force = self.log_force as f64;
+        let partial_min = force + slip + g_min + lp_min - lp_min / 3.0 - one;
+        output_range(f64::min(partial_min, force + lp_min), force + lp_max)
     }
 
     /// The finest angle LSB (rad) this scene accepts: one count must give theta >= 2^-40,
@@ -140,15 +174,18 @@ impl FixedEllipticScene {
         }
         let lp = log2_u32(load);
         let lp3 = div3(lp);
+        // Wrapping adds below never wrap: `new` bounded the constants (|log2| < 100) and
+        // every sum over the declared range (`check_sums`); counts add < 32, tables < 42.
         // Critical angle: g(theta0) = g0 (eq 18 at d/b = 1), phi0 = theta0 / c.
-        let z = self.log_critical + lp3;
+        let z = self.log_critical.wrapping_add(lp3);
         let (critical, margin) = if z > LOG2_HALF_PI {
             (None, None)
         } else {
             let log_theta0 = lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z)?;
-            let counts = margin_counts(log_theta0 - self.log_theta_lsb, a);
+            // Both within the tables' theta range, 2^-42 .. pi/2.
+            let counts = margin_counts(log_theta0.wrapping_sub(self.log_theta_lsb), a);
             (
-                Some(Log2(log_theta0 - self.log_radius_factor)),
+                Some(Log2(log_theta0.wrapping_sub(self.log_radius_factor))),
                 Some(counts),
             )
         };
@@ -156,20 +193,24 @@ impl FixedEllipticScene {
             return Ok(zero_angle(critical, margin));
         }
         // d/b = A g(theta) P^(-1/3) (eq 16).
-        let log_g = lookup(LOG_G_LOW, LOG_G_HIGH, self.log_theta_lsb + log2_u32(a))?;
-        let ls = self.log_slip.saturating_add(log_g).saturating_sub(lp3);
-        // F / (mu P) = s r(s) for s < 1 (eq 21), 1 beyond (eq 29).
+        let log_g = lookup(
+            LOG_G_LOW,
+            LOG_G_HIGH,
+            self.log_theta_lsb.wrapping_add(log2_u32(a)),
+        )?;
+        let ls = self.log_slip.wrapping_add(log_g).wrapping_sub(lp3);
+        // F / (mu P) = s r(s) for s < 1 (eq 21), 1 beyond (eq 29); never above 1.
         let (regime, log_ratio) = if ls < 0 {
             let s = exp2_fixed(ls, 24) as i32; // d/b in Q0.24
             let log_r = LOG_FORCE_OVER_S.eval(s).ok_or(Error::OutOfRange)?;
-            (Regime::Partial, ls + log_r)
+            (Regime::Partial, ls.wrapping_add(log_r).min(0))
         } else {
             (Regime::Gross, 0)
         };
         Ok(FixedEstimate {
             slip_ratio: Log2(ls),
             regime,
-            axial_force: Log2(self.log_force.saturating_add(lp).saturating_add(log_ratio)),
+            axial_force: Log2(self.log_force.wrapping_add(lp).wrapping_add(log_ratio)),
             axial_force_negative: angle < 0,
             critical_angle: critical,
             margin,
@@ -207,7 +248,8 @@ impl FixedEllipticScene {
     /// a = b = p0 = 0.
     ///
     /// # Errors
-    /// As [`FixedEllipticScene::estimate`].
+    /// As [`FixedEllipticScene::estimate`]; [`Error::OutOfRange`] also where a, b or p0
+    /// lies outside 2^-126 .. 2^126 (m, Pa).
     pub fn details(&self, load: u32, angle: i32) -> Result<FixedDetails, Error> {
         let a = angle.unsigned_abs();
         if a > self.range.angle_max {
@@ -227,32 +269,35 @@ impl FixedEllipticScene {
                 p0: zero,
             });
         }
-        let y = self.log_theta_lsb + log2_u32(a);
+        // Within the tables, as in `estimate`.
+        let y = self.log_theta_lsb.wrapping_add(log2_u32(a));
         let log_g = lookup(LOG_G_LOW, LOG_G_HIGH, y)?;
         let log_m = lookup(LOG_M_LOW, LOG_M_HIGH, y)?;
-        let log_n = log_g - log_m - y; // n = g / (m theta)
+        let log_n = log_g.wrapping_sub(log_m).wrapping_sub(y); // n = g / (m theta)
         let (log_a, log_b, log_p0) = if load == 0 {
-            (i32::MIN, i32::MIN, i32::MIN)
+            (Log2::ZERO, Log2::ZERO, Log2::ZERO)
         } else {
+            // a, b and p0 may leave the Q8.24 range where d/b and F do not: in i64
+            // (sums of five i32 at most: no wrap), then a typed error for a result
+            // that does not fit.
             let lp = log2_u32(load);
-            let log_l = self.log_hertz.saturating_add(div3(lp));
-            let (la, lb) = (log_m.saturating_add(log_l), log_n.saturating_add(log_l));
-            (
-                la,
-                lb,
-                self.log_pressure
-                    .saturating_add(lp)
-                    .saturating_sub(la)
-                    .saturating_sub(lb),
-            )
+            let wide = |x: i32| x as i64;
+            let log_l = wide(self.log_hertz).wrapping_add(wide(div3(lp)));
+            let la = wide(log_m).wrapping_add(log_l);
+            let lb = wide(log_n).wrapping_add(log_l);
+            let lp0 = wide(self.log_pressure)
+                .wrapping_add(wide(lp))
+                .wrapping_sub(la)
+                .wrapping_sub(lb);
+            (log2_result(la)?, log2_result(lb)?, log2_result(lp0)?)
         };
         Ok(FixedDetails {
             theta: Log2(y),
             m: Log2(log_m),
             n: Log2(log_n),
-            a: Log2(log_a),
-            b: Log2(log_b),
-            p0: Log2(log_p0),
+            a: log_a,
+            b: log_b,
+            p0: log_p0,
         })
     }
 }

@@ -2,7 +2,11 @@
 
 use super::elliptic::{zero_angle, zero_load};
 use super::logexp::{exp2_fixed, log2_u32};
-use super::{FixedEstimate, InputRange, Log2, Units, angle_max, constant, log_risk, margin_counts};
+use super::uniform::ONE;
+use super::{
+    FixedEstimate, InputRange, Log2, Units, angle_max, constant, constant_below, log_risk,
+    margin_counts, output_range,
+};
 use crate::estimator::DEFAULT_RISK_SLIP_RATIO;
 use crate::reference::Regime;
 use crate::{Error, Scene};
@@ -39,8 +43,10 @@ impl FixedLineScene {
     /// counts of `angle_lsb` rad.
     ///
     /// # Errors
-    /// [`Error::OutOfRange`] for LSBs that are not positive and finite or constants
-    /// beyond the Q8.24 range.
+    /// [`Error::OutOfRange`] for LSBs that are not positive and finite, an angle LSB
+    /// above pi/2 (which leaves no angle count but 0), constants beyond the Q8.24
+    /// range, or a sample in the declared range whose d/b, F or phi0 in counts would lie
+    /// outside 2^-126 .. 2^126, where a Q8.24 log2 cannot hold it.
     pub fn new(scene: &Scene, load_lsb: f64, angle_lsb: f64) -> Result<Self, Error> {
         if !(load_lsb.is_finite() && load_lsb > 0.0 && angle_lsb.is_finite() && angle_lsb > 0.0) {
             return Err(Error::OutOfRange);
@@ -53,26 +59,49 @@ impl FixedLineScene {
             * scene.length().unwrap_or(1.0);
         let root = libm::sqrt(stiffness);
         let root_lsb = libm::sqrt(load_lsb);
+        let angle_counts = angle_max(angle_lsb);
+        if angle_counts == 0 {
+            return Err(Error::OutOfRange); // no angle count but 0 below pi/2
+        }
         // sqrt((1 - nu) R / (pi G l)), as a product of roots (no overflow).
         let sq = libm::sqrt;
         let length = scene.length().unwrap_or(1.0);
         let compliance = sq((1.0 - scene.poisson_ratio()) / PI)
             * (sq(scene.effective_radius()) / sq(scene.shear_modulus()))
             / sq(length);
-        Ok(FixedLineScene {
+        let scene = FixedLineScene {
             log_slip: constant(root / (2.0 * mu) * angle_lsb / root_lsb)?,
             log_critical: constant(2.0 * mu / root * root_lsb)?,
             log_angle_lsb: constant(angle_lsb)?,
-            log_force: constant(mu * load_lsb)?,
+            log_force: constant_below(mu * load_lsb)?,
             log_risk: constant(DEFAULT_RISK_SLIP_RATIO as f64)?,
             units: Units::new(load_lsb, angle_lsb)?,
             log_width: constant(2.0 * compliance * root_lsb)?,
             log_pressure: constant(root_lsb / (PI * compliance * length))?,
             range: InputRange {
                 load_min: 1,
-                angle_max: angle_max(angle_lsb), // |phi| < pi/2
+                angle_max: angle_counts, // |phi| < pi/2
             },
-        })
+        };
+        scene.check_sums()?;
+        Ok(scene)
+    }
+
+    /// Bounds every per-sample sum of [`FixedLineScene::estimate`] over the declared
+    /// range (loads of 1 to 2^32 counts, angles of 1 to `angle_max` counts), in i64.
+    fn check_sums(&self) -> Result<(), Error> {
+        let one = ONE as f64;
+        let half_lp_max = 16.0 * one;
+        let la_max = log2_u32(self.range.angle_max) as f64 + one;
+        // phi0 in counts (eq 28), what the margin is formed from.
+        let critical = self.log_critical as f64 - self.log_angle_lsb as f64;
+        output_range(critical, critical + half_lp_max)?;
+        // d/b (eq 23): |phi| / sqrt(P).
+        let slip = self.log_slip as f64;
+        output_range(slip - half_lp_max, slip + la_max)?;
+        // F = mu P s (2 - s) grows like sqrt(P) in partial slip (eq 27), like P beyond.
+        let force = self.log_force as f64;
+        output_range(f64::min(force + slip, force), force + 32.0 * one)
     }
 
     /// The same scene with another d/b threshold for the risk flag.
@@ -107,34 +136,34 @@ impl FixedLineScene {
         if load == 0 {
             return Ok(zero_load(a, self.log_risk));
         }
-        let half_lp = log2_u32(load) >> 1;
-        let log_phi0 = self.log_critical + half_lp; // eq (28)
+        // Wrapping adds below never wrap: `new` bounded the constants (|log2| < 100)
+        // and every sum over the declared range (`check_sums`); counts add < 32.
+        let lp = log2_u32(load);
+        let half_lp = lp >> 1;
+        let log_phi0 = self.log_critical.wrapping_add(half_lp); // eq (28)
         let critical = Some(Log2(log_phi0));
-        let margin = Some(margin_counts(
-            log_phi0.saturating_sub(self.log_angle_lsb),
-            a,
-        ));
+        let margin = Some(margin_counts(log_phi0.wrapping_sub(self.log_angle_lsb), a));
         if a == 0 {
             return Ok(zero_angle(critical, margin));
         }
         let ls = self
             .log_slip
-            .saturating_add(log2_u32(a))
-            .saturating_sub(half_lp); // eq (23)
-        // F / (mu P) = s (2 - s) below s = 1 (eq 27), 1 above (eq 29).
+            .wrapping_add(log2_u32(a))
+            .wrapping_sub(half_lp); // eq (23)
+        // F / (mu P) = s (2 - s) below s = 1 (eq 27), 1 above (eq 29); never above 1.
         let (regime, log_ratio) = if ls < 0 {
-            let s = exp2_fixed(ls, 24); // Q0.24
-            (
-                Regime::Partial,
-                ls.saturating_add(log2_u32((2 << 24) - s) - (24 << 24)),
-            )
+            let s = exp2_fixed(ls, 24); // Q0.24, below 2^24 (ls < 0)
+            // log2(2 - s) in [0, 1]: (2 - s) in Q0.24 is 2^24 .. 2^25, no wrap.
+            let two_minus_s = (2u32 << 24).wrapping_sub(s);
+            let log_two_minus_s = log2_u32(two_minus_s).wrapping_sub(24 << 24);
+            (Regime::Partial, ls.wrapping_add(log_two_minus_s).min(0))
         } else {
             (Regime::Gross, 0)
         };
         Ok(FixedEstimate {
             slip_ratio: Log2(ls),
             regime,
-            axial_force: Log2(self.log_force.saturating_add(log2_u32(load) + log_ratio)),
+            axial_force: Log2(self.log_force.wrapping_add(lp).wrapping_add(log_ratio)),
             axial_force_negative: angle < 0,
             critical_angle: critical,
             margin,

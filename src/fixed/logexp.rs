@@ -10,6 +10,11 @@ use crate::tables::{EXP2_FRACTION, LOG2_MANTISSA};
 /// all 2^24 fractions it can see, plus 8.6e-8 for the bits below them (test below).
 pub const LOG2_MAX_ERROR: f64 = 3.3e-7;
 
+/// [`log2_u32`] exceeds `log2(x)` by at most this, in Q8.24 units (2^-24), over every
+/// u32: the table part's largest excess over all 2^24 fractions is 0.497 (test below),
+/// and dropping the bits below them only lowers the result.
+pub const LOG2_MAX_EXCESS: f64 = 0.5;
+
 /// Maximum relative error of [`exp2_fixed`] before the final truncation to an integer,
 /// over all 2^24 Q8.24 fractions (test below).
 pub const EXP2_MAX_REL_ERROR: f64 = 2.6e-7;
@@ -23,22 +28,25 @@ pub fn log2_u32(x: u32) -> i32 {
     let lz = x.leading_zeros();
     // The bits below the leading one, as a Q0.32 fraction, then Q8.24.
     let fraction = ((x << lz) << 1) >> 8;
-    // The table covers [0, 1): the default is never taken.
+    // The table covers [0, 1): the default is never taken. The octave (lz <= 31 for
+    // x > 0) plus a mantissa in [0, 2^24] stays below 2^29: no wrap.
     let mantissa = LOG2_MANTISSA.eval(fraction as i32).unwrap_or_default();
-    ((31 - lz as i32) << 24) + mantissa
+    ((31 - lz as i32) << 24).wrapping_add(mantissa)
 }
 
 /// `x / 3` for non-negative x, exactly, by shifts (a Cortex-M0 has no divider).
 #[inline(always)]
 pub fn div3(x: i32) -> i32 {
     let x = x as u32;
-    // Hacker's Delight divu3: q ~ x * 0.010101...b, then one correction.
-    let mut q = (x >> 2) + (x >> 4);
-    q += q >> 4;
-    q += q >> 8;
-    q += q >> 16;
-    let r = x - q * 3;
-    (q + ((11 * r) >> 5)) as i32
+    // Hacker's Delight divu3: q ~ x * 0.010101...b, then one correction. The partial
+    // sums only truncate, so q <= x / 3 and r = x - 3q is small and non-negative: no
+    // operation wraps (the wrapping forms only drop the overflow checks).
+    let mut q = (x >> 2).wrapping_add(x >> 4);
+    q = q.wrapping_add(q >> 4);
+    q = q.wrapping_add(q >> 8);
+    q = q.wrapping_add(q >> 16);
+    let r = x.wrapping_sub(q.wrapping_mul(3));
+    q.wrapping_add(r.wrapping_mul(11) >> 5) as i32
 }
 
 /// `2^l` (l in Q8.24) as an unsigned fixed-point number with `frac_bits` fraction
@@ -53,7 +61,8 @@ pub fn exp2_fixed(l: i32, frac_bits: u32) -> u32 {
         Some(v) => v as u32, // 2^f in Q8.24, in [2^24, 2^25)
         None => ONE as u32,  // unreachable: the table covers [0, 1)
     };
-    let shift = k + frac_bits as i32 - 24;
+    // k in [-128, 127]; frac_bits beyond 2^8 saturates like any large shift.
+    let shift = k.wrapping_add(frac_bits.min(256) as i32).wrapping_sub(24);
     if shift >= 7 {
         u32::MAX
     } else if shift >= 0 {
@@ -76,6 +85,11 @@ mod tests {
         // moves log2 by less than 2^-24 / ln 2 = 8.6e-8.
         let err = |x: u32| (log2_u32(x) as f64 / ONE as f64 - (x as f64).log2()).abs();
         let table = ((1u32 << 24)..(1u32 << 25)).map(err).fold(0.0, f64::max);
+        let excess = ((1u32 << 24)..(1u32 << 25))
+            .map(|x| log2_u32(x) as f64 - (x as f64).log2() * ONE as f64)
+            .fold(f64::MIN, f64::max);
+        println!("log2_u32 largest excess {excess:.3} units");
+        assert!(excess <= LOG2_MAX_EXCESS, "{excess}");
         println!("log2_u32 worst table error {table:.3e}");
         assert!(table + 8.6e-8 <= LOG2_MAX_ERROR, "{table:e}");
         let sampled = (1u32..=u32::MAX)

@@ -266,12 +266,50 @@ fn margin_counts(log_phi0_counts: i32, a: u32) -> i32 {
     (phi0 - a as i64).clamp(i32::MIN as i64, i32::MAX as i64) as i32
 }
 
-/// Q8.24 log2 of a positive f64 scene constant, within +-100; the per-sample sums that
-/// could still leave the i32 range saturate (to values that stand for 0 or infinity).
+/// Q8.24 log2 of a positive f64 scene constant, within +-100. The per-sample sums
+/// that add such constants to logarithms of counts are bounded when the scene is
+/// prepared ([`output_range`]), so that they cannot leave the i32 range.
 fn constant(x: f64) -> Result<i32, Error> {
     let l = Log2::from_f64(x)?.0;
     if l.unsigned_abs() < 100 << 24 {
         Ok(l)
+    } else {
+        Err(Error::OutOfRange)
+    }
+}
+
+/// [`constant`] rounded down, less one unit: with it, `this + log2_u32(P)` stays
+/// below `log2(x P)`, since [`logexp::log2_u32`] exceeds log2 by less than one unit
+/// ([`logexp::LOG2_MAX_EXCESS`]). For F = mu P in gross slip (eq 29): |F| <= mu P.
+fn constant_below(x: f64) -> Result<i32, Error> {
+    constant(x)?;
+    let l = libm::floor(libm::log2(x) * ONE as f64) as i32;
+    Ok(l.saturating_sub(1))
+}
+
+/// The largest |log2| (Q8.24) of a per-sample result: one octave inside what
+/// [`Log2::from_f64`] accepts, and far from the values that stand for 0 and infinity.
+const LOG2_RESULT_LIMIT: i64 = 126 << 24;
+
+/// [`Error::OutOfRange`] unless the bounds `lo..=hi` of a per-sample log2 (Q8.24, worked
+/// out in f64, exact for these integers, when a scene is prepared) lie within
+/// [`LOG2_RESULT_LIMIT`]. A scene that passes adds its per-sample logarithms with
+/// wrapping (never wrapping) arithmetic, and none of its results stands for 0 or
+/// infinity at a load above 0.
+fn output_range(lo: f64, hi: f64) -> Result<(), Error> {
+    let limit = LOG2_RESULT_LIMIT as f64;
+    if -limit <= lo && hi <= limit {
+        Ok(())
+    } else {
+        Err(Error::OutOfRange)
+    }
+}
+
+/// A log2 in i64 (the `details` sums of a few i32, which cannot wrap i64) as [`Log2`],
+/// within [`LOG2_RESULT_LIMIT`].
+fn log2_result(x: i64) -> Result<Log2, Error> {
+    if x.unsigned_abs() <= LOG2_RESULT_LIMIT as u64 {
+        Ok(Log2(x as i32))
     } else {
         Err(Error::OutOfRange)
     }

@@ -47,8 +47,12 @@ impl UniformTable<'_> {
         let linear = mul_q16(d1, t).wrapping_add(d1.wrapping_mul(below) >> shift);
         // t (t - 1) / 2 in Q16, from t/2 in Q15 (products stay below 2^30).
         let u = (t >> 1) as i32;
-        let tt = (u * (u - 32768)) >> 15;
-        Some(v[0].wrapping_add(linear).wrapping_add((d2 * tt) >> 16))
+        let tt = u.wrapping_mul(u.wrapping_sub(32768)) >> 15;
+        // |d2| < 2^17 (the generator checks) and |tt| < 2^14: the product fits i32.
+        Some(
+            v[0].wrapping_add(linear)
+                .wrapping_add(d2.wrapping_mul(tt) >> 16),
+        )
     }
 }
 

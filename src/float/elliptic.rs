@@ -18,6 +18,9 @@ const SMALL_G: f32 = 7.450_581e-9; // 2^-27
 /// scale. As bits: the lower end and the width of the range.
 const LIGHT_LOAD_BITS: u32 = 0x0380_0000; // 2^-120
 const NORMAL_LOAD_SPAN: u32 = 0x7b80_0000 - 0x0380_0000; // up to 2^120
+/// mu at and above which F = mu P could overflow f32 at a load of 2^120 N (the hot
+/// path's heaviest): mu P < 2^127 below it.
+const FRICTION_LIMIT: f64 = 128.0;
 
 /// The tables one elliptic scene reads per sample: g(theta) (eqs 5, 6, 16) and its
 /// inverse (eq 18). [`Tables::FULL`] covers theta from 0 to pi/2; a firmware whose
@@ -67,7 +70,9 @@ impl EllipticScene<'static> {
     /// # Errors
     /// [`Error::PlaneHasNoEllipse`] for a plane, [`Error::Unsupported`] for the exact
     /// theta relation (the cores implement eq 4), [`Error::OutOfRange`] if a constant
-    /// does not fit in f32 or the radii differ by more than 1e24 (c < 2^-40).
+    /// does not fit in f32, the radii differ by more than 1e24 (c < 2^-40), mu is 128
+    /// or more (F = mu P would overflow f32 at ordinary loads), or d/b would overflow
+    /// f32 at the lightest load (A g / P^(1/3) above f32::MAX, eq 16).
     pub fn new(scene: &Scene) -> Result<Self, Error> {
         Self::with_tables(scene, Tables::FULL)
     }
@@ -94,6 +99,15 @@ impl<'t> EllipticScene<'t> {
         let v = hertz_scale(scene);
         let slip_gain =
             core::f64::consts::PI * scene.shear_modulus() * v * v / (3.0 * scene.friction() * c);
+        // mu P < 2^127 for every load of the hot path (up to 2^120 N); heavier loads are
+        // checked per sample. d/b = A g P^(-1/3) <= A (pi/2) / cbrt(2^-149) must fit,
+        // with a factor 2 for the tables' and the cube root's rounding.
+        let lightest_cbrt = libm::cbrt(f32::from_bits(1) as f64);
+        if scene.friction() >= FRICTION_LIMIT
+            || slip_gain * core::f64::consts::FRAC_PI_2 / lightest_cbrt > f32::MAX as f64 / 2.0
+        {
+            return Err(Error::OutOfRange);
+        }
         let constants = [c, 1.0 / c, slip_gain, 1.0 / slip_gain, scene.friction(), v];
         let mut f = [0.0f32; 6];
         for (out, x) in f.iter_mut().zip(constants) {
@@ -134,7 +148,8 @@ impl<'t> EllipticScene<'t> {
     /// # Errors
     /// [`Error::Load`] for a NaN, infinite or negative load; [`Error::Angle`] for a
     /// non-finite angle or |phi| >= pi/2; [`Error::OutOfRange`] for a theta below
-    /// narrowed tables.
+    /// narrowed tables, a load above 2^120 N whose mu P overflows f32, or a load so
+    /// light that phi0 would underflow f32 (below its smallest normal value).
     #[inline]
     pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
         let abs_phi = phi.abs();
@@ -172,7 +187,8 @@ impl<'t> EllipticScene<'t> {
 
     /// Loads outside [2^-120, 2^120] N: bad input (a typed error), zero load (an
     /// unloaded contact slips wherever it is misaligned: d/b = inf, F = 0, phi0 = 0, the
-    /// finished estimate in `Ok(Err(..))`), or a cube root that must scale (`Ok(Ok(..))`).
+    /// finished estimate in `Ok(Err(..))`), a load whose mu P overflows f32 (a typed
+    /// error: F would be infinite), or a cube root that must scale (`Ok(Ok(..))`).
     #[cold]
     #[inline(never)]
     fn extreme_load(
@@ -192,6 +208,10 @@ impl<'t> EllipticScene<'t> {
                 abs_phi,
                 self.risk_slip_ratio,
             )));
+        }
+        // F <= mu P (eq 21) fits f32 when mu P does.
+        if (self.friction * load).to_bits() >= f32::INFINITY.to_bits() {
+            return Err(Error::OutOfRange);
         }
         Ok(Ok(cbrt(load)))
     }
@@ -228,16 +248,21 @@ impl<'t> EllipticScene<'t> {
         }
     }
 
+    /// Below the inverse table: the asymptotics, or [`Error::OutOfRange`] where theta0
+    /// (and so phi0 = theta0 / c) would underflow f32's normal range at a load above 0.
     #[cold]
     #[inline(never)]
     fn theta_outside(&self, g: f32) -> Result<f32, Error> {
         if g == 0.0 {
-            Ok(0.0)
-        } else if g < self.tables.theta_of_g.lower() && self.tables.theta_of_g.lower() <= SMALL_G {
-            Ok(small_theta::theta_small(g))
-        } else {
-            Err(Error::OutOfRange)
+            return Ok(0.0);
         }
+        if g < self.tables.theta_of_g.lower() && self.tables.theta_of_g.lower() <= SMALL_G {
+            let theta = small_theta::theta_small(g);
+            if theta >= f32::MIN_POSITIVE {
+                return Ok(theta);
+            }
+        }
+        Err(Error::OutOfRange)
     }
 
     /// 2a / length for a checked sample (load finite and >= 0, |phi| < pi/2), with

@@ -346,9 +346,19 @@ impl Auto {
             }
             _ => false,
         };
+        // A saturated ellipse holds for every phi >= phi0 that the choice gives the
+        // ellipse. The ellipse is shortest at the largest phi (below pi/2, theta <= pi/2
+        // by eq 4), so the choice takes it above phi0 iff it takes it there.
+        let elliptic_somewhere_above = match (&elliptic, &self.elliptic) {
+            (Some(Inverse::AtLeast { .. }), Some(e)) => {
+                let phi_max = FRAC_PI_2.next_down().min(FRAC_PI_2 * e.inv_radius_factor);
+                self.choose(load, phi_max).0 == ContactModel::Elliptic
+            }
+            _ => false,
+        };
         Ok(
             match (
-                picks(&elliptic, ContactModel::Elliptic),
+                picks(&elliptic, ContactModel::Elliptic) || elliptic_somewhere_above,
                 picks(&line, ContactModel::Line),
             ) {
                 (true, false) => {

@@ -27,13 +27,19 @@ pub struct LineScene {
     pressure_gain: f32,
     /// d/b at and above which the risk flag is raised.
     risk_slip_ratio: f32,
+    /// The lightest load (as f32 bits) above 0 whose results fit f32: d/b finite,
+    /// phi0 a normal number.
+    load_min_bits: u32,
+    /// `heaviest - lightest` (f32 bits): F = mu P and phi0 finite up to the heaviest.
+    load_span_bits: u32,
 }
 
 impl LineScene {
     /// Prepares `scene` for line contact.
     ///
     /// # Errors
-    /// [`Error::OutOfRange`] if a constant does not fit in f32.
+    /// [`Error::OutOfRange`] if a constant does not fit in f32, or no load has all its
+    /// results in f32 (see [`LineScene::load_range`]).
     pub fn new(scene: &Scene) -> Result<Self, Error> {
         let mu = scene.friction();
         let stiffness = core::f64::consts::PI
@@ -62,6 +68,23 @@ impl LineScene {
                 return Err(Error::OutOfRange);
             }
         }
+        let (slip, critical, mu) = (f[0] as f64, f[1] as f64, f[2] as f64);
+        // With a factor 2 for inv_sqrt's and the products' rounding: d/b =
+        // slip |phi| / sqrt(P) <= slip (pi/2) / sqrt(P) finite (eq 23); phi0 =
+        // critical sqrt(P) normal and finite (eq 28); F <= mu P finite (eqs 27, 29).
+        let (max, min_normal) = (f32::MAX as f64, f32::MIN_POSITIVE as f64);
+        let lightest = f64::max(
+            f64::max(
+                f32::from_bits(1) as f64,
+                square(2.0 * slip * core::f64::consts::FRAC_PI_2 / max),
+            ),
+            square(2.0 * min_normal / critical),
+        );
+        let heaviest = f64::min(f64::min(max, max / mu), square(max / (2.0 * critical)));
+        let (lightest, heaviest) = (f32_above(lightest), f32_below(heaviest));
+        if lightest > heaviest {
+            return Err(Error::OutOfRange);
+        }
         Ok(LineScene {
             slip_gain: f[0],
             critical_gain: f[1],
@@ -69,6 +92,9 @@ impl LineScene {
             width_gain: f[3],
             pressure_gain: f[4],
             risk_slip_ratio: DEFAULT_RISK_SLIP_RATIO,
+            load_min_bits: lightest.to_bits(),
+            // Positive f32 order as their bits: no wrap.
+            load_span_bits: heaviest.to_bits().wrapping_sub(lightest.to_bits()),
         })
     }
 
@@ -91,24 +117,19 @@ impl LineScene {
     ///
     /// # Errors
     /// [`Error::Load`] for a NaN, infinite or negative load; [`Error::Angle`] for a
-    /// non-finite angle or |phi| >= pi/2.
+    /// non-finite angle or |phi| >= pi/2; [`Error::OutOfRange`] for a load outside
+    /// [`LineScene::load_range`] (other than 0), where a result would not fit f32.
     #[inline]
     pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
-        check(load, phi)?;
-        let abs_phi = phi.abs();
-        // f32's FRAC_PI_2 lies above pi/2: refused with everything above it.
-        if abs_phi >= FRAC_PI_2 {
-            return Err(Error::Angle);
+        // One unsigned compare on the bits: load outside the scene's range (0, negative,
+        // NaN and inf included) goes to the cold path, which sorts them out.
+        if load.to_bits().wrapping_sub(self.load_min_bits) > self.load_span_bits {
+            return self.outside_load(load, phi);
         }
-        if load == 0.0 {
-            let s = if abs_phi == 0.0 { 0.0 } else { f32::INFINITY };
-            return Ok(Estimate::new(
-                s,
-                0.0,
-                Some(0.0),
-                abs_phi,
-                self.risk_slip_ratio,
-            ));
+        let abs_phi = phi.abs();
+        // On the bits: above pi/2, and also inf and NaN, whose patterns lie above.
+        if abs_phi.to_bits() >= FRAC_PI_2.to_bits() {
+            return Err(Error::Angle);
         }
         let y = inv_sqrt(load); // P^(-1/2), subnormal loads included
         let s = self.slip_gain * abs_phi * y; // eq (23)
@@ -122,6 +143,39 @@ impl LineScene {
             abs_phi,
             self.risk_slip_ratio,
         ))
+    }
+
+    /// Loads outside [`LineScene::load_range`]: bad input, zero load (d/b = inf at
+    /// phi != 0, F = 0, phi0 = 0), or a load whose results would not fit f32.
+    #[cold]
+    #[inline(never)]
+    fn outside_load(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
+        check(load, phi)?;
+        let abs_phi = phi.abs();
+        if abs_phi >= FRAC_PI_2 {
+            return Err(Error::Angle);
+        }
+        if load != 0.0 {
+            return Err(Error::OutOfRange);
+        }
+        let s = if abs_phi == 0.0 { 0.0 } else { f32::INFINITY };
+        Ok(Estimate::new(
+            s,
+            0.0,
+            Some(0.0),
+            abs_phi,
+            self.risk_slip_ratio,
+        ))
+    }
+
+    /// The loads (N/m, or N with a length) [`LineScene::estimate`] accepts besides 0:
+    /// those at which d/b, F and phi0 are finite and phi0 is a normal f32. For a
+    /// realistic scene, every positive f32 load, subnormal ones included.
+    pub fn load_range(&self) -> (f32, f32) {
+        (
+            f32::from_bits(self.load_min_bits),
+            f32::from_bits(self.load_min_bits.wrapping_add(self.load_span_bits)),
+        )
     }
 
     /// The contact strip on request: half-width b (m, eq 22) and peak pressure p0
@@ -154,4 +208,32 @@ pub struct LineDetails {
     pub b: f32,
     /// Peak pressure p0 = 2 P / (pi b) (Pa), P per unit length.
     pub p0: f32,
+}
+
+fn square(x: f64) -> f64 {
+    x * x
+}
+
+/// The smallest f32 at or above `x` (x >= 0; the largest finite f32 for x beyond it).
+fn f32_above(x: f64) -> f32 {
+    let y = x as f32;
+    if (y as f64) < x {
+        y.next_up()
+    } else if y.is_infinite() {
+        f32::MAX
+    } else {
+        y
+    }
+}
+
+/// The largest f32 at or below `x` (x >= 0; the largest finite f32 for x beyond it).
+fn f32_below(x: f64) -> f32 {
+    let y = x as f32;
+    if y.is_infinite() {
+        f32::MAX
+    } else if (y as f64) > x {
+        y.next_down()
+    } else {
+        y
+    }
 }

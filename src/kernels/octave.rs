@@ -22,10 +22,11 @@ pub struct OctaveTable<'a> {
 }
 
 impl<'a> OctaveTable<'a> {
-    /// The table whose first row is the octave `[2^first_exponent, 2^(first_exponent + 1))`.
+    /// The table whose first row is the octave `[2^first_exponent, 2^(first_exponent + 1))`
+    /// (an exponent of f32, -126 to 127; another one gives a table that holds no f32).
     pub const fn new(first_exponent: i32, coeffs: &'a [Row]) -> Self {
         OctaveTable {
-            first_row: (first_exponent + 127) as u32,
+            first_row: first_exponent.wrapping_add(127) as u32,
             coeffs,
         }
     }
@@ -50,7 +51,7 @@ impl<'a> OctaveTable<'a> {
 
     /// Unbiased exponent of the first octave.
     pub fn first_exponent(&self) -> i32 {
-        self.first_row as i32 - 127
+        (self.first_row as i32).wrapping_sub(127) // the inverse of `new`
     }
 
     /// Smallest x in the table, `2^first_exponent`.
@@ -60,7 +61,8 @@ impl<'a> OctaveTable<'a> {
 
     /// x below this are above the table, `2^(first_exponent + rows)`.
     pub fn upper(&self) -> f32 {
-        libm::ldexpf(1.0, self.first_exponent() + self.coeffs.len() as i32)
+        let rows = i32::try_from(self.coeffs.len()).unwrap_or(i32::MAX);
+        libm::ldexpf(1.0, self.first_exponent().saturating_add(rows))
     }
 }
 

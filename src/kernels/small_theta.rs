@@ -29,11 +29,18 @@ fn two_thirds_power(theta: f32) -> f32 {
     let (mut x, mut k) = (theta, 0i32);
     if x < f32::MIN_POSITIVE {
         x *= 16_777_216.0; // 2^24
-        k -= 24;
+        k = -24;
     }
-    let e = ((x.to_bits() >> 23) as i32 - 127).div_euclid(3) * 3;
-    let mantissa = libm::ldexpf(x, -e); // in [1, 8)
-    libm::ldexpf(cbrt(mantissa * mantissa), 2 * (e + k) / 3)
+    // The biased exponent is below 2^8 and k is 0 or -24: no operation here can wrap.
+    let e = ((x.to_bits() >> 23) as i32)
+        .wrapping_sub(127)
+        .div_euclid(3)
+        .wrapping_mul(3);
+    let mantissa = libm::ldexpf(x, e.wrapping_neg()); // in [1, 8)
+    libm::ldexpf(
+        cbrt(mantissa * mantissa),
+        e.wrapping_add(k).wrapping_mul(2) / 3,
+    )
 }
 
 /// `g(theta) = m n theta` for `0 < theta < 2^-40`, subnormals included.

@@ -553,15 +553,15 @@ fn angle_line_below(
 /// at that phi picks that model; see the module docs for two answers or none.
 ///
 /// # Errors
-/// As [`angle_elliptic`] and [`angle_line`]; [`Error::PlaneHasNoEllipse`] for a plane
-/// without length.
+/// As [`angle_elliptic`] and [`angle_line`].
 pub fn angle_estimate(scene: &Scene, load: f64, force: f64) -> Result<Inverse<f64>, Error> {
     check(load, 0.0, force)?;
-    let Some(length) = scene.length() else {
-        return angle_elliptic(scene, load, force);
-    };
-    let per_length = load / length;
-    if scene.is_plane() {
+    // A plane, or radii so unequal that c underflows, has a strip at every phi: line
+    // contact (section 8), P and F per unit length without a length, as
+    // [`super::estimate`] reads them.
+    if scene.is_plane() || scene.radius_factor() == 0.0 {
+        let length = scene.length().unwrap_or(1.0);
+        let per_length = load / length;
         let saturated = scene.friction() * (per_length * 1.0);
         if let Some(answer) = angle_trivial(load, force, 1.0) {
             return Ok(answer);
@@ -571,6 +571,11 @@ pub fn angle_estimate(scene: &Scene, load: f64, force: f64) -> Result<Inverse<f6
             force,
         ));
     }
+    // Without a length section 9 always takes the ellipse.
+    let Some(length) = scene.length() else {
+        return angle_elliptic(scene, load, force);
+    };
+    let per_length = load / length;
     if let Some(answer) = angle_trivial(load, force, 1.5) {
         // F = 0: phi = 0, where the ellipse is infinitely long: line contact, S = 1.
         return Ok(match answer {
@@ -593,11 +598,16 @@ pub fn angle_estimate(scene: &Scene, load: f64, force: f64) -> Result<Inverse<f6
     let picks = |phi: f64, model: ContactModel| {
         super::estimate(scene, load, phi).is_ok_and(|e| e.model() == model)
     };
-    // The largest phi (theta = pi/2, or phi = pi/2 for the exact relation): the ellipse
-    // is shortest there, so the elliptic model is chosen somewhere iff it is there.
+    // The largest phi the forward solution takes: below pi/2 (|phi| >= pi/2 is refused)
+    // and, for eq (4), at most theta = pi/2. The ellipse is shortest there, so the
+    // elliptic model is chosen somewhere iff it is there.
+    let below_right_angle = FRAC_PI_2 * (1.0 - f64::EPSILON);
     let phi_max = match scene.theta_relation() {
-        ThetaRelation::SmallAngle => FRAC_PI_2 / scene.radius_factor() * (1.0 - 4.0 * f64::EPSILON),
-        ThetaRelation::Exact => FRAC_PI_2,
+        ThetaRelation::SmallAngle => libm::fmin(
+            FRAC_PI_2 / scene.radius_factor() * (1.0 - 4.0 * f64::EPSILON),
+            below_right_angle,
+        ),
+        ThetaRelation::Exact => below_right_angle,
     };
     let line_ok = match line_answer {
         Inverse::Exact { value, .. } | Inverse::AtLeast { value } => {

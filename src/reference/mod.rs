@@ -6,6 +6,8 @@
 
 mod carlson;
 mod chain;
+#[cfg(test)]
+mod cost;
 pub mod inverse;
 pub mod line;
 pub mod normal;
@@ -266,6 +268,15 @@ impl Estimate {
     }
 }
 
+/// `d = min(d/b, 1) b` (m): 0 without slip even where b overflowed (0 x inf).
+fn slip_width(slip_ratio: f64, b: f64) -> f64 {
+    if slip_ratio == 0.0 {
+        0.0
+    } else {
+        libm::fmin(slip_ratio, 1.0) * b
+    }
+}
+
 fn check_sample(load: f64, phi: f64) -> Result<(), Error> {
     if !(load.is_finite() && load >= 0.0) {
         return Err(Error::Load);
@@ -339,11 +350,19 @@ fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64
     if load == 0.0 {
         return Some((0.0, 0.0));
     }
-    let v = hertz_scale(scene);
-    // d/b = s  <=>  m n |phi| = 3 mu s P^(1/3) / (pi G v^2)  (eq 15).
+    // d/b = s  <=>  m n |phi| = 3 mu s P^(1/3) / (pi G v^2) (eq 15), with G v^2 from
+    // hertz_scale:
+    // 3 mu / pi (P / (G h^2 R^2))^(1/3), h = 1.5 (1 - nu), one cube root.
+    let h = 1.5 * (1.0 - scene.poisson_ratio());
+    let r = scene.effective_radius();
     let target = chain::chain(
-        &[3.0, scene.friction(), slip_ratio, libm::cbrt(load)],
-        &[PI, scene.shear_modulus(), v, v],
+        &[
+            3.0,
+            scene.friction(),
+            slip_ratio,
+            chain::chain_cbrt(&[load], &[scene.shear_modulus(), h, h, r, r]),
+        ],
+        &[PI],
     );
     let c = scene.radius_factor();
     if c == 0.0 {
@@ -358,19 +377,25 @@ fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64
         ThetaRelation::SmallAngle => FRAC_PI_2,
         ThetaRelation::Exact => libm::asin(c),
     };
-    let kprime_max = normal::ellipse_shape(theta_max)?.kprime;
-    let guess = normal::theta_for_g(libm::fmin(target * scene.radius_factor(), FRAC_PI_2))
-        .map_or(kprime_max, |s| libm::fmax(s.kprime, f64::MIN_POSITIVE));
-    let kprime = solve::increasing_root(
-        |k| {
-            let s = normal::shape_from_kprime(k);
-            s.mn() * phi_of_theta(scene, s.theta) - target
-        },
-        libm::fmin(guess, kprime_max),
-        0.0,
-        kprime_max,
-    )?;
-    let theta0 = libm::fmin(normal::shape_from_kprime(kprime).theta, theta_max);
+    // theta = pi/2 is k' = 1 (tan^2(theta/2) = 1, eqs 5-6).
+    let kprime_max = match scene.theta_relation() {
+        ThetaRelation::SmallAngle => 1.0,
+        ThetaRelation::Exact => normal::ellipse_shape(theta_max)?.kprime,
+    };
+    // d ln phi / d ln theta, and the curvature it adds (large where phi nears pi/2).
+    let phi = |theta: f64| match scene.theta_relation() {
+        ThetaRelation::SmallAngle => (theta / c, 1.0, 1.0),
+        ThetaRelation::Exact => {
+            let phi = phi_of_theta(scene, theta);
+            let cos_phi = libm::cos(phi);
+            let slope = theta * libm::cos(theta) / (c * cos_phi * phi);
+            (phi, slope, 1.0 + 1.0 / (cos_phi * cos_phi))
+        }
+    };
+    let seed = normal::seed_for_g(libm::fmin(target * c, FRAC_PI_2));
+    let (_, theta0) =
+        normal::kprime_for_mn_phi(target, phi, libm::fmin(seed, kprime_max), kprime_max)?;
+    let theta0 = libm::fmin(theta0, theta_max);
     Some((phi_of_theta(scene, theta0), theta0))
 }
 
@@ -412,11 +437,11 @@ pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
             1.0 - nu,
             1.0 - nu,
             g_mod,
-            r1 + r2,
+            tangential::half_sum(r1, r2),
             libm::sqrt(r1),
             libm::sqrt(r2),
         ],
-        &[2.0],
+        &[],
     );
     let axial_force = libm::copysign(mu * (load * tangential::axial_force_ratio(s)), phi);
     let critical = critical_angle(scene, load);
@@ -439,7 +464,7 @@ pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
         pstar,
         p0star,
         slip_ratio: s,
-        d: libm::fmin(s, 1.0) * b,
+        d: slip_width(s, b),
         regime: Regime::of(s),
         axial_force,
         critical_angle: critical.map(|c| c.0),
@@ -511,7 +536,7 @@ pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
         pstar: line::nondimensional_load(load, nu, g_mod, radius),
         p0star,
         slip_ratio: s,
-        d: libm::fmin(s, 1.0) * b,
+        d: slip_width(s, b),
         regime: Regime::of(s),
         axial_force: libm::copysign(mu * (load * line::axial_force_ratio(s)), phi),
         critical_angle,

@@ -84,16 +84,26 @@ pub fn axial_force_ratio_slope(s: f64) -> f64 {
 pub fn nondimensional_load(load: f64, nu: f64, g_modulus: f64, r1: f64, r2: f64) -> f64 {
     let one_nu = 1.0 - nu;
     chain(
-        &[2.0, load],
+        &[load],
         &[
             one_nu,
             one_nu,
             g_modulus,
-            r1 + r2,
+            half_sum(r1, r2),
             libm::sqrt(r1),
             libm::sqrt(r2),
         ],
     )
+}
+
+/// `(R1 + R2) / 2` without overflow (R1 = R2 = f64::MAX) and exact for subnormal radii.
+pub fn half_sum(r1: f64, r2: f64) -> f64 {
+    let sum = r1 + r2;
+    if sum.is_finite() {
+        0.5 * sum
+    } else {
+        0.5 * r1 + 0.5 * r2
+    }
 }
 
 /// Critical non-dimensional load `P0* = (pi m n theta)^3 / (48 mu^3)` (eq 18),

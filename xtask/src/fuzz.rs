@@ -1,7 +1,10 @@
 //! `cargo xtask fuzz [--seconds N]`: every fuzz target under fuzz/ (libFuzzer through
 //! cargo-fuzz, which needs a nightly toolchain) for a bounded time each. A crash stops
 //! with a non-zero status and leaves the input under fuzz/artifacts/: turn it into a
-//! test in tests/fuzz_regressions.rs.
+//! test in tests/fuzz_regressions.rs. Each target starts from its seed inputs in
+//! fuzz/seeds/<target>/ (committed: realistic scenes and the crafted corner cases of
+//! past defects, written by fuzz/seeds/make.py) and its growing corpus in
+//! fuzz/corpus/<target>/ (not committed).
 
 use std::path::Path;
 use std::process::Command;
@@ -45,9 +48,16 @@ pub fn run(root: &Path, budget: Budget) -> Result<(), String> {
     };
     for target in TARGETS {
         eprintln!("fuzzing {target}: {}", limits.join(" "));
+        // libFuzzer writes new inputs to the first directory and reads them all.
+        let corpus = root.join("fuzz/corpus").join(target);
+        std::fs::create_dir_all(&corpus).map_err(|e| format!("{}: {e}", corpus.display()))?;
+        let seeds = root.join("fuzz/seeds").join(target);
         let status = Command::new("cargo")
             .current_dir(root)
-            .args(["+nightly", "fuzz", "run", target, "--"])
+            .args(["+nightly", "fuzz", "run", target])
+            .arg(&corpus)
+            .args(seeds.is_dir().then_some(&seeds))
+            .arg("--")
             .args(&limits)
             .status()
             .map_err(|e| e.to_string())?;

@@ -2,11 +2,13 @@
 //!
 //! `examples/nopanic` holds every per-sample path of the estimator and the scene
 //! preparation, with panic-never as its panic handler: a handler that calls a symbol
-//! which does not exist. The image links only if optimisation (profile `firmware`:
-//! release, fat LTO) removed every call to it, i.e. every panic path. Built for each
+//! which does not exist. The image links only if optimisation (profile `nopanic`: the
+//! firmware profile, release with fat LTO, plus overflow checks) removed every call to
+//! it, i.e. every panic path, an integer overflow included. Built for each
 //! Cortex-M class; run in QEMU where it is installed. `examples/nopanic/canary.rs`
 //! has a panic path on purpose and must fail to link with panic-never's message,
-//! or the proof proves nothing in this setup.
+//! or the proof proves nothing in this setup; `overflow_canary.rs` likewise, with an
+//! integer overflow as its one panic path, or the proof is blind to overflow.
 
 use crate::cross;
 use std::process::ExitCode;
@@ -56,17 +58,22 @@ pub fn run() -> ExitCode {
                 }
             }
         }
-        match cross::build(&mut image(target, "nopanic_canary")) {
-            Err(e) if e.contains(PANIC_NEVER) => {
-                println!("{target}: the canary (a panic on purpose) fails to link, as it must")
-            }
-            Err(e) => {
-                failed = true;
-                eprintln!("{target}: the canary failed for another reason:\n{e}");
-            }
-            Ok(_) => {
-                failed = true;
-                eprintln!("{target}: the canary LINKS: panic-never proves nothing in this build");
+        for (canary, what) in [
+            ("nopanic_canary", "a panic on purpose"),
+            ("nopanic_overflow_canary", "an integer overflow on purpose"),
+        ] {
+            match cross::build(&mut image(target, canary)) {
+                Err(e) if e.contains(PANIC_NEVER) => {
+                    println!("{target}: {canary} ({what}) fails to link, as it must")
+                }
+                Err(e) => {
+                    failed = true;
+                    eprintln!("{target}: {canary} failed for another reason:\n{e}");
+                }
+                Ok(_) => {
+                    failed = true;
+                    eprintln!("{target}: {canary} LINKS: the proof cannot see {what}");
+                }
             }
         }
     }
@@ -84,7 +91,7 @@ fn image(target: &str, example: &str) -> std::process::Command {
     cmd.args([
         "build",
         "--profile",
-        "firmware",
+        "nopanic",
         "--target",
         target,
         "--features",
