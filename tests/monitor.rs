@@ -372,12 +372,13 @@ fn a_full_event_queue_drops_the_oldest_and_counts() {
             if i % 2 == 0 { lo } else { hi },
         ));
     }
-    // 40 changes (the first is the start), 8 kept.
+    // 40 changes (the first is the start); the newest EVENT_CAPACITY kept.
+    let capacity = misalign::monitor::EVENT_CAPACITY as u32;
     let kept: Vec<_> = std::iter::from_fn(|| m.pop_event()).collect();
-    assert_eq!(kept.len(), misalign::monitor::EVENT_CAPACITY);
-    assert_eq!(m.statistics().events_dropped, 40 - 8);
+    assert_eq!(kept.len() as u32, capacity);
+    assert_eq!(m.statistics().events_dropped, 40 - capacity);
     let seqs: Vec<u32> = kept.iter().map(|e| e.seq).collect();
-    assert_eq!(seqs, (32..40).collect::<Vec<_>>());
+    assert_eq!(seqs, (40 - capacity..40).collect::<Vec<_>>());
 }
 
 /// 1e9 small increments of the compensated sum stay within 1e-6 (relative) of the

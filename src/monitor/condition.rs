@@ -100,7 +100,7 @@ fn median_of_sorted(values: &[f32]) -> f32 {
 
 /// Median of finite values, sorting them in place.
 fn median(values: &mut [f32]) -> f32 {
-    // Insertion sort: at most 9 values, and only for the MAD, beyond the floor.
+    // Insertion sort: at most 7 values, and only for the MAD, beyond the floor.
     for i in 1..values.len() {
         let mut j = i;
         while j > 0 && values[j - 1] > values[j] {

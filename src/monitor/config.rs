@@ -3,7 +3,7 @@
 use core::fmt;
 
 /// Capacity of the spike filter's window (samples).
-pub const SPIKE_WINDOW_CAPACITY: usize = 9;
+pub const SPIKE_WINDOW_CAPACITY: usize = 7;
 /// Capacity of the trend buffer (points).
 pub const TREND_CAPACITY: usize = 16;
 
@@ -189,7 +189,7 @@ impl fmt::Display for ConfigError {
             ConfigError::Stop => "stop load must be > 0 and stop speed >= 0, finite",
             ConfigError::NominalSpeed => "nominal speed must be finite and > 0",
             ConfigError::Range => "accepted ranges must be finite and non-empty",
-            ConfigError::SpikeWindow => "spike window must be 3..=9 with k, floors > 0",
+            ConfigError::SpikeWindow => "spike window must be 3..=7 with k, floors > 0",
             ConfigError::Smoothing => "smoothing time constant must be finite and >= 0",
             ConfigError::Trend => "trend needs interval > 0, 3..=16 points, horizon > 0",
         })

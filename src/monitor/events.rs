@@ -5,7 +5,7 @@ use super::risk::RiskState;
 use heapless::Deque;
 
 /// Capacity of the event queue.
-pub const EVENT_CAPACITY: usize = 8;
+pub const EVENT_CAPACITY: usize = 6;
 
 /// Why the sensors were not trusted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
