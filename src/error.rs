@@ -6,6 +6,7 @@ use core::fmt;
 /// theory's comfort zone is not refused; it is flagged in the result's
 /// [`Validity`](crate::reference::Validity).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum Error {
     /// Radius R1 not finite and positive, or R2 not positive (R2 may be +infinity: a plane).
@@ -59,5 +60,6 @@ impl fmt::Display for Error {
     }
 }
 
-#[cfg(feature = "std")]
-impl std::error::Error for Error {}
+// `core::error::Error` (Rust 1.81): an `Error` is a `std::error::Error` on the host
+// without the `std` feature.
+impl core::error::Error for Error {}

@@ -38,6 +38,7 @@ pub const DEFAULT_RISK_SLIP_RATIO: f32 = 0.8;
 /// The per-sample answer in SI f32, whatever the core. Units: N (N/m for line contact
 /// without a length), rad.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Estimate {
     /// Slip ratio d/b (eqs 16, 23); 0 at phi = 0, +inf at P = 0 with phi != 0.
     pub slip_ratio: f32,

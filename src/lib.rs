@@ -34,6 +34,7 @@ pub mod estimator;
 pub mod fixed;
 pub mod float;
 pub mod kernels;
+pub mod monitor;
 pub mod reference;
 pub mod scene;
 #[cfg(feature = "sensors")]

@@ -5,6 +5,7 @@ use crate::Error;
 
 /// How the auxiliary angle theta follows from the misalignment phi.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ThetaRelation {
     /// The paper's eq (4): `theta = 2 |phi| sqrt(R1 R2) / (R1 + R2)`. Default; the
     /// reference data use it.
@@ -19,6 +20,7 @@ pub enum ThetaRelation {
 /// A validated installation, in SI units. Same elastic material for both bodies,
 /// as the paper assumes.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Scene {
     r1: f64,
     r2: f64,

@@ -13,6 +13,7 @@ use crate::{Error, Scene};
 /// not switch). Loads are counts of the total load (N) when the scene has a length;
 /// without one, line contact reads them as N/m.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FixedAuto {
     /// `None` for a plane.
     elliptic: Option<FixedEllipticScene>,
@@ -31,6 +32,7 @@ pub struct FixedAuto {
 
 /// One sample's answer from a [`FixedAuto`] scene: which model answered and its estimate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FixedAutoEstimate {
     /// The model that answered.
     pub model: ContactModel,
@@ -43,6 +45,7 @@ pub struct FixedAutoEstimate {
 
 /// The contact of one sample on request ([`FixedAuto::details`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum FixedContactDetails {
     /// The ellipse: theta, m, n, a, b, p0.
     Elliptic(FixedDetails),

@@ -16,6 +16,7 @@ use core::f64::consts::PI;
 
 /// A prepared elliptic-contact scene for the fixed-point core.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FixedEllipticScene {
     /// log2(c x angle LSB): log2 theta = this + log2(counts) (eq 4).
     log_theta_lsb: i32,
@@ -304,6 +305,7 @@ impl FixedEllipticScene {
 /// The contact ellipse of one sample in the fixed-point core, as base-2 logarithms:
 /// theta (rad), m, n, a and b (m), p0 (Pa).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FixedDetails {
     /// Auxiliary angle theta (rad), eq (4).
     pub theta: Log2,

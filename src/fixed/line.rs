@@ -15,6 +15,7 @@ use core::f64::consts::PI;
 /// A prepared line-contact scene for the fixed-point core. Loads are per unit length
 /// (N/m) without a scene length, total (N) with one, as for [`crate::float::LineScene`].
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FixedLineScene {
     /// log2 of `sqrt(pi (1 - nu) G R l) / (2 mu)` x angle LSB / sqrt(load LSB) (eq 23).
     log_slip: i32,
@@ -196,6 +197,7 @@ impl FixedLineScene {
 
 /// The contact strip of one sample in the fixed-point core, as base-2 logarithms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FixedLineDetails {
     /// Half-width of the strip b (m), eq (22).
     pub b: Log2,

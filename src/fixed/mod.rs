@@ -37,6 +37,7 @@ use uniform::ONE;
 /// A positive quantity as its base-2 logarithm in Q8.24: `x = 2^(self.0 / 2^24)`.
 /// `i32::MIN` stands for 0 and `i32::MAX` for +infinity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Log2(pub i32);
 
 impl Log2 {
@@ -100,6 +101,7 @@ impl Log2 {
 
 /// What a prepared fixed-point scene accepts per sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct InputRange {
     /// Smallest non-zero load in counts (0 is accepted too); below it the critical
     /// angle would fall under the tables (theta0 < 2^-40).
@@ -111,6 +113,7 @@ pub struct InputRange {
 /// The per-sample answer of the fixed-point core. Units: N (N/m for line contact
 /// without a length), rad, angle counts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FixedEstimate {
     /// log2 of the slip ratio d/b; [`Log2::ZERO`] at zero angle, [`Log2::INFINITY`] at
     /// zero load.
@@ -133,6 +136,7 @@ pub struct FixedEstimate {
 /// The units of a fixed-point scene's inputs: what one count of load and of angle
 /// stands for, kept in f32 to convert SI samples and answers (the estimator contract).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(crate) struct Units {
     /// N (or N/m) per load count.
     load_lsb: f32,

@@ -16,6 +16,7 @@ pub fn mul_q16(a: i32, t: u32) -> i32 {
 
 /// A function tabulated at `start + i 2^-spacing_log2` (Q8.24), `i = 0 .. len`.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct UniformTable<'a> {
     /// Argument of `values[0]`, Q8.24.
     pub start: i32,

@@ -15,6 +15,7 @@ use core::f32::consts::FRAC_PI_2;
 /// Per sample the choice costs one table read (1/m at theta) and a comparison of
 /// 2a = 2 m L (eqs 2, 5-6) with the length.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Auto {
     /// `None` for a plane (or radii whose c underflows f32's tables).
     pub(super) elliptic: Option<EllipticScene<'static>>,
@@ -29,6 +30,7 @@ pub struct Auto {
 
 /// One sample's answer from an [`Auto`] scene: which model answered and its estimate.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AutoEstimate {
     /// The model that answered.
     pub model: ContactModel,
@@ -41,6 +43,7 @@ pub struct AutoEstimate {
 
 /// The contact of one sample on request ([`Auto::details`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ContactDetails {
     /// The ellipse: theta, m, n, a, b, p0.
     Elliptic(Details),

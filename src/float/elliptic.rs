@@ -27,6 +27,7 @@ const FRICTION_LIMIT: f64 = 128.0;
 /// scene declares a narrower range of misalignment can pass narrower ones (built at
 /// compile time with [`crate::kernels::octave::narrow_rows`]) and link only those rows.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Tables<'a> {
     /// g(theta) = m n theta.
     pub g: OctaveTable<'a>,
@@ -44,6 +45,7 @@ impl Tables<'static> {
 
 /// A prepared elliptic-contact scene: the per-sample constants of eqs (4), (16), (18).
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct EllipticScene<'t> {
     /// `c = 2 sqrt(R1 R2) / (R1 + R2)` (eq 4): theta = c |phi|.
     pub(super) radius_factor: f32,
@@ -331,6 +333,7 @@ impl<'t> EllipticScene<'t> {
 
 /// The contact ellipse of one sample, on request ([`EllipticScene::details`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Details {
     /// Auxiliary angle theta (rad), eq (4).
     pub theta: f32,

@@ -12,6 +12,7 @@ use core::f32::consts::FRAC_PI_2;
 /// The load is per unit length (N/m) when the scene has no length, and the total load
 /// (N) when it has one; F follows (N/m or N).
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct LineScene {
     /// `sqrt(pi (1 - nu) G R l) / (2 mu)`: d/b = this |phi| / sqrt(P) (eq 23), l the
     /// length (1 without one).
@@ -201,6 +202,7 @@ impl LineScene {
 
 /// The contact strip of one sample, on request ([`LineScene::details`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct LineDetails {
     /// Half-width of the strip b (m), eq (22).
     pub b: f32,

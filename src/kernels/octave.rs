@@ -14,6 +14,7 @@ pub type Row = [f32; 8];
 /// A function tabulated from `2^first_exponent` up to `2^(first_exponent + rows)`,
 /// each octave a polynomial of degree [`DEGREE`].
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct OctaveTable<'a> {
     /// Biased exponent bits of the first octave (`first_exponent + 127`).
     first_row: u32,

@@ -68,6 +68,7 @@ use core::f64::consts::{FRAC_PI_2, PI};
 
 /// Why a measured axial force fits no state of the model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Inconsistency {
     /// |F| above the largest force the model gives at these inputs (mu P for the
     /// phi-inverse, the no-slip limit for the mu-inverse).
@@ -99,6 +100,7 @@ impl Inconsistency {
 /// The answer of an inverse: which case holds, with what it can say. `T` is `f64` here
 /// and `f32` in [`crate::float`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Inverse<T> {
     /// The unique answer, with its sensitivity `d ln(value) / d ln F` (>= 0; +inf where
     /// the forward map is flat).

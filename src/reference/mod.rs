@@ -44,6 +44,7 @@ pub const SLENDER_LIMIT: f64 = 10.0;
 
 /// Which solution produced a result.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ContactModel {
     /// The contact ellipse, sections 5-7.
     Elliptic,
@@ -55,6 +56,7 @@ pub enum ContactModel {
 /// cores. P is the total load (N) whenever the scene has a length; without one, line
 /// contact reads it as a load per unit length (N/m).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ModelChoice {
     /// Section 9, per sample: line contact with P / length when the ellipse is longer
     /// than the rollers (2a > length), and always for a plane; the ellipse otherwise.
@@ -94,6 +96,7 @@ impl ContactModel {
 /// Where the theory's assumptions are stretched. The numbers are still the paper's
 /// equations evaluated exactly; these flags say how far to trust the physics.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Validity {
     /// |phi| above [`ANGLE_LIMIT`], or a critical angle above it.
     pub large_angle: bool,
@@ -122,6 +125,7 @@ impl Validity {
 
 /// Results of the elliptic solution (sections 5-7) for one sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Elliptic {
     /// Misalignment phi (rad), signed, as given.
     pub phi: f64,
@@ -161,6 +165,7 @@ pub struct Elliptic {
 
 /// Results of the line-contact solution (section 8) for one sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Line {
     /// Misalignment phi (rad), signed, as given.
     pub phi: f64,
@@ -196,6 +201,7 @@ pub struct Line {
 
 /// A result of either model, as chosen by [`estimate`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Estimate {
     /// The ellipse fits on the rollers (or no length was given).
     Elliptic(Elliptic),

@@ -14,6 +14,7 @@ const ASYMPTOTIC_BELOW: f64 = 1e-100;
 /// coefficients m, n of eqs (2)-(3) with the erratum of READING-NOTES.md
 /// (`a = m L`, `b = n L`, `L^3 = 3 P (1 - nu) R1 R2 / (2 G (R1 + R2))`).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct EllipseShape {
     /// Auxiliary angle theta (rad), eq (4).
     pub theta: f64,

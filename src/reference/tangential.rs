@@ -6,6 +6,7 @@ use core::f64::consts::PI;
 
 /// Whether part of the contact still sticks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Regime {
     /// `d/b < 1`: a stick zone at the leading edge, microslip over the rest.
     Partial,

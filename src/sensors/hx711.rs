@@ -58,6 +58,7 @@ pub enum PinError<EIn, EOut> {
 /// PD_SCK must not stay high for 60 µs inside a read, or the chip powers down: an
 /// interrupt handler that can run that long should be masked around [`Adc::read`].
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Hx711<Dout, Sck, D> {
     dout: Dout,
     sck: Sck,

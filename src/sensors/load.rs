@@ -129,6 +129,7 @@ impl LoadCalibration<Hx711Channel> {
 /// A load cell on any [`Adc`] (an [`Hx711`](super::Hx711) as a rule): calibrated
 /// readings in N with their faults detected.
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct LoadCell<A: Adc> {
     adc: A,
     calibration: LoadCalibration<A::Channel>,

@@ -169,6 +169,7 @@ pub struct MisalignmentReading {
 /// Two displacement probes on two channels of one [`Adc`] (e.g. A0 and A1 of an
 /// ADS1115): misalignment readings with both probes' faults detected.
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Misalignment<A: Adc> {
     adc: A,
     channels: (A::Channel, A::Channel),

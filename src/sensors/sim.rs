@@ -27,6 +27,7 @@ use super::{Adc, AdcError, Hx711Channel, LoadCalibration, MisalignmentCalibratio
 
 /// Simulated time, ns, shared by the delays and the simulated chips.
 #[derive(Debug, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SimClock {
     now_ns: Cell<u64>,
 }
@@ -57,6 +58,7 @@ impl SimClock {
 
 /// An embedded-hal delay that advances a [`SimClock`] instead of waiting.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SimDelay<'a> {
     clock: &'a SimClock,
 }
@@ -69,6 +71,7 @@ impl DelayNs for SimDelay<'_> {
 
 /// An injected pin or bus error.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SimError;
 
 impl digital::Error for SimError {
@@ -105,6 +108,7 @@ struct Hx711State<'a> {
 /// A simulated HX711 replaying a trace of raw 24-bit codes (clamped to the rails),
 /// through its two pins ([`dout`](Self::dout), [`sck`](Self::sck)).
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SimHx711<'a> {
     clock: &'a SimClock,
     state: RefCell<Hx711State<'a>>,
@@ -272,12 +276,14 @@ impl<'a> SimHx711<'a> {
 
 /// The simulated HX711's DOUT pin.
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SimDout<'c, 'a> {
     chip: &'c SimHx711<'a>,
 }
 
 /// The simulated HX711's PD_SCK pin.
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SimSck<'c, 'a> {
     chip: &'c SimHx711<'a>,
 }
@@ -313,6 +319,7 @@ impl OutputPin for SimSck<'_, '_> {
 /// A simulated ADC of `N` channels (channel `i` replays `traces[i]` in a loop), with
 /// injectable timeouts and bus errors.
 #[derive(Debug, Clone)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SimAdc<'a, const N: usize> {
     traces: [&'a [i32]; N],
     next: [usize; N],
@@ -426,6 +433,7 @@ pub struct SampleCodes {
 /// probe 1 at `d2_m + zero_offset_m + span_m * tan(phi)`), each with a deterministic
 /// dither of up to `dither` counts (xorshift32), as real noise would have.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct TraceEncoder<C> {
     load: LoadCalibration<C>,
     probes: MisalignmentCalibration,

@@ -32,6 +32,7 @@ use embedded_storage_async::nor_flash as nb;
 /// A blocking `embedded-storage` flash driver seen through the async
 /// `embedded-storage-async` traits, for [`Store`](super::Store).
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct BlockingFlash<F>(pub F);
 
 impl<F: blocking::ErrorType> nb::ErrorType for BlockingFlash<F> {

@@ -108,6 +108,7 @@ pub fn crc32(bytes: &[u8]) -> u32 {
 
 /// Writes little-endian fields into a payload, never past its end.
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Writer<'a> {
     out: &'a mut [u8],
     at: usize,
@@ -192,6 +193,7 @@ impl<'a> Writer<'a> {
 
 /// Reads little-endian fields from a payload, never past its end.
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Reader<'a> {
     bytes: &'a [u8],
     at: usize,
@@ -290,6 +292,7 @@ impl<'a> Reader<'a> {
 /// A record decoded: the value, its checkpoint number and the format version it was
 /// stored in (older than [`Checkpoint::VERSION`] when it was migrated).
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Decoded<T> {
     /// The value, in the current version's type.
     pub value: T,

@@ -24,6 +24,7 @@ use embedded_storage::nor_flash::{
 
 /// Why the mock flash refused an operation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum MockError {
     /// Outside the flash.
     OutOfBounds,
@@ -62,6 +63,7 @@ fn kind_to_error(kind: NorFlashErrorKind) -> MockError {
 /// (0xFF) when made. Implements the blocking `embedded-storage` NOR flash traits;
 /// wrap it in [`BlockingFlash`](super::BlockingFlash) for a [`Store`](super::Store).
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct MockFlash<const SECTORS: usize, const SECTOR: usize, const WORD: usize> {
     sectors: [[u8; SECTOR]; SECTORS],
     erases: [u32; SECTORS],

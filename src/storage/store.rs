@@ -179,6 +179,7 @@ impl StorageEvent {
 
 /// A restored value (if any) and what the restore found.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Restore<T> {
     /// The value, if a checkpoint was restored; start from a fresh state otherwise.
     pub value: Option<T>,

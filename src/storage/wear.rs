@@ -34,6 +34,7 @@ pub const RATED_CYCLES: u32 = 10_000;
 
 /// Flash geometry and record size, for the wear arithmetic.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Geometry {
     /// Payload bytes of the record ([`Checkpoint::SIZE`](super::Checkpoint::SIZE)).
     pub payload: usize,

@@ -1,0 +1,276 @@
+//! The monitor's configuration: one value, validated when the monitor is built.
+
+use core::fmt;
+
+/// Capacity of the spike filter's window (samples).
+pub const SPIKE_WINDOW_CAPACITY: usize = 7;
+/// Capacity of the trend buffer (points).
+pub const TREND_CAPACITY: usize = 16;
+
+/// What the warning and alarm thresholds are set on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Thresholds {
+    /// On the slip ratio d/b (eq 16; eq 23 for line contact): the warning (microslip
+    /// over most of the contact) at `warning`, the alarm (gross slip) at `alarm`; a
+    /// raised state clears only below its threshold minus `deadband`.
+    SlipRatio {
+        /// d/b at which `Microslip` is raised (default 0.8).
+        warning: f32,
+        /// d/b at which `GrossSlip` is raised (default 1.0).
+        alarm: f32,
+        /// Clearing deadband in d/b (default 0.05).
+        deadband: f32,
+    },
+    /// On the margin `phi0 - |phi|` to the critical angle (rad): the warning when the
+    /// margin is at or below `warning`, the alarm at or below `alarm` (0: gross slip);
+    /// a raised state clears only above its threshold plus `deadband`.
+    Margin {
+        /// Margin (rad) at which `Microslip` is raised.
+        warning: f32,
+        /// Margin (rad) at which `GrossSlip` is raised.
+        alarm: f32,
+        /// Clearing deadband (rad).
+        deadband: f32,
+    },
+}
+
+/// Spike rejection: a Hampel test over the last `window` values of load and angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SpikeFilter {
+    /// Window length (samples, 3 to [`SPIKE_WINDOW_CAPACITY`]).
+    pub window: u8,
+    /// A value is a spike when it is further than `k` scaled median absolute
+    /// deviations (1.4826 MAD) plus the floor from the window's median.
+    pub k: f32,
+    /// Absolute floor of the load test (N): noise below it is never a spike.
+    pub load_floor: f32,
+    /// Absolute floor of the angle test (rad).
+    pub angle_floor: f32,
+}
+
+/// Time to critical: the least-squares trend of the margin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TrendConfig {
+    /// One trend point (the mean margin) every this many ms.
+    pub interval_ms: u32,
+    /// Points in the fit (3 to [`TREND_CAPACITY`]): the window is
+    /// `points * interval_ms`.
+    pub points: u8,
+    /// An `Approaching` event when the time to critical falls below this (s).
+    pub horizon_s: f32,
+}
+
+/// The monitor's configuration (SI units; times in ms). [`Config::default`] suits the
+/// demo scene: two steel rollers of 50 mm radius, G = 79.3 GPa, nu = 0.3, mu = 0.3,
+/// loaded with about 1 to 5 kN, sampled about once a second, whose load varies over
+/// tens of minutes (the trend's window, 80 min, spans such a cycle).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Config {
+    /// Warning and alarm thresholds with their deadband.
+    pub thresholds: Thresholds,
+    /// On-delay: a more severe state must hold this long before it is entered (ms);
+    /// a start (`Stopped` to `Normal`) is entered at once.
+    pub on_delay_ms: u32,
+    /// Off-delay: a less severe state (or the end of a sensor fault) must hold this
+    /// long before it is entered (ms); the minimum dwell in a raised state.
+    pub off_delay_ms: u32,
+    /// Delay before a sensor fault is reported (ms; 0: at once).
+    pub fault_delay_ms: u32,
+    /// Start-up inhibit: no warning or alarm for this long after the machine starts
+    /// (first sample or leaving `Stopped`) (ms).
+    pub inhibit_ms: u32,
+    /// Below this load (N) the machine stands: `Stopped`, no alarm, no wear. > 0.
+    pub stop_load: f32,
+    /// Below this measured speed (m/s) the machine stands.
+    pub stop_speed: f32,
+    /// Rolling speed (m/s) for the wear integral when the sample has none.
+    pub nominal_speed: f32,
+    /// Lowest accepted load (N; a load cell reads a little below zero at rest).
+    pub load_min: f32,
+    /// Highest accepted load (N).
+    pub load_max: f32,
+    /// Highest accepted |phi| (rad).
+    pub angle_max: f32,
+    /// Highest accepted speed (m/s).
+    pub speed_max: f32,
+    /// Highest accepted |F| of a measured axial force (N).
+    pub force_max: f32,
+    /// Spike rejection; `None`: off.
+    pub spikes: Option<SpikeFilter>,
+    /// Time constant (s) of the exponential smoothing of load and angle, whose
+    /// weight `1 - exp(-dt / tau)` follows the real time step; 0: off.
+    pub smoothing_tau_s: f32,
+    /// A raw load or angle exactly unchanged while running for longer than this is a
+    /// stuck sensor (ms); 0: off.
+    pub stuck_ms: u32,
+    /// A step between samples longer than this is a gap (dropout) (ms); 0: off.
+    pub gap_ms: u32,
+    /// Time to critical; `None`: off.
+    pub trend: Option<TrendConfig>,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            thresholds: Thresholds::SlipRatio {
+                warning: 0.8,
+                alarm: 1.0,
+                deadband: 0.05,
+            },
+            on_delay_ms: 5_000,
+            off_delay_ms: 30_000,
+            fault_delay_ms: 0,
+            inhibit_ms: 60_000,
+            stop_load: 100.0,
+            stop_speed: 0.1,
+            nominal_speed: 2.0,
+            load_min: -200.0,
+            load_max: 50_000.0,
+            angle_max: 0.05,
+            speed_max: 50.0,
+            force_max: 50_000.0,
+            spikes: Some(SpikeFilter {
+                window: 7,
+                k: 4.0,
+                load_floor: 100.0,
+                angle_floor: 2e-5,
+            }),
+            smoothing_tau_s: 3.0,
+            stuck_ms: 120_000,
+            gap_ms: 10_000,
+            trend: Some(TrendConfig {
+                interval_ms: 300_000,
+                points: 16,
+                horizon_s: 3_600.0,
+            }),
+        }
+    }
+}
+
+/// Why a configuration was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum ConfigError {
+    /// A threshold is not finite (or a d/b threshold not positive).
+    Threshold,
+    /// The warning is not before the alarm (d/b: warning >= alarm; margin:
+    /// warning <= alarm).
+    WarningAboveAlarm,
+    /// The deadband is negative, not finite, or so wide that a warning would never
+    /// clear (at least the warning threshold itself on d/b).
+    Deadband,
+    /// The stop load is not positive and finite, or the stop speed negative.
+    Stop,
+    /// The nominal speed is not positive and finite.
+    NominalSpeed,
+    /// An accepted range is empty or not finite.
+    Range,
+    /// The spike window is outside 3..=[`SPIKE_WINDOW_CAPACITY`], or its k or floors
+    /// are not positive and finite.
+    SpikeWindow,
+    /// The smoothing time constant is negative or not finite.
+    Smoothing,
+    /// The trend has a zero interval, points outside 3..=[`TREND_CAPACITY`], or a
+    /// horizon that is not positive and finite.
+    Trend,
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ConfigError::Threshold => "thresholds must be finite (d/b thresholds positive)",
+            ConfigError::WarningAboveAlarm => "the warning threshold must come before the alarm",
+            ConfigError::Deadband => "deadband must be finite, >= 0 and below the warning",
+            ConfigError::Stop => "stop load must be > 0 and stop speed >= 0, finite",
+            ConfigError::NominalSpeed => "nominal speed must be finite and > 0",
+            ConfigError::Range => "accepted ranges must be finite and non-empty",
+            ConfigError::SpikeWindow => "spike window must be 3..=7 with k, floors > 0",
+            ConfigError::Smoothing => "smoothing time constant must be finite and >= 0",
+            ConfigError::Trend => "trend needs interval > 0, 3..=16 points, horizon > 0",
+        })
+    }
+}
+
+impl core::error::Error for ConfigError {}
+
+fn positive(x: f32) -> bool {
+    x.is_finite() && x > 0.0
+}
+
+impl Config {
+    /// Checks that the configuration is consistent.
+    ///
+    /// # Errors
+    /// The first [`ConfigError`] found.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        match self.thresholds {
+            Thresholds::SlipRatio {
+                warning,
+                alarm,
+                deadband,
+            } => {
+                if !(positive(warning) && positive(alarm)) {
+                    return Err(ConfigError::Threshold);
+                }
+                if warning >= alarm {
+                    return Err(ConfigError::WarningAboveAlarm);
+                }
+                if !(deadband.is_finite() && deadband >= 0.0 && deadband < warning) {
+                    return Err(ConfigError::Deadband);
+                }
+            }
+            Thresholds::Margin {
+                warning,
+                alarm,
+                deadband,
+            } => {
+                if !(warning.is_finite() && alarm.is_finite()) {
+                    return Err(ConfigError::Threshold);
+                }
+                if warning <= alarm {
+                    return Err(ConfigError::WarningAboveAlarm);
+                }
+                if !(deadband.is_finite() && deadband >= 0.0) {
+                    return Err(ConfigError::Deadband);
+                }
+            }
+        }
+        if !(positive(self.stop_load) && self.stop_speed.is_finite() && self.stop_speed >= 0.0) {
+            return Err(ConfigError::Stop);
+        }
+        if !positive(self.nominal_speed) {
+            return Err(ConfigError::NominalSpeed);
+        }
+        let range_ok = self.load_min.is_finite()
+            && self.load_max.is_finite()
+            && self.load_min < self.load_max
+            && self.load_max > self.stop_load
+            && positive(self.angle_max)
+            && positive(self.speed_max)
+            && positive(self.force_max);
+        if !range_ok {
+            return Err(ConfigError::Range);
+        }
+        if let Some(s) = self.spikes {
+            let window_ok = (3..=SPIKE_WINDOW_CAPACITY).contains(&usize::from(s.window));
+            if !(window_ok && positive(s.k) && positive(s.load_floor) && positive(s.angle_floor)) {
+                return Err(ConfigError::SpikeWindow);
+            }
+        }
+        if !(self.smoothing_tau_s.is_finite() && self.smoothing_tau_s >= 0.0) {
+            return Err(ConfigError::Smoothing);
+        }
+        if let Some(t) = self.trend {
+            let points_ok = (3..=TREND_CAPACITY).contains(&usize::from(t.points));
+            if !(t.interval_ms > 0 && points_ok && positive(t.horizon_s)) {
+                return Err(ConfigError::Trend);
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,100 @@
+//! Events: every state change and every `Approaching` warning, numbered, in a
+//! fixed-capacity queue that drops the oldest when full and counts what it dropped.
+
+use super::risk::RiskState;
+use heapless::Deque;
+
+/// Capacity of the event queue.
+pub const EVENT_CAPACITY: usize = 6;
+
+/// Why the sensors were not trusted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FaultCause {
+    /// A value is NaN or infinite.
+    NonFinite(super::Channel),
+    /// A value is outside the configured range.
+    OutOfRange(super::Channel),
+    /// A raw value unchanged for longer than configured.
+    Stuck(super::Channel),
+    /// No sample for longer than configured.
+    Gap,
+    /// The timestamp went backwards (a counter reset, not a wrap).
+    TimeBackwards,
+    /// A sensor driver reported a fault on the channel.
+    Driver(super::Channel),
+    /// The estimator refused the sample (outside the prepared scene's range).
+    Estimator,
+}
+
+/// The values behind an event: the last valid estimate (for a `SensorFault` event,
+/// the one before the fault; all zero when there was none yet). SI units.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Reading {
+    /// Conditioned load P (N).
+    pub load: f32,
+    /// Conditioned misalignment phi (rad).
+    pub phi: f32,
+    /// Slip ratio d/b (eq 16; eq 23 for line contact).
+    pub slip_ratio: f32,
+    /// Axial force F (N; eq 21, 27, 29), measured when the sample carries one.
+    pub axial_force: f32,
+    /// Critical angle phi0 at this load (rad), if one exists.
+    pub critical_angle: Option<f32>,
+    /// Margin `phi0 - |phi|` (rad).
+    pub margin: Option<f32>,
+}
+
+/// What happened.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum EventKind {
+    /// The state changed.
+    StateChange {
+        /// The state left.
+        from: RiskState,
+        /// The state entered.
+        to: RiskState,
+        /// For a change to `SensorFault`, the fault that caused it.
+        fault: Option<FaultCause>,
+    },
+    /// The time to critical fell below the configured horizon.
+    Approaching {
+        /// Estimated time until gross slip at the current drift (s).
+        time_to_critical_s: f32,
+    },
+}
+
+/// One event. Sequence numbers are consecutive from 0, so a consumer sees a dropped
+/// event as a gap; [`Statistics::events_dropped`](super::Statistics::events_dropped)
+/// counts them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Event {
+    /// Sequence number (consecutive, from 0).
+    pub seq: u32,
+    /// The sample's raw timestamp (ms, the node's wrapping counter).
+    pub time_ms: u32,
+    /// Monotonic time since the first sample (ms).
+    pub elapsed_ms: u64,
+    /// What happened.
+    pub kind: EventKind,
+    /// The values that caused it.
+    pub reading: Reading,
+}
+
+/// The queue: a heapless deque; full, it drops its oldest event (the newest say what
+/// holds now; the sequence gap and the counter say what was lost).
+pub(crate) type EventQueue = Deque<Event, EVENT_CAPACITY>;
+
+/// Appends `event`, dropping the oldest when full; returns whether one was dropped.
+pub(crate) fn push(queue: &mut EventQueue, event: Event) -> bool {
+    let dropped = queue.is_full();
+    if dropped {
+        queue.pop_front();
+    }
+    // Not full after the pop above.
+    let _ = queue.push_back(event);
+    dropped
+}

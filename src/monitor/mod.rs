@@ -1,0 +1,441 @@
+//! The condition monitor: from a stream of noisy samples to risk states, events,
+//! wear and time to critical, with no heap and no panic, on the node and on the PC.
+//!
+//! Per sample ([`Monitor::process`]): the clock steps (u32 ms wraps are forward
+//! steps), the sensor checks run (non-finite, out of range, stuck, gap, time
+//! backwards, a driver's report), spikes are replaced by the Hampel window's median,
+//! load and angle are smoothed with a weight that follows the real time step, the
+//! [`Estimator`] answers d/b, F, phi0 and the margin, the state machine applies
+//! thresholds, deadband, on- and off-delays and the start-up inhibit, the
+//! dissipated power F phi V (section 7) is integrated per state, and the margin's
+//! trend gives the time to critical. State changes and `Approaching` warnings go to a
+//! fixed queue that a consumer drains ([`Monitor::pop_event`]).
+//!
+//! **Model choice (section 9).** The elliptic and the line-contact solutions differ
+//! by up to 22 % in d/b where the ellipse reaches the rollers' ends; switching per
+//! sample would make the states chatter there. The monitor *fixes the model for the
+//! scene's operating range*: it is generic over one prepared [`Estimator`], to be
+//! given a scene with one model: [`model_for_range`] chooses it once, from the
+//! declared highest load and smallest misalignment, for
+//! [`float::Auto::with_choice`](crate::float::Auto::with_choice) or
+//! [`fixed::FixedAuto::with_choice`](crate::fixed::FixedAuto::with_choice) (or an
+//! elliptic or line scene directly). d/b is then continuous in the samples, and the
+//! deadband handles the noise. (An `Auto` scene left at `ModelChoice::Section9` would
+//! switch per sample: not for a monitor.)
+//!
+//! **Sensor faults are never slip.** A faulted sample is not estimated; its
+//! candidate state is `SensorFault`, and leaving that state waits the off-delay.
+//!
+//! ```
+//! use misalign::monitor::{Config, Monitor, RiskState, Sample, model_for_range};
+//! use misalign::{Scene, float::Auto};
+//!
+//! let scene = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3)?;
+//! // One model for loads up to 5 kN and misalignments from 10 urad.
+//! let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5)?)?;
+//! let mut monitor = Monitor::new(core, Config::default()).expect("the defaults are valid");
+//! for i in 0..300u32 {
+//!     // About 2 kN and 0.1 mrad with some noise (a value exactly constant for two
+//!     // minutes is a stuck sensor), one sample a second.
+//!     let noise = (i % 7) as f32;
+//!     let (load, phi) = (2e3 + noise, 1e-4 + 1e-7 * noise);
+//!     monitor.process(Sample::new(i * 1000, load, phi).with_speed(2.0));
+//! }
+//! assert_eq!(monitor.state(), RiskState::Normal);
+//! assert!(monitor.statistics().total_energy() > 0.0);
+//! while let Some(event) = monitor.pop_event() {
+//!     assert_eq!(event.seq, 0); // Stopped -> Normal
+//! }
+//! # Ok::<(), misalign::Error>(())
+//! ```
+
+mod condition;
+mod config;
+mod events;
+mod model;
+mod risk;
+mod sample;
+pub mod scenario;
+mod state;
+mod stats;
+mod trend;
+mod wear;
+
+pub use condition::StuckTracker;
+pub use config::{
+    Config, ConfigError, SPIKE_WINDOW_CAPACITY, SpikeFilter, TREND_CAPACITY, Thresholds,
+    TrendConfig,
+};
+pub use events::{EVENT_CAPACITY, Event, EventKind, FaultCause, Reading};
+pub use model::model_for_range;
+pub use risk::{Alarm, RiskState};
+pub use sample::{Channel, Clock, Sample};
+pub use state::{MonitorState, STATE_BUDGET_BYTES, Saved, Status};
+pub use stats::{FaultCounts, Statistics};
+pub use trend::{TrendInterval, TrendPoint, time_to_critical};
+pub use wear::{EnergySum, dissipated_power};
+
+use crate::Estimator;
+use sample::Step;
+
+/// The condition monitor over one prepared scene of either core.
+#[derive(Debug, Clone)]
+pub struct Monitor<E> {
+    estimator: E,
+    config: Config,
+    status: Status,
+    load_window: condition::Window,
+    angle_window: condition::Window,
+    trend: trend::TrendBuffer,
+    events: events::EventQueue,
+}
+
+/// The monitor's state, time, status and undelivered events (the estimator, the
+/// configuration and the buffers are left out).
+#[cfg(feature = "defmt")]
+impl<E> defmt::Format for Monitor<E> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(
+            f,
+            "Monitor {{ state: {}, status: {}, pending_events: {} }}",
+            self.status.alarm.state,
+            self.status,
+            self.events.len()
+        );
+    }
+}
+
+/// Checks one channel's value: non-finite, then out of `[lo, hi]`.
+fn check(x: f32, lo: f32, hi: f32, channel: Channel) -> Option<FaultCause> {
+    if !x.is_finite() {
+        Some(FaultCause::NonFinite(channel))
+    } else if x < lo || x > hi {
+        Some(FaultCause::OutOfRange(channel))
+    } else {
+        None
+    }
+}
+
+impl<E: Estimator> Monitor<E> {
+    /// A monitor at rest (`Stopped`) over `estimator`.
+    ///
+    /// # Errors
+    /// The [`ConfigError`] of an inconsistent configuration.
+    pub fn new(estimator: E, config: Config) -> Result<Self, ConfigError> {
+        config.validate()?;
+        Ok(Monitor {
+            estimator,
+            config,
+            status: Status::new(),
+            load_window: condition::Window::new(),
+            angle_window: condition::Window::new(),
+            trend: trend::TrendBuffer::new(),
+            events: events::EventQueue::new(),
+        })
+    }
+
+    /// The reported state.
+    pub fn state(&self) -> RiskState {
+        self.status.alarm.state
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The estimator.
+    pub fn estimator(&self) -> &E {
+        &self.estimator
+    }
+
+    /// What the monitor has counted and integrated.
+    pub fn statistics(&self) -> &Statistics {
+        &self.status.stats
+    }
+
+    /// The last valid running reading, if any.
+    pub fn reading(&self) -> Option<Reading> {
+        self.status.reading
+    }
+
+    /// The latest estimate of the time until gross slip (s) at the current drift of
+    /// the margin; `None` while the margin does not fall or the trend is off.
+    pub fn time_to_critical(&self) -> Option<f32> {
+        self.status.time_to_critical_s
+    }
+
+    /// Monotonic time since the first sample (ms).
+    pub fn elapsed_ms(&self) -> u64 {
+        self.status.clock.elapsed_ms
+    }
+
+    /// The oldest undelivered event.
+    pub fn pop_event(&mut self) -> Option<Event> {
+        self.events.pop_front()
+    }
+
+    /// Undelivered events.
+    pub fn pending_events(&self) -> usize {
+        self.events.len()
+    }
+
+    fn emit(&mut self, kind: EventKind, time_ms: u32) {
+        let event = Event {
+            seq: self.status.next_seq,
+            time_ms,
+            elapsed_ms: self.status.clock.elapsed_ms,
+            kind,
+            reading: self.status.reading.unwrap_or_default(),
+        };
+        self.status.next_seq = self.status.next_seq.wrapping_add(1);
+        if events::push(&mut self.events, event) {
+            let d = &mut self.status.stats.events_dropped;
+            *d = d.saturating_add(1);
+        }
+    }
+
+    /// Clears the conditioning after a sample that was not estimated (a fault, a
+    /// stop): the values before it say nothing about the ones after.
+    fn restart_conditioning(&mut self) {
+        self.load_window.clear();
+        self.angle_window.clear();
+        self.status.smoothed = None;
+    }
+
+    /// Processes one sample and returns the state after it. Never panics; whatever
+    /// the input, bad values are counted as faults and reported as `SensorFault`,
+    /// never as slip.
+    pub fn process(&mut self, sample: Sample) -> RiskState {
+        let config = self.config;
+        let st = &mut self.status;
+        st.stats.samples = st.stats.samples.saturating_add(1);
+        let held = st.alarm.state;
+        let mut fault = None;
+        let dt_ms = match st.clock.step(sample.time_ms) {
+            Step::First => 0,
+            Step::Forward(d) => d,
+            Step::Repeated => {
+                let r = &mut st.stats.repeated_timestamps;
+                *r = r.saturating_add(1);
+                return held;
+            }
+            Step::Backwards => {
+                fault = Some(FaultCause::TimeBackwards);
+                0
+            }
+        };
+        let now = st.clock.elapsed_ms;
+        // Each step counts for the state held during it.
+        let t = &mut st.stats.time_in_state_ms[held.index()];
+        *t = t.saturating_add(u64::from(dt_ms));
+        if config.gap_ms > 0 && dt_ms > config.gap_ms {
+            fault = Some(FaultCause::Gap);
+        }
+        let st = &mut self.status;
+        // Sensor checks, the first fault found wins.
+        let speed = sample.speed.unwrap_or(config.nominal_speed);
+        fault = fault
+            .or(sample.driver_fault.map(FaultCause::Driver))
+            .or_else(|| check(sample.load, config.load_min, config.load_max, Channel::Load))
+            .or_else(|| {
+                check(
+                    sample.phi,
+                    -config.angle_max,
+                    config.angle_max,
+                    Channel::Angle,
+                )
+            })
+            .or_else(|| check(speed, 0.0, config.speed_max, Channel::Speed))
+            .or_else(|| {
+                let f = sample.axial_force?;
+                check(f, -config.force_max, config.force_max, Channel::AxialForce)
+            });
+        let running = sample.load >= config.stop_load && speed >= config.stop_speed;
+        if fault.is_none() && config.stuck_ms > 0 {
+            let load_stuck = st.stuck[0].stuck(sample.load, now, config.stuck_ms, !running);
+            let angle_stuck = st.stuck[1].stuck(sample.phi, now, config.stuck_ms, !running);
+            if load_stuck {
+                fault = Some(FaultCause::Stuck(Channel::Load));
+            } else if angle_stuck {
+                fault = Some(FaultCause::Stuck(Channel::Angle));
+            }
+        }
+        let candidate = match fault {
+            Some(_) => RiskState::SensorFault,
+            None if !running => RiskState::Stopped,
+            None => {
+                st.alarm.note_running(now);
+                match self.estimate(sample, dt_ms, held, now) {
+                    Ok(c) => c,
+                    Err(f) => {
+                        fault = Some(f);
+                        RiskState::SensorFault
+                    }
+                }
+            }
+        };
+        if let Some(f) = fault {
+            self.status.stats.faults.count(f);
+        }
+        if candidate == RiskState::SensorFault || candidate == RiskState::Stopped {
+            // Not estimated: what the windows and the filter hold is stale now.
+            self.restart_conditioning();
+        }
+        let changed = self.status.alarm.offer(&config, candidate, now);
+        let st = &mut self.status;
+        if st.energy_step > 0.0 {
+            st.stats.energy[st.alarm.state.index()].add(st.energy_step);
+            st.energy_step = 0.0;
+        }
+        if let Some(from) = changed {
+            let to = self.status.alarm.state;
+            let cause = if to == RiskState::SensorFault {
+                fault
+            } else {
+                None
+            };
+            self.emit(
+                EventKind::StateChange {
+                    from,
+                    to,
+                    fault: cause,
+                },
+                sample.time_ms,
+            );
+        }
+        self.approaching(sample.time_ms);
+        self.status.alarm.state
+    }
+
+    /// Conditioning, estimate, wear and trend of a valid running sample; the slip
+    /// level it asks for, or the fault that stops it.
+    fn estimate(
+        &mut self,
+        sample: Sample,
+        dt_ms: u32,
+        held: RiskState,
+        now: u64,
+    ) -> Result<RiskState, FaultCause> {
+        let config = &self.config;
+        let st = &mut self.status;
+        let (mut load, mut phi) = (sample.load, sample.phi);
+        if let Some(filter) = &config.spikes {
+            if let Some(m) = self.load_window.hampel(load, filter, filter.load_floor) {
+                load = m;
+                st.stats.spikes = st.stats.spikes.saturating_add(1);
+            }
+            if let Some(m) = self.angle_window.hampel(phi, filter, filter.angle_floor) {
+                phi = m;
+                st.stats.spikes = st.stats.spikes.saturating_add(1);
+            }
+        }
+        let dt_s = dt_ms as f32 * 1e-3;
+        if config.smoothing_tau_s > 0.0 {
+            if let Some([l, p]) = st.smoothed {
+                let w = condition::smoothing_weight(dt_s, config.smoothing_tau_s);
+                load = l + w * (load - l);
+                phi = p + w * (phi - p);
+            }
+            st.smoothed = Some([load, phi]);
+        }
+        // A load cell reads a little below zero at rest; the contact has none.
+        let load = load.max(0.0);
+        let e = self
+            .estimator
+            .estimate_si(load, phi)
+            .map_err(|_| FaultCause::Estimator)?;
+        // The cores answer finite d/b for a running load; anything else is refused,
+        // never carried on as NaN.
+        if e.slip_ratio.is_nan() || !e.axial_force.is_finite() {
+            return Err(FaultCause::Estimator);
+        }
+        let margin = e.margin.filter(|m| m.is_finite());
+        let force = sample.axial_force.unwrap_or(e.axial_force);
+        st.reading = Some(Reading {
+            load,
+            phi,
+            slip_ratio: e.slip_ratio,
+            axial_force: force,
+            critical_angle: e.critical_angle.filter(|c| c.is_finite()),
+            margin,
+        });
+        let s = &mut st.stats;
+        s.max_slip_ratio = s.max_slip_ratio.max(e.slip_ratio);
+        s.max_axial_force = s.max_axial_force.max(force.abs());
+        if let Some(m) = margin {
+            s.min_margin = Some(s.min_margin.map_or(m, |x| x.min(m)));
+        }
+        // Wear (section 7): the power F phi V over the step ending here, for the
+        // state reported after this sample (never `Stopped`: a running sample leaves it).
+        let speed = sample.speed.unwrap_or(config.nominal_speed);
+        st.energy_step = dissipated_power(force, phi, speed) * dt_s;
+        let level = if st.alarm.inhibited(config, now) {
+            RiskState::Normal
+        } else {
+            risk::slip_level(&config.thresholds, e.slip_ratio, margin, held)
+        };
+        if let (Some(tc), Some(m)) = (config.trend, margin) {
+            let iv = &mut st.trend_interval;
+            if iv.count == 0 {
+                iv.start_ms = now;
+            }
+            iv.sum += m;
+            iv.count = iv.count.saturating_add(1);
+            if now.saturating_sub(iv.start_ms) >= u64::from(tc.interval_ms) {
+                let point = TrendPoint {
+                    time_ms: now as u32,
+                    margin: iv.sum / iv.count as f32,
+                };
+                *iv = TrendInterval::default();
+                // Points older than the window leave (after a stop, say).
+                let window = u64::from(tc.interval_ms) * u64::from(tc.points);
+                while let Some(old) = self.trend.front() {
+                    if u64::from((now as u32).wrapping_sub(old.time_ms)) > window {
+                        self.trend.pop_front();
+                    } else {
+                        break;
+                    }
+                }
+                trend::push(&mut self.trend, point, usize::from(tc.points));
+                // The fit waits for a full window: a shorter one mistakes the load's
+                // cycles for a drift.
+                if self.trend.len() < usize::from(tc.points) {
+                    st.time_to_critical_s = None;
+                    return Ok(level);
+                }
+                let mut points = [TrendPoint::default(); config::TREND_CAPACITY];
+                for (slot, p) in points.iter_mut().zip(self.trend.iter()) {
+                    *slot = *p;
+                }
+                let n = self.trend.len().min(config::TREND_CAPACITY);
+                st.time_to_critical_s = time_to_critical(&points[..n]);
+            }
+        }
+        Ok(level)
+    }
+
+    /// The `Approaching` event: once when the time to critical falls below the
+    /// horizon while the contact still sticks; re-armed above 1.5 horizons.
+    fn approaching(&mut self, time_ms: u32) {
+        let Some(tc) = self.config.trend else { return };
+        let st = &mut self.status;
+        let ttc = st.time_to_critical_s;
+        match ttc {
+            Some(t) if t < tc.horizon_s => {
+                let live = matches!(st.alarm.state, RiskState::Normal | RiskState::Microslip);
+                if st.approaching_armed && live {
+                    st.approaching_armed = false;
+                    self.emit(
+                        EventKind::Approaching {
+                            time_to_critical_s: t,
+                        },
+                        time_ms,
+                    );
+                }
+            }
+            Some(t) if t < 1.5 * tc.horizon_s => {}
+            _ => st.approaching_armed = true,
+        }
+    }
+}

@@ -1,0 +1,197 @@
+//! Risk states with the alarm conventions of ISA-18.2 / IEC 62682: thresholds with a
+//! clearing deadband, on-delay, off-delay (minimum dwell), start-up inhibit; a sensor
+//! fault is a state of its own and never reported as slip.
+
+use super::config::{Config, Thresholds};
+
+/// The roller pair's state as the monitor reports it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RiskState {
+    /// Load or speed below the stop thresholds: no alarm, no wear.
+    Stopped,
+    /// Running with part of the contact sticking, below the warning.
+    Normal,
+    /// Warning: microslip over most of the contact (d/b at the warning threshold or the
+    /// margin to the critical angle small).
+    Microslip,
+    /// Alarm: gross slip (d/b at the alarm threshold, or no margin left).
+    GrossSlip,
+    /// The sensors cannot be trusted (non-finite, out of range, stuck, gap, time
+    /// backwards, a driver's report, a sample the estimator refused).
+    SensorFault,
+}
+
+impl RiskState {
+    /// Every state, in the order of [`RiskState::index`].
+    pub const ALL: [RiskState; 5] = [
+        RiskState::Stopped,
+        RiskState::Normal,
+        RiskState::Microslip,
+        RiskState::GrossSlip,
+        RiskState::SensorFault,
+    ];
+
+    /// The state's index in per-state arrays (0 to 4, the order of [`RiskState::ALL`]).
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// A short lower-case name: `stopped`, `normal`, `microslip`, `gross_slip`,
+    /// `sensor_fault`.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            RiskState::Stopped => "stopped",
+            RiskState::Normal => "normal",
+            RiskState::Microslip => "microslip",
+            RiskState::GrossSlip => "gross_slip",
+            RiskState::SensorFault => "sensor_fault",
+        }
+    }
+
+    /// Severity order: Stopped < Normal < Microslip < GrossSlip < SensorFault. A step
+    /// up waits the on-delay (a start, Stopped to Normal, none), a step down the
+    /// off-delay, a sensor fault the fault delay.
+    const fn rank(self) -> u8 {
+        self as u8
+    }
+}
+
+/// The slip level of a valid running sample, with the deadband relative to the
+/// current state: a raised level stays until the value is past its threshold by the
+/// deadband.
+pub(crate) fn slip_level(
+    thresholds: &Thresholds,
+    slip_ratio: f32,
+    margin: Option<f32>,
+    current: RiskState,
+) -> RiskState {
+    // One scale growing with risk: d/b, or minus the margin. No critical angle at
+    // this load (elliptic contact at very high load) means no gross slip: -inf.
+    let (x, warning, alarm, deadband) = match *thresholds {
+        Thresholds::SlipRatio {
+            warning,
+            alarm,
+            deadband,
+        } => (slip_ratio, warning, alarm, deadband),
+        Thresholds::Margin {
+            warning,
+            alarm,
+            deadband,
+        } => (
+            margin.map_or(f32::NEG_INFINITY, |m| -m),
+            -warning,
+            -alarm,
+            deadband,
+        ),
+    };
+    let held = |state: RiskState| current == state || current.rank() > state.rank();
+    let gross = x >= alarm || (current == RiskState::GrossSlip && x >= alarm - deadband);
+    let micro = x >= warning
+        || (held(RiskState::Microslip)
+            && current != RiskState::SensorFault
+            && x >= warning - deadband);
+    if gross {
+        RiskState::GrossSlip
+    } else if micro {
+        RiskState::Microslip
+    } else {
+        RiskState::Normal
+    }
+}
+
+/// The state machine: the current state, since when, and the pending candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Alarm {
+    /// The reported state.
+    pub state: RiskState,
+    /// Monotonic time (ms) the state was entered.
+    pub since_ms: u64,
+    /// A different candidate and the time (ms) it first appeared, on the same side
+    /// (more or less severe) since.
+    pub pending: Option<(RiskState, u64)>,
+    /// Monotonic time (ms) the machine last started (its first running sample since
+    /// the monitor started or since the state was `Stopped`): the start-up inhibit runs
+    /// from here.
+    pub started_ms: Option<u64>,
+}
+
+impl Alarm {
+    /// The machine at rest before the first sample.
+    pub(crate) const fn new() -> Self {
+        Alarm {
+            state: RiskState::Stopped,
+            since_ms: 0,
+            pending: None,
+            started_ms: None,
+        }
+    }
+
+    /// The delay (ms) a candidate must hold before the state moves from `from` to `to`.
+    pub(crate) fn delay_ms(config: &Config, from: RiskState, to: RiskState) -> u32 {
+        if to == RiskState::SensorFault {
+            config.fault_delay_ms
+        } else if from == RiskState::Stopped && to == RiskState::Normal {
+            // A start is no alarm (the start-up inhibit guards what follows); chatter
+            // at the stop load is bounded by the off-delay back to `Stopped`.
+            0
+        } else if to.rank() > from.rank() {
+            config.on_delay_ms
+        } else {
+            config.off_delay_ms
+        }
+    }
+
+    /// Whether the start-up inhibit suppresses warnings and alarms at `now_ms`.
+    pub(crate) fn inhibited(&self, config: &Config, now_ms: u64) -> bool {
+        self.started_ms
+            .is_none_or(|s| now_ms.saturating_sub(s) < u64::from(config.inhibit_ms))
+    }
+
+    /// Notes a running sample at `now_ms`: the first since the monitor started or
+    /// since the state was `Stopped` starts the start-up inhibit. A stop that is not
+    /// reported (shorter than the off-delay) does not restart it, so that a dip of
+    /// the load never clears an alarm through the inhibit.
+    pub(crate) fn note_running(&mut self, now_ms: u64) {
+        if self.started_ms.is_none() {
+            self.started_ms = Some(now_ms);
+        }
+    }
+
+    /// Offers this sample's candidate state at `now_ms`; returns `Some(previous)` when
+    /// the state changes. The candidate must hold for the transition's delay; a
+    /// candidate that changes but stays on the same side of the current state keeps
+    /// its start time (its delay class is the same), any other restarts it.
+    pub(crate) fn offer(
+        &mut self,
+        config: &Config,
+        candidate: RiskState,
+        now_ms: u64,
+    ) -> Option<RiskState> {
+        if candidate == self.state {
+            self.pending = None;
+            return None;
+        }
+        let up = |s: RiskState| s.rank() > self.state.rank();
+        let since = match self.pending {
+            Some((p, t)) if up(p) == up(candidate) => t,
+            _ => now_ms,
+        };
+        self.pending = Some((candidate, since));
+        let delay = Self::delay_ms(config, self.state, candidate);
+        if now_ms.saturating_sub(since) >= u64::from(delay) {
+            let previous = self.state;
+            self.state = candidate;
+            if candidate == RiskState::Stopped {
+                // The next start runs the start-up inhibit again.
+                self.started_ms = None;
+            }
+            self.since_ms = now_ms;
+            self.pending = None;
+            Some(previous)
+        } else {
+            None
+        }
+    }
+}

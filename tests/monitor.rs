@@ -1,0 +1,721 @@
+//! The condition monitor (`misalign::monitor`): states, delays, deadband, inhibit,
+//! faults, events, wear, trend, configuration and persistence.
+
+use misalign::float::EllipticScene;
+use misalign::monitor::{
+    Channel, Config, ConfigError, EnergySum, EventKind, FaultCause, Monitor, RiskState, Sample,
+    Thresholds, TrendConfig, scenario,
+};
+use misalign::{Estimator, Scene};
+
+const LOAD: f32 = 2000.0;
+
+fn core() -> EllipticScene<'static> {
+    EllipticScene::new(&Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap()).unwrap()
+}
+
+/// The defaults with conditioning, trend and inhibit off: states follow the raw samples.
+fn plain() -> Config {
+    Config {
+        spikes: None,
+        smoothing_tau_s: 0.0,
+        stuck_ms: 0,
+        gap_ms: 0,
+        trend: None,
+        inhibit_ms: 0,
+        ..Config::default()
+    }
+}
+
+/// The misalignment (rad) at which d/b = `target` at `load`, by bisection.
+fn angle_for(target: f32, load: f32) -> f32 {
+    let c = core();
+    let (mut lo, mut hi) = (0.0f32, 0.01f32);
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if c.estimate_si(load, mid).unwrap().slip_ratio < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
+/// Feeds one sample a second at `phi` from `t0` (s) for `n` samples; returns the
+/// states after each.
+fn feed<E: Estimator>(m: &mut Monitor<E>, t0: u32, n: u32, phi: f32) -> Vec<RiskState> {
+    (0..n)
+        .map(|i| m.process(Sample::new((t0 + i) * 1000, LOAD, phi)))
+        .collect()
+}
+
+fn changes<E: Estimator>(m: &mut Monitor<E>) -> Vec<(u64, RiskState, RiskState)> {
+    let mut v = Vec::new();
+    while let Some(e) = m.pop_event() {
+        if let EventKind::StateChange { from, to, .. } = e.kind {
+            v.push((e.elapsed_ms, from, to));
+        }
+    }
+    v
+}
+
+#[test]
+fn states_follow_the_slip_ratio_thresholds() {
+    let mut m = Monitor::new(
+        core(),
+        Config {
+            on_delay_ms: 0,
+            off_delay_ms: 0,
+            ..plain()
+        },
+    )
+    .unwrap();
+    assert_eq!(
+        feed(&mut m, 0, 1, angle_for(0.5, LOAD))[0],
+        RiskState::Normal
+    );
+    assert_eq!(
+        feed(&mut m, 1, 1, angle_for(0.85, LOAD))[0],
+        RiskState::Microslip
+    );
+    assert_eq!(
+        feed(&mut m, 2, 1, angle_for(1.05, LOAD))[0],
+        RiskState::GrossSlip
+    );
+    let r = m.reading().unwrap();
+    assert!(r.slip_ratio >= 1.0 && r.margin.unwrap() < 0.0);
+    let c = changes(&mut m);
+    let to: Vec<_> = c.iter().map(|x| x.2).collect();
+    assert_eq!(
+        to,
+        [
+            RiskState::Normal,
+            RiskState::Microslip,
+            RiskState::GrossSlip
+        ]
+    );
+}
+
+#[test]
+fn margin_thresholds_raise_on_the_margin() {
+    let thresholds = Thresholds::Margin {
+        warning: 1e-4,
+        alarm: 0.0,
+        deadband: 1e-5,
+    };
+    let mut m = Monitor::new(
+        core(),
+        Config {
+            on_delay_ms: 0,
+            off_delay_ms: 0,
+            thresholds,
+            ..plain()
+        },
+    )
+    .unwrap();
+    let phi0 = core()
+        .estimate_si(LOAD, 0.0)
+        .unwrap()
+        .critical_angle
+        .unwrap();
+    assert_eq!(feed(&mut m, 0, 1, phi0 - 2e-4)[0], RiskState::Normal);
+    assert_eq!(feed(&mut m, 1, 1, phi0 - 0.5e-4)[0], RiskState::Microslip);
+    assert_eq!(feed(&mut m, 2, 1, phi0 + 1e-5)[0], RiskState::GrossSlip);
+}
+
+#[test]
+fn on_delay_holds_a_raise_back_and_short_excursions_raise_nothing() {
+    let mut m = Monitor::new(core(), plain()).unwrap(); // on-delay 5 s
+    feed(&mut m, 0, 10, angle_for(0.5, LOAD));
+    // 4 s above the alarm: shorter than the on-delay.
+    assert!(
+        feed(&mut m, 10, 4, angle_for(1.1, LOAD))
+            .iter()
+            .all(|&s| s == RiskState::Normal)
+    );
+    feed(&mut m, 14, 10, angle_for(0.5, LOAD));
+    // Held: raised exactly 5 s after the first alarm-level sample.
+    let states = feed(&mut m, 24, 8, angle_for(1.1, LOAD));
+    assert_eq!(states[4], RiskState::Normal);
+    assert_eq!(states[5], RiskState::GrossSlip);
+    let c = changes(&mut m);
+    assert_eq!(
+        c.last().unwrap(),
+        &(29_000, RiskState::Normal, RiskState::GrossSlip)
+    );
+}
+
+#[test]
+fn deadband_and_off_delay_clear_late() {
+    let mut m = Monitor::new(core(), plain()).unwrap(); // deadband 0.05, off-delay 30 s
+    feed(&mut m, 0, 10, angle_for(0.85, LOAD));
+    assert_eq!(m.state(), RiskState::Microslip);
+    // 0.78: below the warning but inside its deadband: stays raised however long.
+    assert!(
+        feed(&mut m, 10, 100, angle_for(0.78, LOAD))
+            .iter()
+            .all(|&s| s == RiskState::Microslip)
+    );
+    // 0.7: below the deadband; clears after the 30 s off-delay, not before.
+    let states = feed(&mut m, 110, 40, angle_for(0.7, LOAD));
+    assert_eq!(states[29], RiskState::Microslip);
+    assert_eq!(states[30], RiskState::Normal);
+}
+
+#[test]
+fn start_up_inhibit_suppresses_alarms_after_a_start() {
+    let config = Config {
+        inhibit_ms: 20_000,
+        on_delay_ms: 0,
+        ..plain()
+    };
+    let mut m = Monitor::new(core(), config).unwrap();
+    let states = feed(&mut m, 0, 30, angle_for(1.2, LOAD));
+    assert!(states[..20].iter().all(|&s| s == RiskState::Normal));
+    assert_eq!(states[20], RiskState::GrossSlip);
+    // A stop, then a start: inhibited again.
+    for i in 30..80 {
+        m.process(Sample::new(i * 1000, 0.0, 1e-4));
+    }
+    assert_eq!(m.state(), RiskState::Stopped);
+    let states = feed(&mut m, 80, 30, angle_for(1.2, LOAD));
+    assert!(states[..20].iter().all(|&s| s == RiskState::Normal));
+    assert_eq!(states[20], RiskState::GrossSlip);
+}
+
+#[test]
+fn a_load_dip_shorter_than_the_off_delay_neither_stops_nor_clears_an_alarm() {
+    // An inhibit (60 s) longer than the off-delay (30 s): were the dip a start, the
+    // inhibit would clear the alarm.
+    let config = Config {
+        inhibit_ms: 60_000,
+        on_delay_ms: 0,
+        ..plain()
+    };
+    let mut m = Monitor::new(core(), config).unwrap();
+    feed(&mut m, 0, 70, angle_for(1.2, LOAD));
+    assert_eq!(m.state(), RiskState::GrossSlip);
+    // Two samples below the stop load, then the alarm condition goes on.
+    m.process(Sample::new(70_000, 10.0, angle_for(1.2, LOAD)));
+    m.process(Sample::new(71_000, 10.0, angle_for(1.2, LOAD)));
+    let states = feed(&mut m, 72, 90, angle_for(1.2, LOAD));
+    assert!(states.iter().all(|&s| s == RiskState::GrossSlip));
+}
+
+#[test]
+fn stopped_has_no_alarm_and_no_wear() {
+    let mut m = Monitor::new(core(), plain()).unwrap();
+    feed(&mut m, 0, 60, angle_for(0.5, LOAD));
+    // Load below the stop load, then standing still at full load (speed 0).
+    for i in 60..200 {
+        let s = if i < 130 {
+            Sample::new(i * 1000, 50.0, 3e-3).with_speed(2.0)
+        } else {
+            Sample::new(i * 1000, LOAD, 3e-3).with_speed(0.0)
+        };
+        m.process(s);
+    }
+    assert_eq!(m.state(), RiskState::Stopped);
+    let s = m.statistics();
+    assert_eq!(s.energy[RiskState::Stopped.index()].total(), 0.0);
+    assert!(s.time_in_state_ms[RiskState::Stopped.index()] >= 100_000);
+    let c = changes(&mut m);
+    assert!(
+        c.iter()
+            .all(|x| x.2 != RiskState::GrossSlip && x.2 != RiskState::Microslip)
+    );
+}
+
+#[test]
+fn sensor_faults_are_never_slip() {
+    let config = Config {
+        stuck_ms: 10_000,
+        gap_ms: 5_000,
+        on_delay_ms: 0,
+        ..plain()
+    };
+    let bad: [(Sample, FaultCause); 7] = [
+        (
+            Sample::new(0, LOAD, f32::NAN),
+            FaultCause::NonFinite(Channel::Angle),
+        ),
+        (
+            Sample::new(0, f32::INFINITY, 1e-3),
+            FaultCause::NonFinite(Channel::Load),
+        ),
+        (
+            Sample::new(0, -5e3, 1e-3),
+            FaultCause::OutOfRange(Channel::Load),
+        ),
+        (
+            Sample::new(0, LOAD, 0.5),
+            FaultCause::OutOfRange(Channel::Angle),
+        ),
+        (
+            Sample::new(0, LOAD, 1e-3).with_speed(-1.0),
+            FaultCause::OutOfRange(Channel::Speed),
+        ),
+        (
+            Sample::new(0, LOAD, 1e-3).with_axial_force(f32::NAN),
+            FaultCause::NonFinite(Channel::AxialForce),
+        ),
+        (
+            Sample {
+                driver_fault: Some(Channel::Angle),
+                ..Sample::new(0, LOAD, 1e-3)
+            },
+            FaultCause::Driver(Channel::Angle),
+        ),
+    ];
+    for (sample, cause) in bad {
+        let mut m = Monitor::new(core(), config).unwrap();
+        feed(&mut m, 0, 10, angle_for(1.2, LOAD)); // gross slip
+        assert_eq!(m.state(), RiskState::GrossSlip);
+        changes(&mut m);
+        let state = m.process(Sample {
+            time_ms: 10_000,
+            ..sample
+        });
+        assert_eq!(state, RiskState::SensorFault, "{cause:?}");
+        let e = m.pop_event().unwrap();
+        assert_eq!(
+            e.kind,
+            EventKind::StateChange {
+                from: RiskState::GrossSlip,
+                to: RiskState::SensorFault,
+                fault: Some(cause)
+            }
+        );
+        // The values reported are the last valid ones, never the bad sample's.
+        assert!(e.reading.slip_ratio.is_finite() && e.reading.phi.is_finite());
+        assert_eq!(m.statistics().faults.total(), 1);
+    }
+    // Stuck: the same raw angle for longer than 10 s while running.
+    let mut m = Monitor::new(core(), config).unwrap();
+    let states = feed(&mut m, 0, 15, angle_for(0.5, LOAD));
+    assert_eq!(states[10], RiskState::Normal);
+    assert_eq!(states[11], RiskState::SensorFault);
+    assert!(m.statistics().faults.stuck > 0);
+    // A gap, then time going backwards.
+    let mut m = Monitor::new(core(), config).unwrap();
+    m.process(Sample::new(0, LOAD, 1e-4));
+    assert_eq!(
+        m.process(Sample::new(6_000, LOAD, 1.1e-4)),
+        RiskState::SensorFault
+    );
+    assert_eq!(m.statistics().faults.gap, 1);
+    m.process(Sample::new(3_000, LOAD, 1.2e-4));
+    assert_eq!(m.statistics().faults.time_backwards, 1);
+    // ... the clock goes on from the new value.
+    m.process(Sample::new(4_000, LOAD, 1.3e-4));
+    assert_eq!(m.elapsed_ms(), 7_000);
+}
+
+#[test]
+fn fault_clears_only_after_the_off_delay_of_good_samples() {
+    let mut m = Monitor::new(core(), plain()).unwrap();
+    feed(&mut m, 0, 5, angle_for(0.5, LOAD));
+    m.process(Sample::new(5_000, f32::NAN, 1e-4));
+    let states = feed(&mut m, 6, 40, angle_for(0.5, LOAD));
+    // Off-delay 30 s from the first good sample (t = 6 s).
+    assert_eq!(states[29], RiskState::SensorFault);
+    assert_eq!(states[30], RiskState::Normal);
+}
+
+#[test]
+fn a_wrapping_clock_is_not_time_going_backwards() {
+    let mut m = Monitor::new(
+        core(),
+        Config {
+            gap_ms: 5_000,
+            ..plain()
+        },
+    )
+    .unwrap();
+    let start = u32::MAX - 2_500;
+    for i in 0..10u32 {
+        m.process(Sample::new(start.wrapping_add(i * 1000), LOAD, 1e-4));
+    }
+    assert_eq!(m.elapsed_ms(), 9_000);
+    assert_eq!(m.statistics().faults.total(), 0);
+    assert_eq!(m.state(), RiskState::Normal);
+}
+
+#[test]
+fn repeated_timestamps_are_counted_and_ignored() {
+    let mut m = Monitor::new(core(), plain()).unwrap();
+    m.process(Sample::new(1000, LOAD, 1e-4));
+    m.process(Sample::new(1000, f32::NAN, 1e-4));
+    m.process(Sample::new(1000, LOAD, 1e-4));
+    let s = m.statistics();
+    assert_eq!(
+        (s.samples, s.repeated_timestamps, s.faults.total()),
+        (3, 2, 0)
+    );
+    assert_eq!(m.state(), RiskState::Normal);
+}
+
+#[test]
+fn a_full_event_queue_drops_the_oldest_and_counts() {
+    let config = Config {
+        on_delay_ms: 0,
+        off_delay_ms: 0,
+        ..plain()
+    };
+    let mut m = Monitor::new(core(), config).unwrap();
+    let (lo, hi) = (angle_for(0.5, LOAD), angle_for(1.2, LOAD));
+    for i in 0..40u32 {
+        m.process(Sample::new(
+            i * 1000,
+            LOAD,
+            if i % 2 == 0 { lo } else { hi },
+        ));
+    }
+    // 40 changes (the first is the start); the newest EVENT_CAPACITY kept.
+    let capacity = misalign::monitor::EVENT_CAPACITY as u32;
+    let kept: Vec<_> = std::iter::from_fn(|| m.pop_event()).collect();
+    assert_eq!(kept.len() as u32, capacity);
+    assert_eq!(m.statistics().events_dropped, 40 - capacity);
+    let seqs: Vec<u32> = kept.iter().map(|e| e.seq).collect();
+    assert_eq!(seqs, (40 - capacity..40).collect::<Vec<_>>());
+}
+
+/// 1e9 small increments of the compensated sum stay within 1e-6 (relative) of the
+/// exact sum, where a plain f32 sum stalls. Increments cycle over 1..=7 mJ-like
+/// binary fractions, so that the exact sum is an integer count; the release-
+/// optimised test profile runs the loop in a few seconds.
+#[test]
+fn wear_keeps_its_precision_over_1e9_increments() {
+    const N: u64 = 1_000_000_000;
+    let unit = 1.0f32 / 1024.0; // ~1 mJ, exact in binary
+    let mut compensated = EnergySum::default();
+    let mut plain = 0.0f32;
+    let mut counts = 0u64;
+    for i in 0..N {
+        let k = (i % 7 + 1) as u32;
+        let term = k as f32 * unit;
+        compensated.add(std::hint::black_box(term));
+        plain += term;
+        counts += u64::from(k);
+    }
+    let exact = counts as f64 / 1024.0;
+    let relative = (compensated.total() - exact).abs() / exact;
+    assert!(relative < 1e-6, "compensated sum off by {relative:e}");
+    // The same increments in a plain f32 sum lose most of the total.
+    assert!(((f64::from(plain) - exact) / exact).abs() > 0.5);
+}
+
+#[test]
+fn wear_integrates_f_phi_v_over_time() {
+    let mut m = Monitor::new(core(), plain()).unwrap();
+    let phi = angle_for(0.6, LOAD);
+    let f = core().estimate_si(LOAD, phi).unwrap().axial_force;
+    for i in 0..=3600u32 {
+        m.process(Sample::new(i * 1000, LOAD, phi).with_speed(1.5));
+    }
+    // One hour at F phi V (section 7); the first sample has no step before it.
+    let expected = f64::from(f) * f64::from(phi) * 1.5 * 3600.0;
+    let got = m.statistics().energy[RiskState::Normal.index()].total();
+    assert!(
+        (got / expected - 1.0).abs() < 1e-5,
+        "{got} J vs {expected} J"
+    );
+    // Without a measured speed, the nominal one (2 m/s).
+    let mut m = Monitor::new(core(), plain()).unwrap();
+    for i in 0..=100u32 {
+        m.process(Sample::new(i * 1000, LOAD, phi));
+    }
+    let expected = f64::from(f) * f64::from(phi) * 2.0 * 100.0;
+    assert!((m.statistics().total_energy() / expected - 1.0).abs() < 1e-5);
+}
+
+#[test]
+fn time_to_critical_follows_a_linear_drift() {
+    let trend = TrendConfig {
+        interval_ms: 10_000,
+        points: 10,
+        horizon_s: 600.0,
+    };
+    let config = Config {
+        trend: Some(trend),
+        ..plain()
+    };
+    let mut m = Monitor::new(core(), config).unwrap();
+    let phi0 = core()
+        .estimate_si(LOAD, 0.0)
+        .unwrap()
+        .critical_angle
+        .unwrap();
+    // Drift 1e-7 rad/s from phi0 - 2e-4: gross slip 2000 s after the start.
+    let rate = 1e-7f32;
+    let mut approaching = None;
+    for i in 0..1800u32 {
+        let phi = phi0 - 2e-4 + rate * i as f32;
+        m.process(Sample::new(i * 1000, LOAD, phi));
+        while let Some(e) = m.pop_event() {
+            if let EventKind::Approaching { time_to_critical_s } = e.kind {
+                approaching.get_or_insert((i, time_to_critical_s));
+            }
+        }
+        if i == 1000 {
+            let ttc = m
+                .time_to_critical()
+                .expect("a falling margin has a time to critical");
+            // The fit is over 10 s means: the exact answer within their spread.
+            assert!((ttc - 1000.0).abs() < 15.0, "{ttc} s");
+        }
+    }
+    let (i, ttc) = approaching.expect("an Approaching event below the horizon");
+    assert!(ttc < 600.0 && (1390..=1420).contains(&i), "{i} {ttc}");
+}
+
+#[test]
+fn inconsistent_configurations_are_refused() {
+    let bad: [(Config, ConfigError); 8] = [
+        (
+            Config {
+                thresholds: Thresholds::SlipRatio {
+                    warning: 1.1,
+                    alarm: 1.0,
+                    deadband: 0.05,
+                },
+                ..plain()
+            },
+            ConfigError::WarningAboveAlarm,
+        ),
+        (
+            Config {
+                thresholds: Thresholds::SlipRatio {
+                    warning: 0.8,
+                    alarm: 1.0,
+                    deadband: -0.1,
+                },
+                ..plain()
+            },
+            ConfigError::Deadband,
+        ),
+        (
+            Config {
+                thresholds: Thresholds::SlipRatio {
+                    warning: f32::NAN,
+                    alarm: 1.0,
+                    deadband: 0.0,
+                },
+                ..plain()
+            },
+            ConfigError::Threshold,
+        ),
+        (
+            Config {
+                thresholds: Thresholds::Margin {
+                    warning: 0.0,
+                    alarm: 1e-4,
+                    deadband: 0.0,
+                },
+                ..plain()
+            },
+            ConfigError::WarningAboveAlarm,
+        ),
+        (
+            Config {
+                stop_load: 0.0,
+                ..plain()
+            },
+            ConfigError::Stop,
+        ),
+        (
+            Config {
+                spikes: Some(misalign::monitor::SpikeFilter {
+                    window: 0,
+                    k: 3.0,
+                    load_floor: 1.0,
+                    angle_floor: 1e-6,
+                }),
+                ..plain()
+            },
+            ConfigError::SpikeWindow,
+        ),
+        (
+            Config {
+                trend: Some(TrendConfig {
+                    interval_ms: 1000,
+                    points: 0,
+                    horizon_s: 60.0,
+                }),
+                ..plain()
+            },
+            ConfigError::Trend,
+        ),
+        (
+            Config {
+                smoothing_tau_s: -1.0,
+                ..plain()
+            },
+            ConfigError::Smoothing,
+        ),
+    ];
+    for (config, error) in bad {
+        assert_eq!(config.validate(), Err(error));
+        assert_eq!(Monitor::new(core(), config).err(), Some(error));
+    }
+    assert_eq!(Config::default().validate(), Ok(()));
+}
+
+fn replay_scenario<E: Estimator>(
+    m: &mut Monitor<E>,
+    samples: &[Sample],
+) -> Vec<misalign::monitor::Event> {
+    let mut events = Vec::new();
+    for &s in samples {
+        m.process(s);
+        events.extend(std::iter::from_fn(|| m.pop_event()));
+    }
+    events
+}
+
+#[test]
+fn state_taken_out_and_put_back_goes_on_identically() {
+    let samples: Vec<Sample> = scenario::Scenario::new().collect();
+    let mut whole = Monitor::new(core(), Config::default()).unwrap();
+    let all = replay_scenario(&mut whole, &samples);
+    let half = samples.len() / 2;
+    let mut first = Monitor::new(core(), Config::default()).unwrap();
+    let mut events = replay_scenario(&mut first, &samples[..half]);
+    // Leave events undelivered, to see them carried over too.
+    first.process(samples[half]);
+    let state = first.snapshot();
+    let copy = state; // a plain Copy value
+    let mut second = Monitor::restore(core(), Config::default(), &copy).unwrap();
+    assert_eq!(second.snapshot(), state);
+    events.extend(std::iter::from_fn(|| second.pop_event()));
+    events.extend(replay_scenario(&mut second, &samples[half + 1..]));
+    assert_eq!(events, all);
+    assert_eq!(second.statistics(), whole.statistics());
+    // The whole state within the 1 KiB budget of issue 10.
+    assert!(core::mem::size_of::<misalign::monitor::MonitorState>() <= 1024);
+}
+
+#[test]
+fn the_scenario_shows_every_condition_and_is_deterministic() {
+    let a: Vec<Sample> = scenario::Scenario::new().collect();
+    let b: Vec<Sample> = scenario::Scenario::new().collect();
+    assert_eq!(a, b);
+    assert_eq!(a.len() as u32, scenario::SHIFT_S - 180); // the 3 min dropout
+    let mut m = Monitor::new(core(), Config::default()).unwrap();
+    let events = replay_scenario(&mut m, &a);
+    let s = m.statistics();
+    assert_eq!((s.faults.gap, s.events_dropped), (1, 0));
+    assert!(s.faults.stuck > 0);
+    // Every injected spike is rejected, and nothing else.
+    let injected = (0..scenario::SHIFT_S)
+        .filter(|t| t % scenario::SPIKE_EVERY_S == scenario::SPIKE_EVERY_S - 1)
+        .filter(|t| !(scenario::STOP_S.0..scenario::STOP_S.1).contains(t))
+        .filter(|t| !(scenario::DROPOUT_S.0..scenario::DROPOUT_S.1).contains(t))
+        .count();
+    assert_eq!(s.spikes as usize, injected);
+    assert!(s.time_in_state_ms[RiskState::Stopped.index()] >= 1_200_000 - 60_000);
+    for state in [
+        RiskState::Microslip,
+        RiskState::GrossSlip,
+        RiskState::SensorFault,
+    ] {
+        assert!(
+            events
+                .iter()
+                .any(|e| matches!(e.kind, EventKind::StateChange { to, .. } if to == state))
+        );
+    }
+    assert!(
+        events
+            .iter()
+            .any(|e| matches!(e.kind, EventKind::Approaching { .. }))
+    );
+    // The clock wrapped an hour in, unnoticed.
+    assert_eq!(s.faults.time_backwards, 0);
+    assert_eq!(m.elapsed_ms(), u64::from(scenario::SHIFT_S - 1) * 1000);
+}
+
+#[test]
+fn hampel_rejects_a_spike_but_follows_a_real_step() {
+    let spikes = Some(misalign::monitor::SpikeFilter {
+        window: 7,
+        k: 4.0,
+        load_floor: 50.0,
+        angle_floor: 1e-5,
+    });
+    let mut m = Monitor::new(core(), Config { spikes, ..plain() }).unwrap();
+    let phi = |i: u32| 1e-4 + 1e-7 * (i % 5) as f32;
+    for i in 0..20 {
+        m.process(Sample::new(i * 1000, LOAD + (i % 3) as f32, phi(i)));
+    }
+    // One sample at three times the load: replaced by the window's median.
+    m.process(Sample::new(20_000, 3.0 * LOAD, phi(20)));
+    assert_eq!(m.statistics().spikes, 1);
+    assert!((m.reading().unwrap().load - LOAD).abs() < 5.0);
+    // A lasting step to 1.5 times the load: rejected only until it fills half the window.
+    for i in 21..40 {
+        m.process(Sample::new(i * 1000, 1.5 * LOAD + (i % 3) as f32, phi(i)));
+    }
+    assert!(m.statistics().spikes <= 1 + 4, "{}", m.statistics().spikes);
+    assert!((m.reading().unwrap().load - 1.5 * LOAD).abs() < 5.0);
+}
+
+#[test]
+fn smoothing_weight_follows_the_real_time_step() {
+    let config = Config {
+        smoothing_tau_s: 3.0,
+        ..plain()
+    };
+    let (a, b) = (1e-4f32, 2e-4f32);
+    // One step of 3 s: 1 - 1/e of the way.
+    let mut m = Monitor::new(core(), config).unwrap();
+    m.process(Sample::new(0, LOAD, a));
+    m.process(Sample::new(3_000, LOAD + 1.0, b));
+    let one = m.reading().unwrap().phi;
+    assert!(((one - a) / (b - a) - (1.0 - (-1.0f32).exp())).abs() < 1e-5);
+    // Two steps of 1.5 s at the same value: the same place, whatever the sampling.
+    let mut m = Monitor::new(core(), config).unwrap();
+    m.process(Sample::new(0, LOAD, a));
+    m.process(Sample::new(1_500, LOAD + 1.0, b));
+    m.process(Sample::new(3_000, LOAD + 2.0, b));
+    assert!((m.reading().unwrap().phi - one).abs() < 1e-9);
+}
+
+#[test]
+fn the_model_is_chosen_once_for_the_operating_range() {
+    use misalign::monitor::model_for_range;
+    use misalign::reference::{self, ModelChoice};
+    let steel = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
+    assert_eq!(
+        model_for_range(&steel, 5e3, 1e-5),
+        Ok(ModelChoice::Elliptic)
+    );
+    let plane = Scene::new(0.05, f64::INFINITY, 79.3e9, 0.3, 0.3).unwrap();
+    assert_eq!(model_for_range(&plane, 5e3, 1e-5), Ok(ModelChoice::Line));
+    // Short rollers: the ellipse at the heaviest load and smallest angle is longer.
+    let short = steel.with_length(0.02).unwrap();
+    assert!(
+        reference::elliptic(&short, 5e3, 1e-5)
+            .unwrap()
+            .validity
+            .longer_than_rollers
+    );
+    assert_eq!(model_for_range(&short, 5e3, 1e-5), Ok(ModelChoice::Line));
+    let long = steel.with_length(2.0).unwrap();
+    assert!(
+        !reference::elliptic(&long, 5e3, 1e-3)
+            .unwrap()
+            .validity
+            .longer_than_rollers
+    );
+    assert_eq!(model_for_range(&long, 5e3, 1e-3), Ok(ModelChoice::Elliptic));
+    assert_eq!(
+        model_for_range(&steel, f64::NAN, 1e-5),
+        Err(misalign::Error::Load)
+    );
+    assert_eq!(
+        model_for_range(&steel, 5e3, 0.0),
+        Err(misalign::Error::Angle)
+    );
+}
