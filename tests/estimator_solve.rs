@@ -272,3 +272,109 @@ fn header_errors_name_the_solve_columns() {
     let (code, _, _, err) = run(&["--solve", "nu"], "");
     assert_eq!(code, 2, "{err}");
 }
+
+mod properties {
+    use super::run;
+    use proptest::prelude::*;
+
+    /// A field: mostly a plausible value between 10^lo and 10^hi (signed when asked),
+    /// sometimes one that no row should hold.
+    fn field(lo: f64, hi: f64, signed: bool) -> impl Strategy<Value = String> {
+        let plausible = (lo..hi, any::<bool>()).prop_map(move |(e, negative)| {
+            let x = 10f64.powf(e);
+            format!("{:e}", if signed && negative { -x } else { x })
+        });
+        let odd = prop_oneof![
+            Just("0"),
+            Just("-0"),
+            Just("NaN"),
+            Just("inf"),
+            Just("-inf"),
+            Just("-1"),
+            Just("1e400"),
+            Just("x"),
+            Just(""),
+        ]
+        .prop_map(String::from);
+        prop_oneof![8 => plausible, 1 => odd]
+    }
+
+    /// `R1,R2,G,nu,mu,phi,P,F,length` rows; each `--solve` reads its own seven columns
+    /// (and the length) and ignores the rest.
+    fn rows() -> impl Strategy<Value = Vec<String>> {
+        let row = (
+            field(-3.0, 0.0, false),
+            prop_oneof![field(-3.0, 0.0, false), Just("inf".to_string())],
+            field(9.0, 11.5, false),
+            (0.0..0.5f64).prop_map(|nu| nu.to_string()),
+            field(-3.0, 0.0, false),
+            field(-9.0, 0.19, true),
+            field(-2.0, 6.0, false),
+            field(-8.0, 6.0, true),
+            prop_oneof![field(-3.0, 0.5, false), Just(String::new())],
+        )
+            .prop_map(|(r1, r2, g, nu, mu, phi, p, f, l)| {
+                [r1, r2, g, nu, mu, phi, p, f, l].join(",")
+            });
+        prop::collection::vec(row, 1..6)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Every model, contact and unknown: exit 0, one row per input row, and every
+        /// answer in the physical range (mu >= 0, |phi| <= pi/2 signed like F,
+        /// sensitivity >= 0), or an error that says why.
+        #[test]
+        fn never_panics_and_stays_physical(rows in rows()) {
+            let input = format!("R1,R2,G,nu,mu,phi,P,F,length\n{}\n", rows.join("\n"));
+            let forces: Vec<f64> = rows
+                .iter()
+                .map(|r| r.split(',').nth(7).unwrap().parse().unwrap_or(f64::NAN))
+                .collect();
+            for model in ["reference", "f32", "fixed"] {
+                for contact in ["auto", "elliptic", "line"] {
+                    for unknown in ["mu", "phi"] {
+                        let args = ["--model", model, "--contact", contact, "--solve", unknown];
+                        let (code, _, out, err) = run(&args, &input);
+                        prop_assert_eq!(code, 0, "{}", err);
+                        prop_assert_eq!(out.len(), rows.len());
+                        for (answer, &f) in out.iter().zip(&forces) {
+                            prop_assert_eq!(answer.len(), 4);
+                            let value = answer[0].parse::<f64>();
+                            match answer[1].as_str() {
+                                "exact" | "at_least" => {
+                                    let x = value.unwrap();
+                                    prop_assert!(x.is_finite(), "{:?}", answer);
+                                    if unknown == "mu" {
+                                        prop_assert!(x >= 0.0, "{:?}", answer);
+                                    } else {
+                                        prop_assert!(x.abs() <= core::f64::consts::FRAC_PI_2);
+                                        prop_assert!(x == 0.0 || x.signum() == f.signum());
+                                    }
+                                    if answer[1] == "exact" {
+                                        let s: f64 = answer[2].parse().unwrap();
+                                        prop_assert!(s >= 0.0, "{:?}", answer);
+                                    } else {
+                                        prop_assert_eq!(&answer[2], "");
+                                    }
+                                    prop_assert_eq!(&answer[3], "");
+                                }
+                                "inconsistent" | "" => {
+                                    prop_assert_eq!(&answer[0], "");
+                                    prop_assert_eq!(&answer[2], "");
+                                    prop_assert!(!answer[3].is_empty(), "{:?}", answer);
+                                }
+                                other => prop_assert!(false, "bound {}", other),
+                            }
+                            if model == "fixed" && !answer[3].contains("no inverse") {
+                                // Only a row the tool cannot read says something else.
+                                prop_assert!(answer[1].is_empty(), "{:?}", answer);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
