@@ -97,7 +97,8 @@ pub enum Model {
     /// The f32 core that runs on a Cortex-M4F (tables, kernels).
     F32,
     /// The fixed-point core for a Cortex-M0/M3; each row's P and phi become integer
-    /// counts of an LSB that holds them exactly (up to 2^30 counts).
+    /// counts of an LSB that holds them exactly (up to 2^30 counts). It has no
+    /// inverse: with --solve, each row's error says so.
     Fixed,
 }
 
