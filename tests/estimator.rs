@@ -401,3 +401,17 @@ fn a_full_disk_is_said() {
     assert_eq!(code, 1);
     assert!(err.contains("cannot write the output"), "{err}");
 }
+
+/// A header with no data row gives the output's header alone, in every mode, so that
+/// the output is still a table (the CSV fuzz target reads its first column).
+#[test]
+fn a_header_alone_gives_the_header_alone() {
+    let (code, out, _) = run(&[], b"R1,R2,G,nu,mu,P,phi\n");
+    assert_eq!(code, 0);
+    assert!(
+        out.starts_with("theta,") && out.lines().count() == 1,
+        "{out}"
+    );
+    let (code, out, _) = run(&["--solve", "mu"], b"R1,R2,G,nu,P,phi,F\n");
+    assert_eq!((code, out.as_str()), (0, "mu,bound,sensitivity,error\n"));
+}

@@ -1,8 +1,9 @@
 //! The estimator's logic, shared by `examples/estimate/main.rs`, the tests, the host
 //! benchmark and the fuzz target.
 //!
-//! Arguments through clap; every output row is one typed [`OutRow`] written through
-//! csv's serde support, so that the header and the values cannot drift apart; every
+//! Arguments through clap; every output row is one typed [`OutRow`] (with `--solve`,
+//! a `solve::SolveRow`) written through csv's serde support, so that the header and
+//! the values cannot drift apart; every
 //! number goes through one formatter (csv's, ryu: the shortest text that reads back to
 //! the same f64 or f32). Input is read as bytes: a bad row (wrong number of fields,
 //! non-UTF-8 or NUL bytes, an unterminated quote, a number that is not one) becomes that
@@ -18,16 +19,19 @@ use misalign::{Error, Scene};
 use serde::Serialize;
 use std::io::{Read, Write};
 
+#[path = "solve.rs"]
+mod solve;
+
 const ABOUT: &str = "Misalignment, microslip and axial force for each row of a CSV file, \
 after \"The rolling contact of misaligned elastic cylinders\".";
 
 const AFTER_HELP: &str = "\
-INPUT (stdin): CSV with a header naming at least R1,R2,G,nu,mu,P,phi, in any order;
-    other columns are ignored, and each needed one may appear once. SI units: R1, R2 in
-    m (R2 = inf is a plane), G in Pa, phi in rad (signed). An optional column `length`
-    (m) is the rollers' contact length. P is the total load in N; only line contact
-    without a length reads it as a load per unit length (N/m). A ';'-separated file is
-    detected and read so (said on stderr).
+INPUT (stdin): CSV with a header naming at least R1,R2,G,nu,mu,P,phi (with --solve,
+    the columns under SOLVE), in any order; other columns are ignored, and each needed
+    one may appear once. SI units: R1, R2 in m (R2 = inf is a plane), G in Pa, phi in
+    rad (signed). An optional column `length` (m) is the rollers' contact length. P is
+    the total load in N; only line contact without a length reads it as a load per
+    unit length (N/m). A ';'-separated file is detected and read so (said on stderr).
 
 MODEL CHOICE (--contact auto, the default; section 9 of the paper): the ellipse, or
     line contact with P / length when the ellipse is longer than the rollers
@@ -48,6 +52,24 @@ OUTPUT (stdout): one row per input row, in order, under one header:
     stretched: large_angle, high_pressure, longer_than_rollers, near_model_switch,
     round_ellipse (a/b < 10: F under-predicted by 2 % or more), no_critical_angle.
 
+SOLVE (--solve mu|phi): the inverse, from a measured axial force F (signed like phi;
+    in N, the same unit as the forward F: per unit length in line contact without a
+    length).
+    --solve mu reads R1,R2,G,nu,P,phi,F (no mu) and writes mu,bound,sensitivity,error.
+        The scene needs a friction coefficient to be built: it gets the placeholder
+        mu = 1, which the inverses do not read.
+    --solve phi reads R1,R2,G,nu,mu,P,F and writes phi,bound,sensitivity,error; phi is
+        signed like F.
+    bound is exact (sensitivity = d ln answer / d ln F: a relative error of F times it
+    is the answer's), at_least (F only bounds the answer from below, where the forward
+    map saturates: gross slip for phi, no slip for mu) or inconsistent (no state of the
+    model gives F; error says why: above_model, opposite_sign, zero_load,
+    no_misalignment, between_models). --contact as for the forward estimate: auto follows
+    section 9 (the mu-inverse takes the model chosen at P and phi; the phi-inverse keeps
+    each model's answer only where the choice takes that model). --model reference or
+    f32; --model fixed answers every row with an error: the fixed-point core has no
+    inverse. Bad rows get a message in error, and the batch goes on.
+
 EXIT STATUS: 0; 1 when the input has no header, lacks a column or repeats one, or the
     output cannot be written; 2 for bad options.";
 
@@ -61,6 +83,10 @@ struct Options {
     /// Which contact model answers: section 9's choice per row, or one forced.
     #[arg(long, value_enum, default_value_t = Contact::Auto)]
     contact: Contact,
+    /// The inverse: this unknown from a measured axial force F instead of the forward
+    /// estimate (SOLVE below).
+    #[arg(long, value_enum)]
+    solve: Option<solve::Unknown>,
 }
 
 /// `--model`.
@@ -71,7 +97,8 @@ pub enum Model {
     /// The f32 core that runs on a Cortex-M4F (tables, kernels).
     F32,
     /// The fixed-point core for a Cortex-M0/M3; each row's P and phi become integer
-    /// counts of an LSB that holds them exactly (up to 2^30 counts).
+    /// counts of an LSB that holds them exactly (up to 2^30 counts). It has no
+    /// inverse: with --solve, each row's error says so.
     Fixed,
 }
 
@@ -136,6 +163,13 @@ pub struct OutRow<'a> {
 }
 
 const INPUTS: [&str; 7] = ["R1", "R2", "G", "nu", "mu", "P", "phi"];
+
+impl Options {
+    /// The input columns this run needs, in the order its rows are read.
+    fn inputs(&self) -> &'static [&'static str; 7] {
+        self.solve.map_or(&INPUTS, solve::Unknown::inputs)
+    }
+}
 
 /// The flags column, built in a buffer reused from row to row.
 fn write_flags(out: &mut String, v: &Validity, no_critical_angle: bool) {
@@ -217,24 +251,58 @@ fn number(name: &str, field: &[u8]) -> Result<f64, String> {
     Ok(x)
 }
 
-/// The scene and sample of a row, or the message for its `error` column.
-fn scene_and_sample(
+/// The numbers of a row's needed columns (named `names`), or the message for its
+/// `error` column.
+fn numbers(
     record: &csv::ByteRecord,
     columns: &[usize; 7],
-    length: Option<usize>,
-) -> Result<(Scene, f64, f64), String> {
+    names: &[&str; 7],
+) -> Result<[f64; 7], String> {
     let mut x = [0.0; 7];
     for (k, &c) in columns.iter().enumerate() {
-        x[k] = number(INPUTS[k], record.get(c).unwrap_or(b""))?;
+        x[k] = number(names[k], record.get(c).unwrap_or(b""))?;
     }
-    let mut scene = Scene::new(x[0], x[1], x[2], x[3], x[4]).map_err(|e| e.to_string())?;
+    Ok(x)
+}
+
+/// The scene of a row from its constants (R1, R2, G, nu, mu) and its optional length.
+fn scene_of(
+    [r1, r2, g, nu, mu]: [f64; 5],
+    record: &csv::ByteRecord,
+    length: Option<usize>,
+) -> Result<Scene, String> {
+    let mut scene = Scene::new(r1, r2, g, nu, mu).map_err(|e| e.to_string())?;
     if let Some(field) = length.and_then(|c| record.get(c))
         && !field.iter().all(u8::is_ascii_whitespace)
     {
         let l = number("length", field)?;
         scene = scene.with_length(l).map_err(|e| e.to_string())?;
     }
+    Ok(scene)
+}
+
+/// The scene and sample of a row, or the message for its `error` column.
+fn scene_and_sample(
+    record: &csv::ByteRecord,
+    columns: &[usize; 7],
+    length: Option<usize>,
+) -> Result<(Scene, f64, f64), String> {
+    let x = numbers(record, columns, &INPUTS)?;
+    let scene = scene_of([x[0], x[1], x[2], x[3], x[4]], record, length)?;
     Ok((scene, x[5], x[6]))
+}
+
+/// The `--solve` answer of a row, or the message for its `error` column.
+fn solve_row(
+    options: &Options,
+    unknown: solve::Unknown,
+    record: &csv::ByteRecord,
+    columns: &[usize; 7],
+    length: Option<usize>,
+) -> Result<misalign::reference::inverse::Inverse<Num>, String> {
+    let x = numbers(record, columns, unknown.inputs())?;
+    let scene = scene_of(unknown.scene_constants(&x), record, length)?;
+    solve::answer(unknown, options.model, options.contact, &scene, &x)
 }
 
 /// One row's input.
@@ -491,7 +559,10 @@ fn fixed_row(x: &Sample) -> Result<Answer, String> {
 }
 
 /// Where the needed columns are: `Err` with the message when one is missing or repeated.
-fn find_columns(header: &csv::ByteRecord) -> Result<([usize; 7], Option<usize>), String> {
+fn find_columns(
+    header: &csv::ByteRecord,
+    inputs: &[&str; 7],
+) -> Result<([usize; 7], Option<usize>), String> {
     let names: Vec<&[u8]> = header.iter().collect();
     let find = |name: &str| -> Result<Option<usize>, String> {
         let at: Vec<usize> = (0..names.len())
@@ -511,9 +582,9 @@ fn find_columns(header: &csv::ByteRecord) -> Result<([usize; 7], Option<usize>),
         }
     };
     let mut columns = [0usize; 7];
-    for (k, name) in INPUTS.iter().enumerate() {
+    for (k, name) in inputs.iter().enumerate() {
         columns[k] = find(name)?
-            .ok_or_else(|| format!("input lacks column {name} (needs {})", INPUTS.join(",")))?;
+            .ok_or_else(|| format!("input lacks column {name} (needs {})", inputs.join(",")))?;
     }
     Ok((columns, find("length")?))
 }
@@ -535,6 +606,23 @@ fn bad_record(record: &csv::ByteRecord, fields: usize) -> Option<String> {
         }
     }
     None
+}
+
+/// The header `row` is written under, alone (an input with no data row): the row
+/// serialised into a scratch writer, whose first record is the header.
+fn write_header<W: Write, R: Serialize>(
+    writer: &mut csv::Writer<W>,
+    row: &R,
+) -> Result<(), csv::Error> {
+    let mut scratch = csv::Writer::from_writer(Vec::new());
+    scratch.serialize(row)?;
+    let bytes = scratch.into_inner().map_err(|e| e.into_error())?;
+    let mut header = csv::ByteRecord::new();
+    csv::ReaderBuilder::new()
+        .has_headers(false)
+        .from_reader(&bytes[..])
+        .read_byte_record(&mut header)?;
+    writer.write_byte_record(&header)
 }
 
 fn reader(delimiter: u8, headers: bool, input: &[u8]) -> csv::Reader<&[u8]> {
@@ -580,6 +668,7 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
     }
     // The header: the first record, ','-separated, or ';'-separated if only that
     // gives the needed columns.
+    let inputs = options.inputs();
     let mut delimiter = b',';
     let mut rdr = reader(delimiter, true, &data);
     let mut header = match rdr.byte_headers() {
@@ -588,15 +677,15 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
             let _ = writeln!(
                 err,
                 "estimate: input has no header (needs {})",
-                INPUTS.join(",")
+                inputs.join(",")
             );
             return 1;
         }
     };
-    if find_columns(&header).is_err() && header.len() == 1 && header[0].contains(&b';') {
+    if find_columns(&header, inputs).is_err() && header.len() == 1 && header[0].contains(&b';') {
         let mut semi = reader(b';', true, &data);
         if let Ok(h) = semi.byte_headers()
-            && find_columns(h).is_ok()
+            && find_columns(h, inputs).is_ok()
         {
             let _ = writeln!(
                 err,
@@ -605,7 +694,7 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
             (delimiter, header, rdr) = (b';', h.clone(), semi);
         }
     }
-    let (columns, length) = match find_columns(&header) {
+    let (columns, length) = match find_columns(&header, inputs) {
         Ok(c) => c,
         Err(message) => {
             let _ = writeln!(err, "estimate: {message}");
@@ -617,11 +706,11 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
     let mut record = csv::ByteRecord::new();
     let (mut flags, mut message) = (String::new(), String::new());
     let mut origin = 0; // byte offset of `rdr`'s input in `data`
+    let mut rows = 0usize;
     loop {
         let mut restart = None;
         while let Ok(true) = rdr.read_byte_record(&mut record) {
             let start = origin + record.position().map_or(0, |p| p.byte() as usize);
-            let mut row = OutRow::default();
             message.clear();
             // An unterminated quote runs to the end of the input: that row's error,
             // and the batch goes on from the line after the row's start.
@@ -632,35 +721,52 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
                 restart = rest.iter().position(|&b| b == b'\n').map(|i| start + i + 1);
             } else if let Some(m) = bad_record(&record, header.len()) {
                 message.push_str(&m);
-            } else {
-                let result =
-                    scene_and_sample(&record, &columns, length).and_then(|(scene, load, phi)| {
-                        let x = Sample {
-                            scene,
-                            load,
-                            phi,
-                            choice,
-                        };
-                        match options.model {
-                            Model::Reference => reference_row(&x),
-                            Model::F32 => f32_row(&x),
-                            Model::Fixed => fixed_row(&x),
-                        }
-                    });
-                match result {
-                    Ok(answer) => {
-                        write_flags(&mut flags, &answer.validity, answer.no_critical_angle);
-                        row = answer.row;
-                        row.flags = &flags;
-                    }
-                    Err(m) => message = m,
-                }
             }
-            row.error = &message;
-            if let Err(e) = writer.serialize(&row) {
+            let readable = message.is_empty();
+            let written = if let Some(unknown) = options.solve {
+                let mut answer = None;
+                if readable {
+                    match solve_row(&options, unknown, &record, &columns, length) {
+                        Ok(a) => answer = Some(a),
+                        Err(m) => message = m,
+                    }
+                }
+                writer.serialize(solve::SolveRow::new(unknown, answer, &message))
+            } else {
+                let mut row = OutRow::default();
+                if readable {
+                    let result = scene_and_sample(&record, &columns, length).and_then(
+                        |(scene, load, phi)| {
+                            let x = Sample {
+                                scene,
+                                load,
+                                phi,
+                                choice,
+                            };
+                            match options.model {
+                                Model::Reference => reference_row(&x),
+                                Model::F32 => f32_row(&x),
+                                Model::Fixed => fixed_row(&x),
+                            }
+                        },
+                    );
+                    match result {
+                        Ok(answer) => {
+                            write_flags(&mut flags, &answer.validity, answer.no_critical_angle);
+                            row = answer.row;
+                            row.flags = &flags;
+                        }
+                        Err(m) => message = m,
+                    }
+                }
+                row.error = &message;
+                writer.serialize(&row)
+            };
+            if let Err(e) = written {
                 let _ = writeln!(err, "estimate: cannot write the output: {e}");
                 return 1;
             }
+            rows += 1;
             if restart.is_some() {
                 break;
             }
@@ -673,7 +779,15 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
             _ => break,
         }
     }
-    if let Err(e) = writer.flush() {
+    // No data row: the header alone, so that the output is still a table.
+    let header = if rows > 0 {
+        Ok(())
+    } else if let Some(unknown) = options.solve {
+        write_header(&mut writer, &solve::SolveRow::new(unknown, None, ""))
+    } else {
+        write_header(&mut writer, &OutRow::default())
+    };
+    if let Err(e) = header.and_then(|()| writer.flush().map_err(csv::Error::from)) {
         let _ = writeln!(err, "estimate: cannot write the output: {e}");
         return 1;
     }
