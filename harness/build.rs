@@ -1,139 +1,59 @@
-//! Build script. On the host it does nothing. For a firmware image (`target_os =
-//! "none"`) it writes two files into OUT_DIR:
+//! The memory layout of every Cortex-M image that depends on this crate: the
+//! measurement images here, and the root package's firmware example and on-target
+//! tests (through their dev-dependency on this crate). Writes into OUT_DIR, which it
+//! puts on the linker's search path of every dependent:
 //!
-//! - `misalign-memory.x`, the memory layout that `memory.x` (crate root) includes:
-//!   the file named by the environment variable `MISALIGN_MEMORY_X` (a linker script
-//!   with a MEMORY command, absolute or relative to the crate root), or else the QEMU
-//!   board of the target: `boards/microbit.x` for thumbv6m (Cortex-M0),
-//!   `boards/mps2-an386.x` for every other target. A layout cannot simply be a
-//!   `memory.x` on the search path: the linker looks in the current directory (the
-//!   crate root) first, so the root `memory.x` would always win.
-//! - `firmware_expected.rs`, the answers of the f64 reference, evaluated here on the
-//!   host, for the firmware's built-in trace (`examples/firmware/trace.rs`).
+//! - `misalign-memory.x`: the file named by the environment variable
+//!   `MISALIGN_MEMORY_X` (a linker script with a MEMORY command, absolute or relative
+//!   to the repository root), or else the QEMU board of the target:
+//!   `boards/microbit.x` for thumbv6m (Cortex-M0), `boards/mps2-an386.x` for every
+//!   other target (paths in this crate);
+//! - `memory.x`, which includes it, for cortex-m-rt's `link.x`. (The root package's
+//!   own `memory.x` includes the same file; a layout cannot simply be a `memory.x`
+//!   on the search path, since the linker looks in its current directory first.)
 //!
-//! The reference is compiled into this script from the library's own sources (it
-//! depends on nothing but `Scene`, `Error` and libm), so the firmware checks itself
-//! against exactly the code that `cargo test` holds to the 50-digit data.
-#![allow(dead_code, unused_imports)]
+//! On the host it does nothing. The library `misalign` has no build script.
 
-#[path = "src/error.rs"]
-mod error;
-#[path = "src/reference/mod.rs"]
-mod reference;
-#[path = "src/scene.rs"]
-mod scene;
-#[path = "examples/firmware/trace.rs"]
-mod trace;
-
-use error::Error;
-use scene::{Scene, ThetaRelation};
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-env-changed=MISALIGN_MEMORY_X");
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
-    let root = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("manifest dir"));
-    for watched in [
-        "src/error.rs",
-        "src/scene.rs",
-        "src/reference",
-        "examples/firmware/trace.rs",
-    ] {
-        println!("cargo:rerun-if-changed={watched}");
-    }
-    memory_layout(&root, &out);
-    let expected = expected_values();
-    std::fs::write(out.join("firmware_expected.rs"), expected).expect("write expected values");
-}
-
-/// Copies the chosen layout to `OUT_DIR/misalign-memory.x` and puts OUT_DIR on the
-/// linker's search path of the examples and tests (not of dependents).
-fn memory_layout(root: &Path, out: &Path) {
-    println!("cargo:rerun-if-env-changed=MISALIGN_MEMORY_X");
-    println!("cargo:rerun-if-changed=boards");
-    let target = std::env::var("TARGET").unwrap_or_default();
-    let chosen = match std::env::var_os("MISALIGN_MEMORY_X") {
-        Some(path) if !path.is_empty() => root.join(path),
-        _ if target.starts_with("thumbv6m") => root.join("boards/microbit.x"),
-        _ => root.join("boards/mps2-an386.x"),
-    };
-    println!("cargo:rerun-if-changed={}", chosen.display());
-    let layout = std::fs::read_to_string(&chosen).unwrap_or_else(|e| {
+    let here = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("manifest dir"));
+    let layout = chosen_layout(&here);
+    println!("cargo:rerun-if-changed={}", layout.display());
+    let text = std::fs::read_to_string(&layout).unwrap_or_else(|e| {
         panic!(
             "MISALIGN_MEMORY_X: cannot read the memory layout {}: {e}",
-            chosen.display()
+            layout.display()
         )
     });
-    let text = format!(
-        "/* Written by build.rs from {} */\n{layout}",
-        chosen.display()
+    write(
+        &out,
+        "misalign-memory.x",
+        &format!(
+            "/* Written by harness/build.rs from {} */\n{text}",
+            layout.display()
+        ),
     );
-    std::fs::write(out.join("misalign-memory.x"), text).expect("write misalign-memory.x");
-    for kind in ["examples", "tests"] {
-        println!("cargo:rustc-link-arg-{kind}=-L{}", out.display());
+    write(&out, "memory.x", "INCLUDE misalign-memory.x\n");
+    println!("cargo:rustc-link-search={}", out.display());
+}
+
+/// `MISALIGN_MEMORY_X` (relative to the repository root), or the target's QEMU board.
+fn chosen_layout(here: &Path) -> PathBuf {
+    let target = std::env::var("TARGET").unwrap_or_default();
+    match std::env::var_os("MISALIGN_MEMORY_X") {
+        Some(path) if !path.is_empty() => here.join("..").join(path),
+        _ if target.starts_with("thumbv6m") => here.join("boards/microbit.x"),
+        _ => here.join("boards/mps2-an386.x"),
     }
 }
 
-/// The generated `ELLIPTIC_EXPECTED` and `LINE_EXPECTED` arrays, one `Answer` (a type
-/// the including module defines) per trace sample.
-fn expected_values() -> String {
-    let (r1, r2, g, nu, mu) = trace::SCENE;
-    let scene = Scene::new(r1, r2, g, nu, mu).expect("the demo scene is valid");
-    let mut text = String::from(
-        "// Generated by build.rs from the f64 reference: do not edit.\n\
-         // Fields: slip ratio d/b, axial force F, critical angle phi0, margin\n\
-         // phi0 - |phi|, gross slip, microslip risk (d/b >= 0.8).\n",
-    );
-    let elliptic = trace::ELLIPTIC.map(|(p, phi)| {
-        let e = reference::elliptic(&scene, p as f64, phi as f64)
-            .unwrap_or_else(|err| panic!("reference::elliptic({p}, {phi}): {err:?}"));
-        (e.slip_ratio, e.axial_force, e.critical_angle, phi)
-    });
-    let line = trace::LINE.map(|(p, phi)| {
-        let l = reference::line(&scene, p as f64, phi as f64)
-            .unwrap_or_else(|err| panic!("reference::line({p}, {phi}): {err:?}"));
-        (l.slip_ratio, l.axial_force, Some(l.critical_angle), phi)
-    });
-    for (name, rows) in [
-        ("ELLIPTIC_EXPECTED", &elliptic[..]),
-        ("LINE_EXPECTED", &line[..]),
-    ] {
-        writeln!(text, "pub const {name}: [Answer; {}] = [", rows.len()).unwrap();
-        for &(s, force, critical, phi) in rows {
-            let margin = critical.map(|c| c - (phi as f64).abs());
-            writeln!(
-                text,
-                "    Answer {{ slip_ratio: {}, axial_force: {}, critical_angle: {}, \
-                 margin: {}, gross: {}, risk: {} }},",
-                lit(s),
-                lit(force),
-                opt(critical),
-                opt(margin),
-                s >= 1.0,
-                s >= 0.8,
-            )
-            .unwrap();
-        }
-        text.push_str("];\n");
-    }
-    text
-}
-
-/// An f32 literal of `x` (rounded from f64), infinities included.
-fn lit(x: f64) -> String {
-    let x = x as f32;
-    match x {
-        f32::INFINITY => "f32::INFINITY".into(),
-        f32::NEG_INFINITY => "f32::NEG_INFINITY".into(),
-        _ if x.is_nan() => panic!("the reference gave NaN"),
-        _ => format!("{x:e}"),
-    }
-}
-
-fn opt(x: Option<f64>) -> String {
-    x.map_or("None".into(), |x| format!("Some({})", lit(x)))
+fn write(dir: &Path, name: &str, text: &str) {
+    std::fs::write(dir.join(name), text).unwrap_or_else(|e| panic!("write {name}: {e}"));
 }

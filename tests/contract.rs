@@ -6,7 +6,7 @@ use misalign::float::{EllipticScene, LineScene, Prepared};
 use misalign::{Error, Estimate, Estimator, Scene};
 
 fn scene() -> Scene {
-    Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap()
+    Scene::DEMO
 }
 
 /// Relative difference, with both zero or both infinite counting as equal.

@@ -1,12 +1,8 @@
-//! What the firmware example and the on-target tests share (Cortex-M only): the
-//! defmt logger, exit through semihosting, the panic and HardFault handlers, stack
-//! painting and an instruction counter (for the benchmark, too). Included with
-//! `#[path = "../support/mod.rs"] mod support;`.
-//!
-//! Logging: defmt over semihosting (QEMU; `tools/qemu-run` decodes it with
-//! defmt-print), or over RTT with the `rtt` feature (a real board, e.g. with
-//! `probe-rs run`, which also serves the semihosting exit).
-#![allow(dead_code)]
+//! What the firmware example, the on-target tests and the benchmark image share: exit
+//! through semihosting, what their panic and HardFault handlers do
+//! ([`log_panics_and_faults!`](crate::log_panics_and_faults) defines them), stack
+//! painting and an instruction counter. They log through defmt; the logger is the
+//! crate `misalign-logger` (`harness/logger`), which each of them links itself.
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
@@ -14,10 +10,6 @@ use core::sync::atomic::{AtomicBool, Ordering};
 // (cortex-m's single-core implementation), linked even where nothing names them.
 use cortex_m as _;
 use cortex_m_rt as _;
-#[cfg(feature = "rtt")]
-use defmt_rtt as _;
-#[cfg(not(feature = "rtt"))]
-use defmt_semihosting as _;
 
 /// Exit status of a panic (as Rust's test harness).
 pub const PANIC: i32 = 101;
@@ -30,11 +22,12 @@ pub fn exit(code: i32) -> ! {
     semihosting::process::exit(code)
 }
 
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
+/// Logs a panic (once: a panic while logging it does not recurse) and exits with
+/// [`PANIC`].
+pub fn log_panic(info: &core::panic::PanicInfo) -> ! {
     static PANICKING: AtomicBool = AtomicBool::new(false);
-    // A panic while logging the panic (e.g. in the logger) must not recurse. (Load and
-    // store, not swap: the Cortex-M0 has no atomic read-modify-write; single core.)
+    // (Load and store, not swap: the Cortex-M0 has no atomic read-modify-write;
+    // single core.)
     if !PANICKING.load(Ordering::Relaxed) {
         PANICKING.store(true, Ordering::Relaxed);
         match info.location() {
@@ -50,10 +43,8 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     exit(PANIC)
 }
 
-/// A HardFault ends the run with [`HARD_FAULT`] instead of cortex-m-rt's endless
-/// loop, so that QEMU exits and says so.
-#[cortex_m_rt::exception]
-unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
+/// Logs a HardFault's pc and exits with [`HARD_FAULT`].
+pub fn log_hard_fault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
     defmt::error!("HardFault at pc {=u32:#010x}", frame.pc());
     exit(HARD_FAULT)
 }

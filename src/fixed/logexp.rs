@@ -3,7 +3,7 @@
 //! become additions, shifts and a division by 3.
 
 use super::uniform::ONE;
-use crate::tables::{EXP2_FRACTION, LOG2_MANTISSA};
+use super::tables::{EXP2_FRACTION, LOG2_MANTISSA};
 
 /// Maximum error of [`log2_u32`] in log2 units (the relative error of the number it
 /// stands for is 0.69 times this), over every u32: the table part is measured over

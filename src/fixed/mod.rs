@@ -15,11 +15,21 @@
 //! time, while these quantities span ten decades per scene and need a per-value
 //! exponent; a Q8.24 logarithm is one.
 
-pub mod logexp;
-pub mod uniform;
-
 mod elliptic;
 mod line;
+internal! {
+    /// Q8.24 log2, exp2 and division by 3.
+    mod logexp;
+}
+internal! {
+    /// The generated tables of the fixed-point core.
+    #[rustfmt::skip]
+    mod tables;
+}
+internal! {
+    /// Uniform Q8.24 tables with quadratic interpolation.
+    mod uniform;
+}
 
 pub use elliptic::{FixedDetails, FixedEllipticScene};
 pub use line::FixedLineScene;

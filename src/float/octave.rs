@@ -2,7 +2,7 @@
 //! in the local variable `u = mantissa(x)` in [1, 2), taken from the bits as they
 //! are. The octave comes from the exponent bits: no logarithm, no search, no
 //! division. The tables
-//! themselves are generated from the f64 reference (`cargo xtask tables`, src/tables.rs).
+//! themselves are generated from the f64 reference (`cargo xtask tables`, src/float/tables.rs).
 
 /// Degree of the polynomial per octave.
 pub const DEGREE: usize = 6;
@@ -65,7 +65,7 @@ impl<'a> OctaveTable<'a> {
 
 /// Copies rows `skip .. skip + K` of a generated coefficient array into a smaller one,
 /// at compile time: a firmware whose scene declares a narrower range of misalignment
-/// links only those rows (see `tables`).
+/// links only those rows (see [`Tables`](super::Tables)).
 pub const fn narrow_rows<const C: usize, const N: usize, const K: usize>(
     rows: &[[f32; C]; N],
     skip: usize,

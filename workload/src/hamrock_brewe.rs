@@ -4,7 +4,6 @@
 //! the library. Its ellipticity k = 1.0339 (Ry/Rx)^0.636 was fitted for 1 <= k <= 10;
 //! at small misalignment the contact is far more slender (k in the thousands), where it
 //! is far off.
-#![allow(dead_code)]
 
 /// A scene prepared for the baseline (f32).
 #[derive(Clone, Copy, Debug)]
@@ -22,13 +21,30 @@ pub struct HamrockBrewe {
 /// What the baseline estimates per sample.
 #[derive(Clone, Copy, Debug)]
 pub struct Baseline {
+    /// Slip ratio d/b.
     pub slip_ratio: f32,
+    /// Gross slip (d/b >= 1).
     pub gross: bool,
+    /// Axial force F (N).
     pub axial_force: f32,
+    /// Critical angle phi0 (rad).
     pub critical_angle: f32,
 }
 
 impl HamrockBrewe {
+    /// The baseline for `scene`.
+    pub fn of(scene: &misalign::Scene) -> Self {
+        Self::new(
+            scene.r1(),
+            scene.r2(),
+            scene.shear_modulus(),
+            scene.poisson_ratio(),
+            scene.friction(),
+        )
+    }
+
+    /// The baseline for radii `r1`, `r2` (m), shear modulus `g` (Pa), Poisson's ratio
+    /// `nu` and friction `mu`.
     pub fn new(r1: f64, r2: f64, g: f64, nu: f64, mu: f64) -> Self {
         HamrockBrewe {
             curvature_sum: (1.0 / r1 + 1.0 / r2) as f32,
@@ -62,6 +78,7 @@ impl HamrockBrewe {
         (a, b)
     }
 
+    /// The baseline's estimate for load `load` (N) and misalignment `phi` (rad).
     pub fn estimate(&self, load: f32, phi: f32) -> Baseline {
         let abs_phi = libm::fabsf(phi);
         let (a, b) = self.semi_axes(load, abs_phi);

@@ -1,15 +1,10 @@
-//! The benchmark's scene and samples, shared by the host benchmark and the firmware
-//! benchmark images: a few hundred (P, phi) over the practical domain (theta ~ 1e-5 to
-//! 1e-2, loads from 50 N to 5 kN on printing-press rollers), the same on every run.
-#![allow(dead_code)]
+//! The benchmark's samples on the demo scene (`misalign::Scene::DEMO`), shared by the
+//! host benchmark and the benchmark image: a few hundred (P, phi) over the practical
+//! domain (theta ~ 1e-5 to 1e-2, loads from 50 N to 5 kN on printing-press rollers),
+//! the same on every run.
 
 /// Largest load in the samples (N).
 pub const LOAD_MAX: f64 = 5000.0;
-
-/// The demo scene: two steel rollers of 50 mm radius, mu = 0.3.
-pub fn scene() -> misalign::Scene {
-    misalign::Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).expect("valid scene")
-}
 
 /// `n` samples, log-spaced in phi (1e-5 to 1e-2 rad) and in P (50 N to 5 kN), with
 /// alternating sign of phi; a fixed low-discrepancy walk, no random generator.

@@ -3,7 +3,7 @@
 //!
 //! Measured, per core (profile `firmware`: release with fat LTO, one codegen unit):
 //!
-//! - image flash and RAM of the minimal images (`examples/minimal`): flash is
+//! - image flash and RAM of the minimal images (`harness/src/bin/minimal_*.rs`): flash is
 //!   .vector_table + .text + .rodata + .data, RAM the statics (.data + .bss + .uninit)
 //!   as llvm-size counts them; the stack comes on top;
 //! - **estimator flash** (budgeted): `minimal_<model>` minus `minimal_<model>_prepare`,
@@ -16,65 +16,17 @@
 //!   the firmware's trace, by stack painting on the target (`examples/firmware`);
 //! - instructions per sample (reported): SysTick under QEMU's `-icount`.
 
-use crate::cross::{self, Artifacts, Sections};
+use crate::cross::{self, Artifacts, CPUS, Cpu, Sections};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
 /// Per-sample estimator budget: flash (code + tables) and stack, in bytes. Applied to
-/// the cores marked `budget` below; lower them when the estimator beats them.
+/// the cores whose images are measured (`Cpu::sizes`); lower them when the estimator
+/// beats them.
 pub const FLASH_BUDGET: u64 = 8 * 1024;
 pub const STACK_BUDGET: u64 = 256;
-
-struct Core {
-    name: &'static str,
-    target: &'static str,
-    machine: &'static str,
-    /// The number format of the estimator it runs.
-    number: &'static str,
-    /// Size table and budget for this core (the Cortex-M7 runs the Cortex-M4F's images).
-    sizes: bool,
-    budget: bool,
-}
-
-/// The cores: the f32 core with an FPU (Cortex-M4F, M7), the fixed-point core without
-/// one (Cortex-M3, M0); the budget holds for both (`cargo xtask bench` measures the
-/// f32 core in soft float there too).
-const CORES: [Core; 4] = [
-    Core {
-        name: "Cortex-M4F",
-        target: "thumbv7em-none-eabihf",
-        machine: "mps2-an386",
-        number: "f32",
-        sizes: true,
-        budget: true,
-    },
-    Core {
-        name: "Cortex-M7",
-        target: "thumbv7em-none-eabihf",
-        machine: "mps2-an500",
-        number: "f32",
-        sizes: false,
-        budget: false,
-    },
-    Core {
-        name: "Cortex-M3",
-        target: "thumbv7m-none-eabi",
-        machine: "mps2-an385",
-        number: "fixed",
-        sizes: true,
-        budget: true,
-    },
-    Core {
-        name: "Cortex-M0",
-        target: "thumbv6m-none-eabi",
-        machine: "microbit",
-        number: "fixed",
-        sizes: true,
-        budget: true,
-    },
-];
 
 const MODELS: [&str; 2] = ["elliptic", "line"];
 const MINIMAL: [&str; 5] = [
@@ -123,7 +75,8 @@ pub fn run(readme: bool) -> ExitCode {
     };
     let mut rows = Vec::new();
     let mut built: Vec<Built> = Vec::new();
-    for core in &CORES {
+    // The Cortex-M4F first: the README's table starts with the FPU core.
+    for core in CPUS.iter().rev() {
         step(
             start,
             &format!("{} ({}, QEMU {})", core.name, core.target, core.machine),
@@ -138,17 +91,21 @@ pub fn run(readme: bool) -> ExitCode {
                 }
             }
         }
-        let Built { images, test, .. } = built.iter().find(|b| b.target == core.target).unwrap();
+        let Built {
+            firmware,
+            harness,
+            test,
+            ..
+        } = built.iter().find(|b| b.target == core.target).unwrap();
 
         // The firmware: every answer checked, stack and instructions measured.
-        let runs =
-            match cross::artifact(images, "firmware").and_then(|elf| run_firmware(core, &elf)) {
-                Ok(runs) => runs,
-                Err(e) => {
-                    failures.push(format!("{} firmware: {e}", core.name));
-                    Vec::new()
-                }
-            };
+        let runs = match run_firmware(core, firmware) {
+            Ok(runs) => runs,
+            Err(e) => {
+                failures.push(format!("{} firmware: {e}", core.name));
+                Vec::new()
+            }
+        };
 
         // The on-target tests.
         match cross::qemu(core.machine, test) {
@@ -165,7 +122,7 @@ pub fn run(readme: bool) -> ExitCode {
 
         // The minimal images: they run, and their sizes.
         if core.sizes {
-            match sizes(core, images, &llvm_size, &runs) {
+            match sizes(core, harness, &llvm_size, &runs) {
                 Ok(mut r) => rows.append(&mut r),
                 Err(e) => failures.push(format!("{} sizes: {e}", core.name)),
             }
@@ -180,7 +137,7 @@ pub fn run(readme: bool) -> ExitCode {
 
     step(
         start,
-        "a real board's layout: MISALIGN_MEMORY_X=boards/stm32f4.x, --features rtt",
+        "a real board's layout: MISALIGN_MEMORY_X=harness/boards/stm32f4.x, --features rtt",
     );
     match board(&llvm_size) {
         Ok(line) => println!("  {line}"),
@@ -194,7 +151,7 @@ pub fn run(readme: bool) -> ExitCode {
     );
     failures.extend(over);
     if readme && failures.is_empty() {
-        match write_readme(&table) {
+        match crate::write_readme_section("firmware", &table) {
             Ok(()) => println!("wrote the table into README.md"),
             Err(e) => failures.push(e),
         }
@@ -247,16 +204,17 @@ pub(crate) fn preflight() -> Result<(), String> {
 /// What one target's builds made.
 struct Built {
     target: &'static str,
-    /// The firmware and minimal images (profile `firmware`).
-    images: Artifacts,
+    /// The firmware example (profile `firmware`).
+    firmware: PathBuf,
+    /// The harness's minimal images (profile `firmware`).
+    harness: Artifacts,
     /// The on-target test (profile `test`).
     test: PathBuf,
 }
 
-/// Builds the firmware-profile images and the on-target test for `target`.
+/// Builds the firmware example, the minimal images and the on-target test for `target`.
 fn build_target(target: &'static str) -> Result<Built, String> {
-    let mut cmd = cross::cargo();
-    cmd.args([
+    let firmware = cross::build(cross::cargo().args([
         "build",
         "--profile",
         "firmware",
@@ -264,16 +222,15 @@ fn build_target(target: &'static str) -> Result<Built, String> {
         target,
         "--features",
         "firmware",
-    ])
-    .args([
-        "--message-format=json-render-diagnostics",
         "--example",
         "firmware",
-    ]);
+        "--message-format=json-render-diagnostics",
+    ]))?;
+    let mut minimal = cross::harness_build(target);
     for m in MINIMAL {
-        cmd.args(["--example", m]);
+        minimal.args(["--bin", m]);
     }
-    let images = cross::build(&mut cmd)?;
+    let harness = cross::build(&mut minimal)?;
     let tests = cross::build(cross::cargo().args([
         "test",
         "--no-run",
@@ -287,13 +244,14 @@ fn build_target(target: &'static str) -> Result<Built, String> {
     ]))?;
     Ok(Built {
         target,
-        images,
+        firmware: cross::artifact(&firmware, "firmware")?,
+        harness,
         test: cross::artifact(&tests, "on_target")?,
     })
 }
 
 /// Runs the firmware on `core`: exit 0 and one `result` line per contact model.
-fn run_firmware(core: &Core, elf: &Path) -> Result<Vec<(String, Run)>, String> {
+fn run_firmware(core: &Cpu, elf: &Path) -> Result<Vec<(String, Run)>, String> {
     let (status, log) = cross::qemu(core.machine, elf)?;
     let results: Vec<(String, Run)> = log.lines().filter_map(parse_result).collect();
     if status != Some(0) || results.len() != MODELS.len() {
@@ -333,7 +291,7 @@ fn parse_result(line: &str) -> Option<(String, Run)> {
 
 /// Runs the minimal images (each must exit 0) and measures them.
 fn sizes(
-    core: &Core,
+    core: &Cpu,
     images: &Artifacts,
     llvm_size: &Path,
     runs: &[(String, Run)],
@@ -356,7 +314,7 @@ fn sizes(
             let prepare = get(&format!("minimal_{model}_prepare"));
             Row {
                 core: core.name,
-                number: core.number,
+                number: if core.has_fpu() { "f32" } else { "fixed" },
                 model,
                 image_flash: full.flash(),
                 image_ram: full.ram(),
@@ -367,7 +325,7 @@ fn sizes(
                     .find(|(m, _)| m == model)
                     .map(|(_, r)| r.clone())
                     .unwrap_or_default(),
-                budget: core.budget,
+                budget: core.sizes,
             }
         })
         .collect())
@@ -399,7 +357,7 @@ fn fw_alias() -> Result<(), String> {
 fn board(llvm_size: &Path) -> Result<String, String> {
     let built = cross::build(
         cross::cargo()
-            .env("MISALIGN_MEMORY_X", "boards/stm32f4.x")
+            .env("MISALIGN_MEMORY_X", "harness/boards/stm32f4.x")
             .args(["build", "--release", "--target", "thumbv7em-none-eabihf"])
             .args(["--features", "rtt", "--example", "firmware"])
             .arg("--message-format=json-render-diagnostics"),
@@ -458,16 +416,4 @@ fn table(rows: &[Row]) -> (String, Vec<String>) {
         }
     }
     (t, over)
-}
-
-/// Writes `table` between the firmware markers of README.md.
-fn write_readme(table: &str) -> Result<(), String> {
-    let path = crate::root().join("README.md");
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("README.md: {e}"))?;
-    let (begin, end) = ("<!-- firmware:begin -->", "<!-- firmware:end -->");
-    let (Some(a), Some(b)) = (text.find(begin), text.find(end)) else {
-        return Err("README.md has no firmware markers".into());
-    };
-    let new = format!("{}{begin}\n{table}{}", &text[..a], &text[b..]);
-    std::fs::write(&path, new).map_err(|e| format!("README.md: {e}"))
 }

@@ -1,36 +1,29 @@
 //! The benchmark image (`cargo xtask bench`): per model and per operation, the
 //! instructions per call (mean and maximum over the practical samples of
-//! `benches/common/samples.rs`), counted by SysTick under QEMU's `-icount`. One line
+//! `misalign_workload::samples`), counted by SysTick under QEMU's `-icount`. One line
 //! per measurement: `bench model=<m> op=<op> n=<calls> mean=<x> max=<y>`; the host
 //! pairs it with the error of the same code against the reference.
 //!
 //! Models: the f64 reference (soft float on every Cortex-M here), the f32 core (soft
 //! float on the M0 and M3), the fixed-point core and the Hamrock & Brewe baseline.
-#![cfg_attr(target_os = "none", no_std)]
-#![cfg_attr(target_os = "none", no_main)]
+#![no_std]
+#![no_main]
 
-#[cfg(target_os = "none")]
-#[path = "../support/mod.rs"]
-mod support;
+use misalign_harness::support;
+use misalign_logger as _;
 
-#[cfg(target_os = "none")]
-#[path = "../../benches/common/hamrock_brewe.rs"]
-mod hamrock_brewe;
-#[cfg(target_os = "none")]
-#[path = "../../benches/common/samples.rs"]
-mod samples;
+misalign_harness::log_panics_and_faults!();
 
-#[cfg(target_os = "none")]
 mod run {
-    use super::support::counter::{Counter, SystClkSource};
-    use super::{hamrock_brewe::HamrockBrewe, samples};
     use core::hint::black_box;
     use misalign::fixed::logexp::{exp2_fixed, log2_u32};
+    use misalign::fixed::tables::LOG_G_HIGH;
     use misalign::fixed::{FixedEllipticScene, FixedLineScene};
-    use misalign::float::{EllipticScene, LineScene};
-    use misalign::kernels::{axial_force::axial_force_ratio, cbrt::cbrt, sqrt::inv_sqrt};
-    use misalign::reference;
-    use misalign::tables::{G_OF_THETA, LOG_G_HIGH, THETA_OF_G};
+    use misalign::float::kernels::{axial_force::axial_force_ratio, cbrt::cbrt, sqrt::inv_sqrt};
+    use misalign::float::{EllipticScene, G_OF_THETA, LineScene, THETA_OF_G};
+    use misalign::{Scene, reference};
+    use misalign_harness::support::counter::{Counter, SystClkSource};
+    use misalign_workload::{Model, Operation, hamrock_brewe::HamrockBrewe, samples};
 
     /// Samples per operation (the reference, a thousand times slower, gets an eighth).
     const SAMPLES: usize = match option_env!("MISALIGN_BENCH_SAMPLES") {
@@ -71,12 +64,12 @@ mod run {
             self.sum += x as u64;
             self.max = self.max.max(x);
         }
-        fn print(&self, model: &str, op: &str) {
+        fn print(&self, model: Model, op: Operation) {
             let mean = (self.sum + self.n as u64 / 2) / (self.n as u64).max(1);
             defmt::println!(
                 "bench model={=str} op={=str} n={=u32} mean={=u64} max={=u32}",
-                model,
-                op,
+                model.name(),
+                op.name(),
                 self.n,
                 mean,
                 self.max
@@ -97,7 +90,7 @@ mod run {
     }
 
     pub fn main(counter: Counter) -> i32 {
-        let scene = samples::scene();
+        let scene = Scene::DEMO;
         let (Ok(core), Ok(line)) = (EllipticScene::new(&scene), LineScene::new(&scene)) else {
             return 2;
         };
@@ -108,7 +101,7 @@ mod run {
         ) else {
             return 2;
         };
-        let baseline = HamrockBrewe::new(0.05, 0.05, 79.3e9, 0.3, 0.3);
+        let baseline = HamrockBrewe::of(&scene);
         let f32s = || samples::practical(SAMPLES).map(|(p, phi)| (p as f32, phi as f32));
         let counts = || {
             samples::practical(SAMPLES)
@@ -117,37 +110,40 @@ mod run {
         let c = &counter;
 
         // The full per-sample estimate (d/b, regime, F, phi0), every model.
-        each(c, f32s(), |(p, phi)| core.estimate(p, phi)).print("f32", "estimate");
-        each(c, counts(), |(p, a)| fixed.estimate(p, a)).print("fixed", "estimate");
-        each(c, f32s(), |(p, phi)| baseline.estimate(p, phi)).print("hamrock-brewe", "estimate");
+        each(c, f32s(), |(p, phi)| core.estimate(p, phi)).print(Model::F32, Operation::Estimate);
+        each(c, counts(), |(p, a)| fixed.estimate(p, a)).print(Model::Fixed, Operation::Estimate);
+        each(c, f32s(), |(p, phi)| baseline.estimate(p, phi))
+            .print(Model::HamrockBrewe, Operation::Estimate);
         // Line contact.
-        each(c, f32s(), |(p, phi)| line.estimate(p, phi)).print("f32", "estimate:line");
-        each(c, counts(), |(p, a)| fixed_line.estimate(p, a)).print("fixed", "estimate:line");
+        each(c, f32s(), |(p, phi)| line.estimate(p, phi))
+            .print(Model::F32, Operation::EstimateLine);
+        each(c, counts(), |(p, a)| fixed_line.estimate(p, a))
+            .print(Model::Fixed, Operation::EstimateLine);
         // The f32 kernels, on what they see in these estimates.
         let thetas = || f32s().map(|(_, phi)| phi.abs());
-        each(c, thetas(), |t| G_OF_THETA.eval(t)).print("f32", "table:g");
+        each(c, thetas(), |t| G_OF_THETA.eval(t)).print(Model::F32, Operation::TableG);
         each(c, f32s().map(|(p, _)| 0.93 * libm::cbrtf(p) * 1e-4), |g| {
             THETA_OF_G.eval(g)
         })
-        .print("f32", "table:theta_of_g");
-        each(c, f32s().map(|(p, _)| p), cbrt).print("f32", "kernel:cbrt");
-        each(c, f32s().map(|(p, _)| p), libm::cbrtf).print("f32", "kernel:libm_cbrtf");
-        each(c, f32s().map(|(p, _)| p), inv_sqrt).print("f32", "kernel:inv_sqrt");
-        each(c, f32s().map(|(p, _)| p), libm::sqrtf).print("f32", "kernel:libm_sqrtf");
+        .print(Model::F32, Operation::TableThetaOfG);
+        each(c, f32s().map(|(p, _)| p), cbrt).print(Model::F32, Operation::KernelCbrt);
+        each(c, f32s().map(|(p, _)| p), libm::cbrtf).print(Model::F32, Operation::KernelLibmCbrtf);
+        each(c, f32s().map(|(p, _)| p), inv_sqrt).print(Model::F32, Operation::KernelInvSqrt);
+        each(c, f32s().map(|(p, _)| p), libm::sqrtf).print(Model::F32, Operation::KernelLibmSqrtf);
         let slips = || (0..SAMPLES).map(|i| (i as f32 + 0.5) / SAMPLES as f32);
-        each(c, slips(), axial_force_ratio).print("f32", "kernel:axial_force");
+        each(c, slips(), axial_force_ratio).print(Model::F32, Operation::KernelAxialForce);
         // The fixed-point kernels.
-        each(c, counts().map(|(p, _)| p), log2_u32).print("fixed", "kernel:log2");
+        each(c, counts().map(|(p, _)| p), log2_u32).print(Model::Fixed, Operation::KernelLog2);
         each(c, counts().map(|(p, _)| (p as i32) >> 8), |l| {
             exp2_fixed(-l, 24)
         })
-        .print("fixed", "kernel:exp2");
+        .print(Model::Fixed, Operation::KernelExp2);
         each(
             c,
             counts().map(|(_, a)| -(a.unsigned_abs() as i32 >> 6)),
             |y| LOG_G_HIGH.eval(y),
         )
-        .print("fixed", "table:log_g");
+        .print(Model::Fixed, Operation::TableLogG);
 
         // The f64 reference, a thousand times slower: on SysTick's reference clock,
         // whose 24 bits last long enough (the core clock's would wrap on a Cortex-M0).
@@ -165,16 +161,15 @@ mod run {
         each(c, samples::practical(few), |(p, phi)| {
             reference::elliptic(&scene, p, phi)
         })
-        .print("reference", "estimate");
+        .print(Model::Reference, Operation::Estimate);
         each(c, samples::practical(few), |(p, phi)| {
             reference::line(&scene, p, phi)
         })
-        .print("reference", "estimate:line");
+        .print(Model::Reference, Operation::EstimateLine);
         0
     }
 }
 
-#[cfg(target_os = "none")]
 #[cortex_m_rt::entry]
 fn main() -> ! {
     let Some(peripherals) = cortex_m::Peripherals::take() else {
@@ -183,10 +178,4 @@ fn main() -> ! {
     let counter = support::counter::Counter::new(peripherals.SYST);
     defmt::println!("bench ticks_per_1000={=u32}", counter.ticks_per_1000());
     support::exit(run::main(counter))
-}
-
-#[cfg(not(target_os = "none"))]
-fn main() {
-    eprintln!("a firmware image: `cargo xtask bench` builds it for Cortex-M and runs it in QEMU");
-    std::process::exit(2);
 }

@@ -1,26 +1,18 @@
 //! Minimal image without the estimator: the baseline of the size table. It reads
 //! the scene and a sample and emits them as `minimal_elliptic` and `minimal_line`
 //! read theirs and emit their answers.
-#![cfg_attr(target_os = "none", no_std)]
-#![cfg_attr(target_os = "none", no_main)]
+#![no_std]
+#![no_main]
 
-#[cfg(target_os = "none")]
-mod common;
-#[cfg(target_os = "none")]
-mod panic;
+use misalign_harness::io;
 
-#[cfg(target_os = "none")]
+misalign_harness::exit_on_panic!();
+
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    let (r1, r2, g, nu, mu) = common::scene();
-    common::emit((r1, r2, g, nu, mu));
-    let (load, phi) = common::sample();
-    common::emit((load, phi));
-    common::exit(0)
-}
-
-#[cfg(not(target_os = "none"))]
-fn main() {
-    eprintln!("a firmware image: `cargo xtask firmware` builds it for Cortex-M");
-    std::process::exit(2);
+    let (r1, r2, g, nu, mu) = io::scene();
+    io::emit((r1, r2, g, nu, mu));
+    let (load, phi) = io::sample();
+    io::emit((load, phi));
+    io::exit(0)
 }

@@ -1,53 +1,22 @@
 //! Minimal image with the elliptic estimator: prepares the scene once
-//! ([`EllipticScene::new`], f64) and estimates one sample. Its flash minus that of
+//! ([`EllipticScene::new`], f64) and estimates one sample; without an FPU (Cortex-M0,
+//! M3) the fixed-point core's ([`FixedEllipticScene::new`]). Its flash minus that of
 //! `minimal_elliptic_prepare` is the per-sample estimator (code and tables).
-#![cfg_attr(target_os = "none", no_std)]
-#![cfg_attr(target_os = "none", no_main)]
+#![no_std]
+#![no_main]
 
-#[cfg(target_os = "none")]
-mod common;
-#[cfg(target_os = "none")]
-mod panic;
+use misalign_harness::io;
 
-#[cfg(all(target_os = "none", target_abi = "eabihf"))]
+use misalign::fixed::FixedEllipticScene;
+use misalign::float::EllipticScene;
+
+misalign_harness::exit_on_panic!();
+
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    use misalign::{Scene, float::EllipticScene};
-    let (r1, r2, g, nu, mu) = common::scene();
-    let Ok(scene) = Scene::new(r1, r2, g, nu, mu).and_then(|s| EllipticScene::new(&s)) else {
-        common::exit(2)
-    };
-    let (load, phi) = common::sample();
-    match scene.estimate(load, phi) {
-        Ok(e) => {
-            common::emit(e);
-            common::exit(0)
-        }
-        Err(_) => common::exit(1),
-    }
-}
-
-/// Without an FPU (Cortex-M0, M3) the image holds the fixed-point core.
-#[cfg(all(target_os = "none", not(target_abi = "eabihf")))]
-#[cortex_m_rt::entry]
-fn main() -> ! {
-    use misalign::{Scene, fixed::FixedEllipticScene};
-    let (r1, r2, g, nu, mu) = common::scene();
-    let prepared = Scene::new(r1, r2, g, nu, mu)
-        .and_then(|s| FixedEllipticScene::new(&s, common::LOAD_LSB, common::ANGLE_LSB));
-    let Ok(scene) = prepared else { common::exit(2) };
-    let (load, angle) = common::counts();
-    match scene.estimate(load, angle) {
-        Ok(e) => {
-            common::emit(e);
-            common::exit(0)
-        }
-        Err(_) => common::exit(1),
-    }
-}
-
-#[cfg(not(target_os = "none"))]
-fn main() {
-    eprintln!("a firmware image: `cargo xtask firmware` builds it for Cortex-M");
-    std::process::exit(2);
+    io::image(
+        EllipticScene::new,
+        FixedEllipticScene::new,
+        io::Body::Estimate,
+    )
 }

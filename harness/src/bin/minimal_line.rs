@@ -1,53 +1,18 @@
 //! Minimal image with the line-contact estimator: prepares the scene once
-//! ([`LineScene::new`], f64) and estimates one sample. Its flash minus that of
+//! ([`LineScene::new`], f64) and estimates one sample; without an FPU (Cortex-M0, M3)
+//! the fixed-point core's ([`FixedLineScene::new`]). Its flash minus that of
 //! `minimal_line_prepare` is the per-sample estimator (code and tables).
-#![cfg_attr(target_os = "none", no_std)]
-#![cfg_attr(target_os = "none", no_main)]
+#![no_std]
+#![no_main]
 
-#[cfg(target_os = "none")]
-mod common;
-#[cfg(target_os = "none")]
-mod panic;
+use misalign_harness::io;
 
-#[cfg(all(target_os = "none", target_abi = "eabihf"))]
+use misalign::fixed::FixedLineScene;
+use misalign::float::LineScene;
+
+misalign_harness::exit_on_panic!();
+
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    use misalign::{Scene, float::LineScene};
-    let (r1, r2, g, nu, mu) = common::scene();
-    let Ok(scene) = Scene::new(r1, r2, g, nu, mu).and_then(|s| LineScene::new(&s)) else {
-        common::exit(2)
-    };
-    let (load, phi) = common::sample();
-    match scene.estimate(load, phi) {
-        Ok(e) => {
-            common::emit(e);
-            common::exit(0)
-        }
-        Err(_) => common::exit(1),
-    }
-}
-
-/// Without an FPU (Cortex-M0, M3) the image holds the fixed-point core.
-#[cfg(all(target_os = "none", not(target_abi = "eabihf")))]
-#[cortex_m_rt::entry]
-fn main() -> ! {
-    use misalign::{Scene, fixed::FixedLineScene};
-    let (r1, r2, g, nu, mu) = common::scene();
-    let prepared = Scene::new(r1, r2, g, nu, mu)
-        .and_then(|s| FixedLineScene::new(&s, common::LOAD_LSB, common::ANGLE_LSB));
-    let Ok(scene) = prepared else { common::exit(2) };
-    let (load, angle) = common::counts();
-    match scene.estimate(load, angle) {
-        Ok(e) => {
-            common::emit(e);
-            common::exit(0)
-        }
-        Err(_) => common::exit(1),
-    }
-}
-
-#[cfg(not(target_os = "none"))]
-fn main() {
-    eprintln!("a firmware image: `cargo xtask firmware` builds it for Cortex-M");
-    std::process::exit(2);
+    io::image(LineScene::new, FixedLineScene::new, io::Body::Estimate)
 }

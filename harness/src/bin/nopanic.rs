@@ -6,44 +6,40 @@
 //! to a symbol that does not exist: the image links only if the optimiser (release,
 //! fat LTO: the `firmware` profile) removed every path to a panic. It also runs: in
 //! QEMU it exits with 0.
-#![cfg_attr(target_os = "none", no_std)]
-#![cfg_attr(target_os = "none", no_main)]
+#![no_std]
+#![no_main]
 
-#[cfg(target_os = "none")]
 use panic_never as _;
 
-#[cfg(target_os = "none")]
-#[path = "../minimal/common.rs"]
-mod io;
+use misalign_harness::io;
 
 /// Which per-sample paths run: both cores.
-#[cfg(target_os = "none")]
 mod paths {
     use misalign::fixed::{FixedEllipticScene, FixedLineScene};
     use misalign::float::{EllipticScene, LineScene};
     use misalign::{Error, Scene};
+    use misalign_harness::io;
 
     pub fn fixed_core(scene: &Scene, load: u32, angle: i32) -> Result<(), Error> {
-        let (lsb_p, lsb_a) = (super::io::LOAD_LSB, super::io::ANGLE_LSB);
+        let (lsb_p, lsb_a) = (io::LOAD_LSB, io::ANGLE_LSB);
         let elliptic = FixedEllipticScene::new(scene, lsb_p, lsb_a)?;
         let line = FixedLineScene::new(scene, lsb_p, lsb_a)?;
-        super::io::emit(elliptic.estimate(load, angle));
-        super::io::emit(elliptic.details(load, angle));
-        super::io::emit(line.estimate(load, angle));
+        io::emit(elliptic.estimate(load, angle));
+        io::emit(elliptic.details(load, angle));
+        io::emit(line.estimate(load, angle));
         Ok(())
     }
 
     pub fn f32_core(scene: &Scene, load: f32, phi: f32) -> Result<(), Error> {
         let elliptic = EllipticScene::new(scene)?;
         let line = LineScene::new(scene)?;
-        super::io::emit(elliptic.estimate(load, phi));
-        super::io::emit(elliptic.details(load, phi));
-        super::io::emit(line.estimate(load, phi));
+        io::emit(elliptic.estimate(load, phi));
+        io::emit(elliptic.details(load, phi));
+        io::emit(line.estimate(load, phi));
         Ok(())
     }
 }
 
-#[cfg(target_os = "none")]
 #[cortex_m_rt::entry]
 fn main() -> ! {
     let (r1, r2, g, nu, mu) = io::scene();
@@ -54,10 +50,4 @@ fn main() -> ! {
         paths::fixed_core(&scene, load_counts, angle_counts)
     });
     semihosting::process::exit(if result.is_ok() { 0 } else { 1 })
-}
-
-#[cfg(not(target_os = "none"))]
-fn main() {
-    eprintln!("a firmware image: `cargo xtask nopanic` builds it for Cortex-M");
-    std::process::exit(2);
 }

@@ -9,7 +9,7 @@
 //!   `1 - s` is exact there.
 
 use super::sqrt::inv_sqrt_normal;
-use crate::tables::{AXIAL_FORCE_HIGH, AXIAL_FORCE_LOW};
+use crate::float::tables::{AXIAL_FORCE_HIGH, AXIAL_FORCE_LOW};
 
 /// Maximum relative error of [`axial_force_ratio`] against eq (21) in f64, over all
 /// f32 s with a normal result (s >= 2^-126): 1.272e-7 measured over every one of them
