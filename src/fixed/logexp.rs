@@ -10,8 +10,8 @@ use super::tables::{EXP2_FRACTION, LOG2_MANTISSA};
 /// all 2^24 fractions it can see, plus 8.6e-8 for the bits below them (test below).
 pub const LOG2_MAX_ERROR: f64 = 3.3e-7;
 
-/// Maximum relative error of [`exp2_fixed`] before the final truncation to an integer,
-/// over all 2^24 Q8.24 fractions (test below).
+/// Maximum relative error of the Q8.24 exp2 (`exp2_fixed`) before the final
+/// truncation to an integer, over all 2^24 Q8.24 fractions (test below).
 pub const EXP2_MAX_REL_ERROR: f64 = 2.6e-7;
 
 /// `log2(x)` in Q8.24 for `x >= 1` (`x = 0` gives `i32::MIN`, standing for -inf).

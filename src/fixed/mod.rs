@@ -33,6 +33,7 @@ internal! {
 
 pub use elliptic::{FixedDetails, FixedEllipticScene};
 pub use line::FixedLineScene;
+pub use logexp::EXP2_MAX_REL_ERROR;
 
 use crate::Error;
 use crate::reference::Regime;
@@ -73,7 +74,7 @@ impl Log2 {
     }
 
     /// The value as f32, by integer operations only (no libm, no soft-float exp2):
-    /// relative error at most [`logexp::EXP2_MAX_REL_ERROR`] plus half an f32 ulp;
+    /// relative error at most [`EXP2_MAX_REL_ERROR`] plus half an f32 ulp;
     /// below f32's normal range it is 0, above it +infinity.
     pub fn to_f32(self) -> f32 {
         let l = self.0;
