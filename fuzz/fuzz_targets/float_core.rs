@@ -6,7 +6,7 @@ use arbitrary::Arbitrary;
 use libfuzzer_sys::fuzz_target;
 use misalign::Scene;
 use misalign::float::{EllipticScene, LineScene};
-use misalign::kernels::{axial_force, cbrt, sqrt};
+use misalign::float::kernels::{axial_force, cbrt, sqrt};
 
 #[derive(Arbitrary, Debug)]
 struct Input {
