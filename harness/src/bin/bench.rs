@@ -90,7 +90,9 @@ mod run {
     }
 
     pub fn main(counter: Counter) -> i32 {
-        let scene = Scene::DEMO;
+        // Opaque to the optimiser, as a scene read from a configuration block: nothing
+        // of it is folded into the per-sample code.
+        let scene = black_box(Scene::DEMO);
         let (Ok(core), Ok(line)) = (EllipticScene::new(&scene), LineScene::new(&scene)) else {
             return 2;
         };
