@@ -493,25 +493,12 @@ fn rows(samples: usize) -> Result<Vec<Row>, String> {
         .collect())
 }
 
-/// The figure's rows: every estimate, and the kernels where they run (f32 on the
-/// Cortex-M4F, fixed point on the Cortex-M0), so that the labels stay legible.
-fn figure_rows(rows: &[Row]) -> Vec<BenchRow> {
-    rows.iter()
-        .filter(|r| {
-            r.operation == Operation::Estimate
-                || (r.operation != Operation::EstimateLine
-                    && ((r.model == Model::F32 && r.cpu == "cortex-m4f")
-                        || (r.model == Model::Fixed && r.cpu == "cortex-m0")))
-        })
-        .map(Row::plotted)
-        .collect()
-}
-
 /// docs/bench.csv, docs/speed-vs-error.svg and the README's tables.
 fn write_outputs(rows: &[Row]) -> Result<(), String> {
     let docs = crate::root().join("docs");
     std::fs::write(docs.join("bench.csv"), csv_text(rows)).map_err(|e| e.to_string())?;
-    crate::figures::speed_vs_error(&figure_rows(rows), &docs.join("speed-vs-error.svg"))
+    let plotted: Vec<BenchRow> = rows.iter().map(Row::plotted).collect();
+    crate::figures::speed_vs_error(&plotted, &docs.join("speed-vs-error.svg"))
         .map_err(|e| e.to_string())?;
     let tables = format!("{}\n{}", readable(rows), accuracy_and_cost(rows));
     crate::write_readme_section("bench", &tables)

@@ -61,18 +61,14 @@ struct Row {
 /// `readme`: also write the table into README.md (between its firmware markers).
 pub fn run(readme: bool) -> ExitCode {
     let start = Instant::now();
-    let mut failures: Vec<String> = Vec::new();
-    if let Err(e) = preflight() {
-        eprintln!("firmware: {e}");
-        return ExitCode::FAILURE;
-    }
-    let llvm_size = match cross::llvm_tool("llvm-size") {
+    let llvm_size = match preflight().and_then(|()| cross::llvm_tool("llvm-size")) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("firmware: {e}");
             return ExitCode::FAILURE;
         }
     };
+    let mut failures: Vec<String> = Vec::new();
     let mut rows = Vec::new();
     let mut built: Vec<Built> = Vec::new();
     // The Cortex-M4F first: the README's table starts with the FPU core.
@@ -91,59 +87,10 @@ pub fn run(readme: bool) -> ExitCode {
                 }
             }
         }
-        let Built {
-            firmware,
-            harness,
-            test,
-            ..
-        } = built.iter().find(|b| b.target == core.target).unwrap();
-
-        // The firmware: every answer checked, stack and instructions measured.
-        let runs = match run_firmware(core, firmware) {
-            Ok(runs) => runs,
-            Err(e) => {
-                failures.push(format!("{} firmware: {e}", core.name));
-                Vec::new()
-            }
-        };
-
-        // The on-target tests.
-        match cross::qemu(core.machine, test) {
-            Ok((Some(0), log)) if log.contains("all tests passed!") => {
-                let n = log.lines().filter(|l| l.contains(") running `")).count();
-                println!("  on-target tests: {n} passed");
-            }
-            Ok((status, log)) => failures.push(format!(
-                "{} on-target tests failed (exit {status:?}):\n{log}",
-                core.name
-            )),
-            Err(e) => failures.push(format!("{} on-target tests: {e}", core.name)),
-        }
-
-        // The minimal images: they run, and their sizes.
-        if core.sizes {
-            match sizes(core, harness, &llvm_size, &runs) {
-                Ok(mut r) => rows.append(&mut r),
-                Err(e) => failures.push(format!("{} sizes: {e}", core.name)),
-            }
-        }
+        let b = built.iter().find(|b| b.target == core.target).unwrap();
+        rows.extend(check_core(core, b, &llvm_size, &mut failures));
     }
-
-    step(start, "the README's command: cargo fw");
-    match fw_alias() {
-        Ok(()) => println!("  cargo fw: exit 0"),
-        Err(e) => failures.push(format!("cargo fw: {e}")),
-    }
-
-    step(
-        start,
-        "a real board's layout: MISALIGN_MEMORY_X=harness/boards/stm32f4.x, --features rtt",
-    );
-    match board(&llvm_size) {
-        Ok(line) => println!("  {line}"),
-        Err(e) => failures.push(format!("board build: {e}")),
-    }
-
+    check_commands(start, &llvm_size, &mut failures);
     let (table, over) = table(&rows);
     println!(
         "\nEstimator on Cortex-M (profile `firmware`, bytes; budget per sample on the FPU core: \
@@ -157,16 +104,68 @@ pub fn run(readme: bool) -> ExitCode {
         }
     }
     step(start, "done");
+    report(&failures)
+}
+
+/// On one core: the firmware (every answer checked, stack and instructions measured),
+/// the on-target tests, and the minimal images (they run; their sizes) where the core
+/// measures them. Returns the core's rows of the size table.
+fn check_core(core: &Cpu, built: &Built, llvm_size: &Path, failures: &mut Vec<String>) -> Vec<Row> {
+    let runs = match run_firmware(core, &built.firmware) {
+        Ok(runs) => runs,
+        Err(e) => {
+            failures.push(format!("{} firmware: {e}", core.name));
+            Vec::new()
+        }
+    };
+    match cross::qemu(core.machine, &built.test) {
+        Ok((Some(0), log)) if log.contains("all tests passed!") => {
+            let n = log.lines().filter(|l| l.contains(") running `")).count();
+            println!("  on-target tests: {n} passed");
+        }
+        Ok((status, log)) => failures.push(format!(
+            "{} on-target tests failed (exit {status:?}):\n{log}",
+            core.name
+        )),
+        Err(e) => failures.push(format!("{} on-target tests: {e}", core.name)),
+    }
+    if !core.sizes {
+        return Vec::new();
+    }
+    sizes(core, &built.harness, llvm_size, &runs).unwrap_or_else(|e| {
+        failures.push(format!("{} sizes: {e}", core.name));
+        Vec::new()
+    })
+}
+
+/// The README's command (`cargo fw`) and the real board's build.
+fn check_commands(start: Instant, llvm_size: &Path, failures: &mut Vec<String>) {
+    step(start, "the README's command: cargo fw");
+    match fw_alias() {
+        Ok(()) => println!("  cargo fw: exit 0"),
+        Err(e) => failures.push(format!("cargo fw: {e}")),
+    }
+    step(
+        start,
+        "a real board's layout: MISALIGN_MEMORY_X=harness/boards/stm32f4.x, --features rtt",
+    );
+    match board(llvm_size) {
+        Ok(line) => println!("  {line}"),
+        Err(e) => failures.push(format!("board build: {e}")),
+    }
+}
+
+/// Success if nothing failed, else every failure on stderr.
+fn report(failures: &[String]) -> ExitCode {
     if failures.is_empty() {
         println!("firmware: every image and on-target test passed, within budget");
-        ExitCode::SUCCESS
-    } else {
-        for f in &failures {
-            eprintln!("\nFAILED: {f}");
-        }
-        eprintln!("\nfirmware: {} failure(s)", failures.len());
-        ExitCode::FAILURE
+        return ExitCode::SUCCESS;
     }
+    for f in failures {
+        eprintln!("\nFAILED: {f}");
+    }
+    eprintln!("\nfirmware: {} failure(s)", failures.len());
+    ExitCode::FAILURE
 }
 
 fn step(start: Instant, what: &str) {

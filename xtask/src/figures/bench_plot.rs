@@ -79,17 +79,84 @@ pub fn parse_bench_csv(text: &str) -> Res<Vec<BenchRow>> {
     Ok(rows.into_iter().filter(plotted).collect())
 }
 
-/// Whether the figure plots `row`: a whole estimate, or a `table:` or `kernel:`
-/// variant.
+/// Whether the figure plots `row`: every elliptic estimate, and the `table:` and
+/// `kernel:` variants where they run (f32 on the Cortex-M4F, fixed point on the
+/// Cortex-M0), so that the labels stay legible.
 pub fn plotted(row: &BenchRow) -> bool {
-    row.operation == "estimate"
-        || row.operation.starts_with("table:")
-        || row.operation.starts_with("kernel:")
+    let variant = row.operation.starts_with("table:") || row.operation.starts_with("kernel:");
+    let where_it_runs = (row.model == "f32" && row.cpu == "cortex-m4f")
+        || (row.model == "fixed" && row.cpu == "cortex-m0");
+    row.operation == "estimate" || (variant && where_it_runs)
 }
 
 /// `cortex-m4f` -> `m4f`.
 fn short_cpu(cpu: &str) -> &str {
     cpu.strip_prefix("cortex-").unwrap_or(cpu)
+}
+
+/// The figure's log axes, in whole decades.
+struct Axes {
+    /// Where an error of exactly 0 (the reference against itself) is drawn: on a
+    /// dashed line one decade below the smallest non-zero error, which says so.
+    floor: f64,
+    x_lo: i32,
+    x_hi: i32,
+    y_lo: i32,
+    y_hi: i32,
+    /// Some row has an error of exactly 0.
+    has_zero: bool,
+}
+
+impl Axes {
+    fn of(rows: &[BenchRow]) -> Self {
+        let min_err = rows
+            .iter()
+            .map(|r| r.error)
+            .filter(|e| *e > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        let floor = if min_err.is_finite() {
+            ten_to(min_err.log10().floor() as i32 - 1)
+        } else {
+            1e-16
+        };
+        // Three times the largest count leaves room for the labels right of the points.
+        let (x_lo, _) = decades(rows.iter().map(|r| r.instructions));
+        let (_, x_hi) = decades(rows.iter().map(|r| r.instructions * 3.0));
+        let (y_lo, y_hi) = decades(rows.iter().map(|r| r.error.max(floor)));
+        let has_zero = rows.iter().any(|r| r.error == 0.0);
+        Axes {
+            floor,
+            x_lo,
+            x_hi,
+            y_lo: y_lo - i32::from(has_zero),
+            y_hi,
+            has_zero,
+        }
+    }
+}
+
+/// Whole decades around `values`: (floor(log10 min), ceil(log10 max)), at least one.
+fn decades(values: impl Iterator<Item = f64>) -> (i32, i32) {
+    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    let (lo, hi) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    (lo, hi.max(lo + 1))
+}
+
+/// The models of the estimate rows: the four known ones in a fixed order, then any
+/// other in sorted order.
+fn models_in_order(rows: &[BenchRow]) -> Vec<&str> {
+    let mut models: Vec<&str> = vec!["reference", "f32", "fixed", "hamrock-brewe"];
+    let mut others: Vec<&str> = rows
+        .iter()
+        .filter(|r| r.operation == "estimate" && !models.contains(&r.model.as_str()))
+        .map(|r| r.model.as_str())
+        .collect();
+    others.sort_unstable();
+    others.dedup();
+    models.extend(others);
+    models
 }
 
 /// The speed-against-error figure of the benchmark's `rows` (those it [`plotted`]) as
@@ -106,44 +173,16 @@ pub fn speed_vs_error_svg(rows: &[BenchRow]) -> Res<String> {
     if rows.is_empty() {
         return Err("bench CSV has no estimate, table: or kernel: row to plot".into());
     }
-    // An error of exactly 0 (the reference against itself) is drawn on a dashed
-    // line one decade below the smallest non-zero error, which says so.
-    let min_err = rows
-        .iter()
-        .map(|r| r.error)
-        .filter(|e| *e > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    let floor = if min_err.is_finite() {
-        ten_to(min_err.log10().floor() as i32 - 1)
-    } else {
-        1e-16
-    };
+    let Axes {
+        floor,
+        x_lo,
+        x_hi,
+        y_lo,
+        y_hi,
+        has_zero,
+    } = Axes::of(&rows);
     let y_of = |r: &BenchRow| r.error.max(floor);
-    // Whole decades around the data: (floor(log10 min), ceil(log10 max)), at least one.
-    let decades = |values: &mut dyn Iterator<Item = f64>| {
-        let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        });
-        let (lo, hi) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
-        (lo, hi.max(lo + 1))
-    };
-    // Three times the largest count leaves room for the labels right of the points.
-    let (x_lo, _) = decades(&mut rows.iter().map(|r| r.instructions));
-    let (_, x_hi) = decades(&mut rows.iter().map(|r| r.instructions * 3.0));
-    let (y_lo, y_hi) = decades(&mut rows.iter().map(y_of));
-    let has_zero = rows.iter().any(|r| r.error == 0.0);
-    let y_lo = y_lo - i32::from(has_zero);
-
-    // Models in a fixed order, then any other in sorted order.
-    let mut models: Vec<&str> = vec!["reference", "f32", "fixed", "hamrock-brewe"];
-    let mut others: Vec<&str> = rows
-        .iter()
-        .filter(|r| r.operation == "estimate" && !models.contains(&r.model.as_str()))
-        .map(|r| r.model.as_str())
-        .collect();
-    others.sort_unstable();
-    others.dedup();
-    models.extend(others);
+    let models = models_in_order(&rows);
     let palette = [BLUE_, GREEN_, VERMILION, ORANGE, PURPLE, SKY, BLACK];
 
     render(|root| {
