@@ -64,11 +64,13 @@ pub const CPUS: [Cpu; 4] = [
 ];
 
 /// `cargo build` of the harness's images (harness/, its own workspace) for `target`,
-/// profile `firmware`, into the root's target directory, with JSON messages for
-/// [`build`]; add `--bin` arguments.
+/// profile `firmware`, into the root's target directory (`CARGO_TARGET_DIR` if set),
+/// with JSON messages for [`build`]; add `--bin` arguments.
 pub fn harness_build(target: &str) -> Command {
+    let target_dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(|| crate::root().join("target"), PathBuf::from);
     let mut cmd = cargo();
-    cmd.env("CARGO_TARGET_DIR", crate::root().join("target"))
+    cmd.env("CARGO_TARGET_DIR", target_dir)
         .args(["build", "--manifest-path", "harness/Cargo.toml"])
         .args(["--profile", "firmware", "--target", target])
         .arg("--message-format=json-render-diagnostics");
