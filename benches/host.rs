@@ -1,4 +1,4 @@
-//! Host speed (issue 6): nanoseconds per estimate for the f64 reference, the f32 core,
+//! Host speed: nanoseconds per estimate for the f64 reference, the f32 core,
 //! the fixed-point core and the Hamrock & Brewe baseline on the same few hundred samples
 //! over the practical domain, and estimates per second for a batch through the CSV
 //! estimator. `cargo bench --bench host`.
@@ -6,19 +6,16 @@
 #[path = "../examples/estimate/cli.rs"]
 #[allow(dead_code)]
 mod cli;
-#[path = "common/hamrock_brewe.rs"]
-mod hamrock_brewe;
-#[path = "common/samples.rs"]
-mod samples;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use misalign::fixed::{FixedEllipticScene, exact_lsb};
 use misalign::float::EllipticScene;
-use misalign::reference;
+use misalign::{Scene, reference};
+use misalign_workload::{hamrock_brewe::HamrockBrewe, samples};
 use std::hint::black_box;
 
 fn estimate(c: &mut Criterion) {
-    let scene = samples::scene();
+    let scene = Scene::DEMO;
     let inputs: Vec<(f64, f64)> = samples::practical(256).collect();
     let core = EllipticScene::new(&scene).unwrap();
     let (load_lsb, _) = exact_lsb(samples::LOAD_MAX, 1 << 30, 0.0);
@@ -28,7 +25,7 @@ fn estimate(c: &mut Criterion) {
         .iter()
         .map(|&(p, phi)| ((p / load_lsb) as u32, (phi / angle_lsb) as i32))
         .collect();
-    let baseline = hamrock_brewe::HamrockBrewe::new(0.05, 0.05, 79.3e9, 0.3, 0.3);
+    let baseline = HamrockBrewe::of(&scene);
     let mut group = c.benchmark_group("estimate");
     group.throughput(Throughput::Elements(inputs.len() as u64));
     group.bench_function("reference", |b| {

@@ -19,7 +19,7 @@
 //! fn slip_ratio<E: Estimator>(core: &E) -> f32 {
 //!     core.estimate_si(1e3, 2e-4).map(|e| e.slip_ratio).unwrap_or(f32::NAN)
 //! }
-//! let scene = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3)?;
+//! let scene = Scene::DEMO; // two steel rollers of 50 mm, mu = 0.3
 //! let f32_core = EllipticScene::new(&scene)?;
 //! // The fixed-point core counts 1 mN and 10 prad.
 //! let fixed_core = FixedEllipticScene::new(&scene, 1e-3, 1e-11)?;

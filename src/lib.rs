@@ -19,8 +19,12 @@
 //!
 //! Layers: [`scene`] (one installation, validated), [`reference`](mod@reference) (the
 //! whole paper in f64), [`float`] (the f32 core), [`fixed`] (the fixed-point core),
-//! [`kernels`] and [`tables`] (what the cores compute with). See ARCHITECTURE.md for
-//! which module owns what.
+//! [`estimator`] (the contract both cores implement). Each core keeps its kernels and
+//! generated tables inside it. See ARCHITECTURE.md for which module owns what.
+//!
+//! The hidden feature `_internals` makes the cores' kernels and tables public for the
+//! workspace's own tooling (table generator, sweeps, benchmark, fuzzing). It is not
+//! part of the API: no semver promise, not for users.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -29,11 +33,25 @@
 #[cfg_attr(test, macro_use)]
 extern crate std;
 
+/// A module that only the workspace's tooling reaches into: public (and hidden from
+/// the docs) with the feature `_internals`, crate-private without it.
+macro_rules! internal {
+    ($(#[$attr:meta])* mod $name:ident;) => {
+        #[cfg(feature = "_internals")]
+        #[doc(hidden)]
+        $(#[$attr])*
+        pub mod $name;
+        #[cfg(not(feature = "_internals"))]
+        #[allow(dead_code)]
+        $(#[$attr])*
+        pub(crate) mod $name;
+    };
+}
+
 mod error;
 pub mod estimator;
 pub mod fixed;
 pub mod float;
-pub mod kernels;
 pub mod monitor;
 pub mod reference;
 pub mod scene;
@@ -41,8 +59,6 @@ pub mod scene;
 pub mod sensors;
 #[cfg(feature = "sequential-storage")]
 pub mod storage;
-#[rustfmt::skip]
-pub mod tables;
 
 pub use error::Error;
 pub use estimator::{Estimate, Estimator};

@@ -32,6 +32,20 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The demo installation of this crate's examples, firmware, benchmarks, figures
+    /// and tests: two steel printing-press rollers, R1 = R2 = 50 mm, G = 79.3 GPa,
+    /// nu = 0.3, mu = 0.3, no length (elliptic contact). A valid scene: it is what
+    /// [`Scene::new`] makes of these values.
+    pub const DEMO: Scene = Scene {
+        r1: 0.05,
+        r2: 0.05,
+        length: None,
+        shear_modulus: 79.3e9,
+        poisson_ratio: 0.3,
+        friction: 0.3,
+        theta_relation: ThetaRelation::SmallAngle,
+    };
+
     /// A scene of two rollers of radii `r1`, `r2` (m; `r2 = f64::INFINITY` is a plane),
     /// shear modulus `shear_modulus` G (Pa), Poisson's ratio `poisson_ratio` nu and
     /// friction coefficient `friction` mu.
@@ -96,35 +110,35 @@ impl Scene {
     }
 
     /// Radius R1 (m).
-    pub fn r1(&self) -> f64 {
+    pub const fn r1(&self) -> f64 {
         self.r1
     }
     /// Radius R2 (m); infinite for a plane.
-    pub fn r2(&self) -> f64 {
+    pub const fn r2(&self) -> f64 {
         self.r2
     }
     /// Contact length of the rollers (m), if given.
-    pub fn length(&self) -> Option<f64> {
+    pub const fn length(&self) -> Option<f64> {
         self.length
     }
     /// Shear modulus G (Pa).
-    pub fn shear_modulus(&self) -> f64 {
+    pub const fn shear_modulus(&self) -> f64 {
         self.shear_modulus
     }
     /// Poisson's ratio nu.
-    pub fn poisson_ratio(&self) -> f64 {
+    pub const fn poisson_ratio(&self) -> f64 {
         self.poisson_ratio
     }
     /// Friction coefficient mu.
-    pub fn friction(&self) -> f64 {
+    pub const fn friction(&self) -> f64 {
         self.friction
     }
     /// The theta(phi) relation in use.
-    pub fn theta_relation(&self) -> ThetaRelation {
+    pub const fn theta_relation(&self) -> ThetaRelation {
         self.theta_relation
     }
     /// True when body 2 is a plane (R2 = infinity).
-    pub fn is_plane(&self) -> bool {
+    pub const fn is_plane(&self) -> bool {
         self.r2.is_infinite()
     }
 

@@ -7,7 +7,7 @@ use misalign::float::{Auto, EllipticScene, LineScene};
 use misalign::{Error, Estimate, Estimator, Scene};
 
 fn scene() -> Scene {
-    Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap()
+    Scene::DEMO
 }
 
 /// Relative difference, with both zero or both infinite counting as equal.
@@ -116,7 +116,7 @@ fn risk_threshold_is_set_the_same_way_in_every_core() {
 #[test]
 fn log2_to_f32_is_within_its_bound_over_every_fraction() {
     // Every Q8.24 fraction, at one exponent; then the limits of f32's range.
-    let bound = misalign::fixed::logexp::EXP2_MAX_REL_ERROR + f32::EPSILON as f64 / 2.0;
+    let bound = misalign::fixed::EXP2_MAX_REL_ERROR + f32::EPSILON as f64 / 2.0;
     let mut worst: f64 = 0.0;
     for f in (0..1 << 24).step_by(7) {
         let l = (-3 << 24) + f;

@@ -1,5 +1,5 @@
 //! Bad and edge input for the f32 and fixed-point cores: typed errors, defined answers
-//! at zero load and zero angle, no NaN (issue 3, "Bad input").
+//! at zero load and zero angle, no NaN: bad input never panics or answers NaN.
 
 use misalign::fixed::{FixedEllipticScene, FixedLineScene, Log2};
 use misalign::float::{EllipticScene, LineScene};
@@ -7,7 +7,7 @@ use misalign::reference::Regime;
 use misalign::{Error, Scene, ThetaRelation};
 
 fn scene() -> Scene {
-    Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap()
+    Scene::DEMO
 }
 
 #[test]
@@ -189,4 +189,20 @@ fn fixed_zero_load_and_zero_angle() {
     assert_eq!(Log2::ZERO.to_f64(), 0.0);
     assert_eq!(Log2::INFINITY.to_f64(), f64::INFINITY);
     assert_eq!(Log2::from_f64(0.0), Err(Error::OutOfRange));
+}
+
+/// The demo scene is a valid scene: exactly what `Scene::new` makes of its values.
+#[test]
+fn the_demo_scene_is_what_new_makes_of_its_values() {
+    let d = Scene::DEMO;
+    let made = Scene::new(
+        d.r1(),
+        d.r2(),
+        d.shear_modulus(),
+        d.poisson_ratio(),
+        d.friction(),
+    );
+    assert_eq!(made, Ok(d));
+    assert_eq!(d.length(), None);
+    assert_eq!(d.theta_relation(), ThetaRelation::SmallAngle);
 }

@@ -1,4 +1,4 @@
-//! The fixed-point core against the independent reference data (issue 3's targets):
+//! The fixed-point core against the independent reference data, to its accuracy target:
 //! maximum relative error <= 1e-4 for d/b, F and phi0 over every row. Each row's load
 //! and angle become counts of an LSB that represents them exactly (x = counts x LSB,
 //! with up to 1.2e9 counts, as many as the scene's angle range allows), so that what is

@@ -1,4 +1,4 @@
-//! The f32 core against the independent reference data (issue 3's targets): maximum
+//! The f32 core against the independent reference data, to its accuracy target: maximum
 //! relative error <= 2e-6 for m, n, d/b, F and phi0 over every row, inputs rounded to
 //! f32; the regime agrees except within 1e-6 of d/b = 1.
 

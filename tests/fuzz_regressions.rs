@@ -87,8 +87,11 @@ fn f32_scene_with_radii_apart_by_more_than_1e24() {
         EllipticScene::new(&s).err(),
         Some(misalign::Error::OutOfRange)
     );
-    assert_eq!(misalign::kernels::small_theta::theta_small(1e-44), 0.0);
-    assert!(misalign::kernels::small_theta::theta_small(1e-20) > 0.0);
+    assert_eq!(
+        misalign::float::kernels::small_theta::theta_small(1e-44),
+        0.0
+    );
+    assert!(misalign::float::kernels::small_theta::theta_small(1e-20) > 0.0);
 }
 
 /// Fuzz (reference and float_core): mu P overflows while d/b underflows to 0, and

@@ -1,4 +1,4 @@
-//! Hard cases (issue 5): awkward but valid input to the reference and both cores.
+//! Hard cases: awkward but valid input to the reference and both cores.
 //! Each case matches the reference within the core's stated error (f32 2e-6, fixed
 //! 1e-4) or gets a typed error from all of them: never a panic, a NaN or a silent
 //! infinity.

@@ -1,8 +1,10 @@
-//! On-target tests of the f32 core: every public path of `misalign::float` run on the
-//! microcontroller (`cargo xtask firmware` runs them on the Cortex-M4F and the
-//! Cortex-M0 in QEMU; defmt-test harness, log over semihosting, exit status 0 when
-//! all pass, 101 on the first failure). The answers are held to the f64 reference
-//! evaluated on the same target, to the relative 2e-6 of `tests/float_core.rs`.
+//! On-target tests of both cores: every public path of the f32 core (`misalign::float`)
+//! and of the fixed-point core (`misalign::fixed`) run on the microcontroller (`cargo
+//! xtask firmware` runs them on the Cortex-M4F, M7, M3 and M0 in QEMU; defmt-test
+//! harness, log over semihosting, exit status 0 when all pass, 101 on the first
+//! failure). The answers are held to the f64 reference evaluated on the same target,
+//! to the relative 2e-6 of `tests/float_core.rs` (f32) and 1e-4 (fixed point).
+//! The logger, handlers and memory layout come from the harness crate.
 //!
 //! ```sh
 //! cargo test --target thumbv7em-none-eabihf --features firmware --test on_target
@@ -14,8 +16,9 @@
 #![cfg_attr(target_os = "none", no_main)]
 
 #[cfg(target_os = "none")]
-#[path = "../examples/support/mod.rs"]
-mod support;
+misalign_harness::log_panics_and_faults!();
+#[cfg(target_os = "none")]
+use misalign_logger as _;
 
 #[cfg(not(target_os = "none"))]
 fn main() {
@@ -37,7 +40,7 @@ mod check {
     pub const ANGLES: [f32; 7] = [-1.5e-3, -2e-5, 3e-6, 9e-5, 4e-4, 1e-3, 5e-3];
 
     pub fn demo() -> Scene {
-        Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap()
+        Scene::DEMO
     }
 
     /// A scene of unequal rollers, so that theta != phi.
@@ -74,10 +77,11 @@ mod check {
 #[cfg(target_os = "none")]
 #[defmt_test::tests]
 mod tests {
+    use misalign::float::octave::{OctaveTable, Row, narrow_rows};
     use misalign::float::{EllipticScene, LineScene, Tables};
-    use misalign::kernels::octave::{OctaveTable, Row, narrow_rows};
+    use misalign::float::{G_OF_THETA, G_OF_THETA_ROWS, THETA_OF_G, THETA_OF_G_ROWS};
     use misalign::reference::{self, Regime};
-    use misalign::{Error, Scene, ThetaRelation, tables};
+    use misalign::{Error, Scene, ThetaRelation};
 
     use super::check::*;
 
@@ -275,13 +279,13 @@ mod tests {
     fn narrowed_tables_and_risk_threshold() {
         // Rows from theta = 2^-20 up: below that the scene refuses the sample.
         const SKIP: usize = 20;
-        const G_ROWS: usize = tables::G_OF_THETA_ROWS.len();
-        const T_ROWS: usize = tables::THETA_OF_G_ROWS.len();
-        static G: [Row; G_ROWS - SKIP] = narrow_rows(&tables::G_OF_THETA_ROWS, SKIP);
-        static T: [Row; T_ROWS] = narrow_rows(&tables::THETA_OF_G_ROWS, 0);
+        const G_ROWS: usize = G_OF_THETA_ROWS.len();
+        const T_ROWS: usize = THETA_OF_G_ROWS.len();
+        static G: [Row; G_ROWS - SKIP] = narrow_rows(&G_OF_THETA_ROWS, SKIP);
+        static T: [Row; T_ROWS] = narrow_rows(&THETA_OF_G_ROWS, 0);
         let narrow = Tables {
-            g: OctaveTable::new(tables::G_OF_THETA.first_exponent() + SKIP as i32, &G),
-            theta_of_g: OctaveTable::new(tables::THETA_OF_G.first_exponent(), &T),
+            g: OctaveTable::new(G_OF_THETA.first_exponent() + SKIP as i32, &G),
+            theta_of_g: OctaveTable::new(THETA_OF_G.first_exponent(), &T),
         };
         let scene = demo();
         let full = EllipticScene::new(&scene).unwrap();

@@ -1,4 +1,4 @@
-//! Property tests (issue 5): what the physics demands, on random scenes and samples,
+//! Property tests: what the physics demands, on random scenes and samples,
 //! for the reference and both cores.
 
 use misalign::Scene;

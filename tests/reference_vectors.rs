@@ -1,5 +1,5 @@
 //! The f64 reference against the independent 50-digit values of tests/data:
-//! every row, every quantity, within 1e-12 relative (issue 2).
+//! every row, every quantity, within 1e-12 relative (the reference's accuracy).
 
 mod common;
 use common::{Worst, num, read_rows};

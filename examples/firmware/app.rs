@@ -1,57 +1,72 @@
 //! The firmware proper (Cortex-M only).
 //!
-//! Every estimator is reached through [`Core`]: the f32 core where there is an FPU
-//! (Cortex-M4F, M7), the fixed-point core where there is none (Cortex-M0, M3). The
-//! trace, the check against the reference, the stack and instruction measurements are
-//! the same for both.
+//! Every core is reached through the library's estimator contract,
+//! [`misalign::Estimator`]: the f32 core where there is an FPU (Cortex-M4F, M7), the
+//! fixed-point core where there is none (Cortex-M0, M3). The trace, the check against
+//! the reference, the stack and instruction measurements are the same for both.
 
-use crate::support::{self, counter::Counter, stack};
-use crate::trace;
-use misalign::fixed::{FixedEllipticScene, FixedEstimate, FixedLineScene};
-use misalign::float::{EllipticScene, Estimate, LineScene};
+use crate::trace::{self, Answer};
+use misalign::fixed::{FixedEllipticScene, FixedLineScene};
+use misalign::float::{EllipticScene, LineScene};
 use misalign::reference::Regime;
-use misalign::{Error, Scene};
+use misalign::{Error, Estimate, Estimator, Scene};
+use misalign_harness::support::{self, counter::Counter, stack};
 
 /// The fixed-point core's LSBs in the firmware: 1 mN and 10 prad per count.
 const LOAD_LSB: f64 = 1e-3;
 const ANGLE_LSB: f64 = 1e-11;
 
-/// One answer in f32, whatever the core: what is checked against the reference.
-#[derive(Clone, Copy, defmt::Format)]
-pub struct Answer {
-    slip_ratio: f32,
-    axial_force: f32,
-    critical_angle: Option<f32>,
-    margin: Option<f32>,
-    gross: bool,
-    risk: bool,
-}
+/// "f32" with an FPU, "f32-soft" without (thumbv6m, thumbv7m: soft float).
+const F32: &str = if cfg!(target_abi = "eabihf") {
+    "f32"
+} else {
+    "f32-soft"
+};
 
-// `ELLIPTIC_EXPECTED`, `LINE_EXPECTED`: the reference's answers for `trace`.
-include!(concat!(env!("OUT_DIR"), "/firmware_expected.rs"));
-
-/// An estimator as the firmware drives it: prepared once, then one call per sample.
-trait Core {
-    /// Contact model, for the log and `cargo xtask firmware`.
-    const NAME: &'static str;
+/// How the firmware runs one prepared core: its name in the log and in `cargo xtask
+/// firmware`'s table, and what it is held to.
+struct Run<'a, E> {
+    core: &'a E,
+    /// Contact model ("elliptic", "line").
+    model: &'static str,
     /// Number format ("f32", "f32-soft", "fixed").
-    const NUMBER: &'static str;
-    /// Relative tolerance against the reference: the core's bound on the reference data
-    /// (f32 2e-6, fixed point 1e-4).
-    const TOLERANCE: f32;
-    /// A sample in the core's own units (f32 SI here; counts for a fixed-point core).
-    type Sample: Copy;
-    /// The core's own answer.
-    type Output: Copy;
-    /// The sample in the core's units; `None` when its input range cannot hold it to
-    /// 1e-5 (then it is skipped and said so).
-    fn sample(load: f32, phi: f32) -> Option<Self::Sample>;
-    fn estimate(&self, sample: Self::Sample) -> Result<Self::Output, Error>;
-    /// The answer in f32 SI units.
-    fn answer(output: &Self::Output) -> Answer;
+    number: &'static str,
+    /// Relative tolerance against the reference: the core's bound on the reference
+    /// data (f32 2e-6, fixed point 1e-4).
+    tolerance: f32,
+    /// The fixed-point core's `(load, angle)` LSBs: a sample is estimated only if its
+    /// counts hold it to 1e-5 (else it is skipped and said so); `None` for f32.
+    lsb: Option<(f64, f64)>,
 }
 
-fn f32_answer(e: &Estimate) -> Answer {
+/// The f32 core's run of `core`.
+fn f32_run<'a, E>(core: &'a E, model: &'static str) -> Run<'a, E> {
+    Run {
+        core,
+        model,
+        number: F32,
+        tolerance: 2e-6,
+        lsb: None,
+    }
+}
+
+/// The fixed-point core's run of `core`.
+fn fixed_run<'a, E>(core: &'a E, model: &'static str) -> Run<'a, E> {
+    Run {
+        core,
+        model,
+        number: "fixed",
+        tolerance: 1e-4,
+        lsb: Some((LOAD_LSB, ANGLE_LSB)),
+    }
+}
+
+/// Whether `x` is 0 or holds at least 1e5 counts of `lsb` (quantised to 5e-6 at most).
+fn representable(x: f32, lsb: f64) -> bool {
+    x == 0.0 || libm::fabs(x as f64) / lsb >= 1e5 - 0.5
+}
+
+fn answer(e: &Estimate) -> Answer {
     Answer {
         slip_ratio: e.slip_ratio,
         axial_force: e.axial_force,
@@ -62,119 +77,11 @@ fn f32_answer(e: &Estimate) -> Answer {
     }
 }
 
-/// "f32" with an FPU, "f32-soft" without (thumbv6m, thumbv7m: soft float).
-const F32: &str = if cfg!(target_abi = "eabihf") {
-    "f32"
-} else {
-    "f32-soft"
-};
-
-impl Core for EllipticScene<'static> {
-    const NAME: &'static str = "elliptic";
-    const NUMBER: &'static str = F32;
-    const TOLERANCE: f32 = 2e-6;
-    type Sample = (f32, f32);
-    type Output = Estimate;
-    fn sample(load: f32, phi: f32) -> Option<(f32, f32)> {
-        Some((load, phi))
-    }
-    #[inline(always)]
-    fn estimate(&self, (load, phi): (f32, f32)) -> Result<Estimate, Error> {
-        EllipticScene::estimate(self, load, phi)
-    }
-    fn answer(e: &Estimate) -> Answer {
-        f32_answer(e)
-    }
-}
-
-impl Core for LineScene {
-    const NAME: &'static str = "line";
-    const NUMBER: &'static str = F32;
-    const TOLERANCE: f32 = 2e-6;
-    type Sample = (f32, f32);
-    type Output = Estimate;
-    fn sample(load: f32, phi: f32) -> Option<(f32, f32)> {
-        Some((load, phi))
-    }
-    #[inline(always)]
-    fn estimate(&self, (load, phi): (f32, f32)) -> Result<Estimate, Error> {
-        LineScene::estimate(self, load, phi)
-    }
-    fn answer(e: &Estimate) -> Answer {
-        f32_answer(e)
-    }
-}
-
-/// A value as counts of `lsb`, if it is 0 or holds at least 1e5 counts (quantised to
-/// 5e-6 at most) and fits.
-fn counts(x: f32, lsb: f64, max: f64) -> Option<f64> {
-    let c = libm::round(libm::fabs(x as f64) / lsb);
-    ((x == 0.0 || c >= 1e5) && c <= max).then_some(c)
-}
-
-fn fixed_sample(load: f32, phi: f32) -> Option<(u32, i32)> {
-    let p = counts(load, LOAD_LSB, u32::MAX as f64)?;
-    let a = counts(phi, ANGLE_LSB, i32::MAX as f64)?;
-    Some((p as u32, if phi < 0.0 { -(a as i32) } else { a as i32 }))
-}
-
-fn fixed_answer(e: &FixedEstimate) -> Answer {
-    let force = e.axial_force.to_f64() as f32;
-    Answer {
-        slip_ratio: e.slip_ratio.to_f64() as f32,
-        axial_force: if e.axial_force_negative {
-            -force
-        } else {
-            force
-        },
-        critical_angle: e.critical_angle.map(|c| c.to_f64() as f32),
-        margin: e.margin.map(|m| (m as f64 * ANGLE_LSB) as f32),
-        gross: e.regime == Regime::Gross,
-        risk: e.microslip_risk,
-    }
-}
-
-impl Core for FixedEllipticScene {
-    const NAME: &'static str = "elliptic";
-    const NUMBER: &'static str = "fixed";
-    const TOLERANCE: f32 = 1e-4;
-    type Sample = (u32, i32);
-    type Output = FixedEstimate;
-    fn sample(load: f32, phi: f32) -> Option<(u32, i32)> {
-        fixed_sample(load, phi)
-    }
-    #[inline(always)]
-    fn estimate(&self, (load, angle): (u32, i32)) -> Result<FixedEstimate, Error> {
-        FixedEllipticScene::estimate(self, load, angle)
-    }
-    fn answer(e: &FixedEstimate) -> Answer {
-        fixed_answer(e)
-    }
-}
-
-impl Core for FixedLineScene {
-    const NAME: &'static str = "line";
-    const NUMBER: &'static str = "fixed";
-    const TOLERANCE: f32 = 1e-4;
-    type Sample = (u32, i32);
-    type Output = FixedEstimate;
-    fn sample(load: f32, phi: f32) -> Option<(u32, i32)> {
-        fixed_sample(load, phi)
-    }
-    #[inline(always)]
-    fn estimate(&self, (load, angle): (u32, i32)) -> Result<FixedEstimate, Error> {
-        FixedLineScene::estimate(self, load, angle)
-    }
-    fn answer(e: &FixedEstimate) -> Answer {
-        fixed_answer(e)
-    }
-}
-
 /// The per-sample call whose stack and instructions are measured: the estimator and
 /// nothing else (it is inlined here).
 #[inline(never)]
-fn call<C: Core>(core: &C, sample: C::Sample) -> Result<C::Output, Error> {
-    core.estimate(sample)
+fn call<E: Estimator>(core: &E, load: E::Load, phi: E::Angle) -> Result<E::Output, Error> {
+    core.estimate(load, phi)
 }
 
 #[cortex_m_rt::entry]
@@ -188,35 +95,38 @@ fn main() -> ! {
         F32,
         counter.ticks_per_1000()
     );
-    let (r1, r2, g, nu, mu) = trace::SCENE;
-    let Ok(scene) = Scene::new(r1, r2, g, nu, mu) else {
-        support::exit(2)
-    };
+    let scene = Scene::DEMO;
     let failures = if cfg!(target_abi = "eabihf") {
         // With an FPU: the f32 core.
-        let prepared = EllipticScene::new(&scene).and_then(|e| Ok((e, LineScene::new(&scene)?)));
-        let Ok((elliptic, line)) = prepared else {
-            defmt::error!(
-                "cannot prepare the demo scene: {}",
-                defmt::Debug2Format(&prepared.err())
-            );
-            support::exit(2)
-        };
-        run(&elliptic, &trace::ELLIPTIC, &ELLIPTIC_EXPECTED, &counter)
-            + run(&line, &trace::LINE, &LINE_EXPECTED, &counter)
+        let (elliptic, line) = prepared(EllipticScene::new(&scene), LineScene::new(&scene));
+        run(
+            f32_run(&elliptic, "elliptic"),
+            &trace::ELLIPTIC,
+            &trace::ELLIPTIC_EXPECTED,
+            &counter,
+        ) + run(
+            f32_run(&line, "line"),
+            &trace::LINE,
+            &trace::LINE_EXPECTED,
+            &counter,
+        )
     } else {
         // Without one: the fixed-point core.
-        let prepared = FixedEllipticScene::new(&scene, LOAD_LSB, ANGLE_LSB)
-            .and_then(|e| Ok((e, FixedLineScene::new(&scene, LOAD_LSB, ANGLE_LSB)?)));
-        let Ok((elliptic, line)) = prepared else {
-            defmt::error!(
-                "cannot prepare the demo scene: {}",
-                defmt::Debug2Format(&prepared.err())
-            );
-            support::exit(2)
-        };
-        run(&elliptic, &trace::ELLIPTIC, &ELLIPTIC_EXPECTED, &counter)
-            + run(&line, &trace::LINE, &LINE_EXPECTED, &counter)
+        let (elliptic, line) = prepared(
+            FixedEllipticScene::new(&scene, LOAD_LSB, ANGLE_LSB),
+            FixedLineScene::new(&scene, LOAD_LSB, ANGLE_LSB),
+        );
+        run(
+            fixed_run(&elliptic, "elliptic"),
+            &trace::ELLIPTIC,
+            &trace::ELLIPTIC_EXPECTED,
+            &counter,
+        ) + run(
+            fixed_run(&line, "line"),
+            &trace::LINE,
+            &trace::LINE_EXPECTED,
+            &counter,
+        )
     };
     if failures == 0 {
         defmt::println!("all answers within the core's tolerance of the reference");
@@ -226,90 +136,75 @@ fn main() -> ! {
     support::exit(1)
 }
 
-/// Runs `core` over `trace`: first every sample once on a painted stack (the deepest
+/// Both prepared scenes, or exit 2 with the error.
+fn prepared<A, B>(elliptic: Result<A, Error>, line: Result<B, Error>) -> (A, B) {
+    match (elliptic, line) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(e), _) | (_, Err(e)) => {
+            defmt::error!("cannot prepare the demo scene: {}", defmt::Debug2Format(&e));
+            support::exit(2)
+        }
+    }
+}
+
+/// Runs the core over `trace`: first every sample once on a painted stack (the deepest
 /// stack use of [`call`]), then every sample under the instruction counter, then the
 /// check of every answer. Returns the number of mismatches.
-fn run<C: Core, const N: usize>(
-    core: &C,
+fn run<E: Estimator, const N: usize>(
+    run: Run<'_, E>,
     trace: &[(f32, f32); N],
     expected: &[Answer; N],
     counter: &Counter,
 ) -> usize {
-    let samples = trace.map(|(load, phi)| C::sample(load, phi));
+    let core = run.core;
+    let samples = trace.map(|(load, phi)| {
+        let fits = run
+            .lsb
+            .is_none_or(|(p, a)| representable(load, p) && representable(phi, a));
+        fits.then(|| core.input(load, phi).ok()).flatten()
+    });
     let mut outputs = [None; N];
     let sp = stack::paint();
     for (out, sample) in outputs.iter_mut().zip(&samples) {
-        *out = sample.map(|s| call(core, s));
+        *out = sample.map(|(load, phi)| call(core, load, phi));
     }
     let stack_bytes = stack::used(sp);
 
     let (mut max, mut sum, mut measured) = (0u32, 0u32, 0u32);
-    for &sample in samples.iter().flatten() {
-        let (_, n) = counter.measure(|| core::hint::black_box(call(core, sample)));
+    for &(load, phi) in samples.iter().flatten() {
+        let (_, n) = counter.measure(|| core::hint::black_box(call(core, load, phi)));
         max = max.max(n);
         sum += n;
         measured += 1;
     }
 
-    let (mut failures, mut worst) = (0, 0.0f32);
+    let mut failures = 0;
+    let mut worst = 0.0f32;
     for ((&(load, phi), out), want) in trace.iter().zip(&outputs).zip(expected) {
         let Some(out) = out else {
             defmt::info!(
                 "{=str} P={=f32} phi={=f32}: outside the {=str} core's input range, skipped",
-                C::NAME,
+                run.model,
                 load,
                 phi,
-                C::NUMBER
+                run.number
             );
             continue;
         };
-        match out {
-            Ok(o) => {
-                let got = C::answer(o);
-                let ok = matches(&got, want, phi, C::TOLERANCE);
-                worst = worst.max(worst_error(&got, want));
-                failures += usize::from(!ok);
-                if ok {
-                    defmt::info!(
-                        "{=str} P={=f32} phi={=f32}: d/b={=f32} F={=f32} phi0={} margin={} gross={=bool} risk={=bool}",
-                        C::NAME,
-                        load,
-                        phi,
-                        got.slip_ratio,
-                        got.axial_force,
-                        got.critical_angle,
-                        got.margin,
-                        got.gross,
-                        got.risk
-                    );
-                } else {
-                    defmt::error!(
-                        "{=str} P={=f32} phi={=f32}: got {} want {}",
-                        C::NAME,
-                        load,
-                        phi,
-                        got,
-                        want
-                    );
-                }
-            }
-            Err(e) => {
-                failures += 1;
-                defmt::error!(
-                    "{=str} P={=f32} phi={=f32}: error {} (want {})",
-                    C::NAME,
-                    load,
-                    phi,
-                    defmt::Debug2Format(e),
-                    want
-                );
-            }
+        let got = out
+            .as_ref()
+            .map(|o| answer(&core.to_estimate(o)))
+            .map_err(|e| *e);
+        let ok = check(&run, (load, phi), got, want);
+        if let Ok(got) = got {
+            worst = worst.max(worst_error(&got, want));
         }
+        failures += usize::from(!ok);
     }
     defmt::println!(
         "result model={=str} core={=str} samples={=u32} failures={=usize} worst_relative_error={=f32} stack_bytes={=usize} instructions_max={=u32} instructions_mean={=u32}",
-        C::NAME,
-        C::NUMBER,
+        run.model,
+        run.number,
         measured,
         failures,
         worst,
@@ -320,6 +215,53 @@ fn run<C: Core, const N: usize>(
     failures
 }
 
+/// Logs one answer against the reference's and says whether it matches.
+fn check<E>(
+    run: &Run<'_, E>,
+    (load, phi): (f32, f32),
+    got: Result<Answer, Error>,
+    want: &Answer,
+) -> bool {
+    match got {
+        Ok(got) if matches(&got, want, phi, run.tolerance) => {
+            defmt::info!(
+                "{=str} P={=f32} phi={=f32}: d/b={=f32} F={=f32} phi0={} margin={} gross={=bool} risk={=bool}",
+                run.model,
+                load,
+                phi,
+                got.slip_ratio,
+                got.axial_force,
+                got.critical_angle,
+                got.margin,
+                got.gross,
+                got.risk
+            );
+            true
+        }
+        Ok(got) => {
+            defmt::error!(
+                "{=str} P={=f32} phi={=f32}: got {} want {}",
+                run.model,
+                load,
+                phi,
+                got,
+                want
+            );
+            false
+        }
+        Err(e) => {
+            defmt::error!(
+                "{=str} P={=f32} phi={=f32}: error {} (want {})",
+                run.model,
+                load,
+                phi,
+                defmt::Debug2Format(&e),
+                want
+            );
+            false
+        }
+    }
+}
 /// The largest relative error of d/b, F and phi0 (against the reference rounded to
 /// f32; exact agreement, zeros and infinities included, counts as 0, and so do
 /// subnormal values, which f32 holds to an absolute 2^-149 only).
@@ -340,7 +282,7 @@ fn worst_error(got: &Answer, want: &Answer) -> f32 {
         .max(critical)
 }
 
-/// Within `tolerance` (the core's, [`Core::TOLERANCE`]) of the reference, or, below
+/// Within `tolerance` (the core's, [`Run::tolerance`]) of the reference, or, below
 /// f32's normal range (F of a subnormal load), within two steps of 2^-149 (the
 /// reference's rounding to f32 and the core's); the regime and the risk flag may differ
 /// only within that tolerance of their thresholds (d/b = 1 and 0.8).

@@ -10,8 +10,8 @@ use arbitrary::Arbitrary;
 use extreme::{X32, X64};
 use libfuzzer_sys::fuzz_target;
 use misalign::Scene;
+use misalign::float::kernels::{axial_force, cbrt, sqrt};
 use misalign::float::{Auto, EllipticScene, Estimate, LineScene};
-use misalign::kernels::{axial_force, cbrt, sqrt};
 
 #[derive(Arbitrary, Debug)]
 struct Input {

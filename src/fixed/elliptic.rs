@@ -1,6 +1,9 @@
 //! The elliptic contact (paper sections 5-7) in fixed point.
 
 use super::logexp::{div3, exp2_fixed, log2_u32};
+use super::tables::{
+    LOG_FORCE_OVER_S, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW, LOG_THETA_HIGH, LOG_THETA_LOW,
+};
 use super::uniform::{ONE, UniformTable};
 use super::{
     FixedEstimate, InputRange, LOG2_HALF_PI, Log2, Units, angle_max, constant, constant_below,
@@ -8,9 +11,6 @@ use super::{
 };
 use crate::estimator::DEFAULT_RISK_SLIP_RATIO;
 use crate::reference::{Regime, hertz_scale};
-use crate::tables::{
-    LOG_FORCE_OVER_S, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW, LOG_THETA_HIGH, LOG_THETA_LOW,
-};
 use crate::{Error, Scene, ThetaRelation};
 use core::f64::consts::PI;
 

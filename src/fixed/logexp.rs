@@ -3,7 +3,7 @@
 //! become additions, shifts and a division by 3.
 
 use super::uniform::ONE;
-use crate::tables::{EXP2_FRACTION, LOG2_MANTISSA};
+use super::tables::{EXP2_FRACTION, LOG2_MANTISSA};
 
 /// Maximum error of [`log2_u32`] in log2 units (the relative error of the number it
 /// stands for is 0.69 times this), over every u32: the table part is measured over
@@ -15,8 +15,8 @@ pub const LOG2_MAX_ERROR: f64 = 3.3e-7;
 /// and dropping the bits below them only lowers the result.
 pub const LOG2_MAX_EXCESS: f64 = 0.5;
 
-/// Maximum relative error of [`exp2_fixed`] before the final truncation to an integer,
-/// over all 2^24 Q8.24 fractions (test below).
+/// Maximum relative error of the Q8.24 exp2 (`exp2_fixed`) before the final
+/// truncation to an integer, over all 2^24 Q8.24 fractions (test below).
 pub const EXP2_MAX_REL_ERROR: f64 = 2.6e-7;
 
 /// `log2(x)` in Q8.24 for `x >= 1` (`x = 0` gives `i32::MIN`, standing for -inf).

@@ -18,16 +18,27 @@
 //! time, while these quantities span ten decades per scene and need a per-value
 //! exponent; a Q8.24 logarithm is one.
 
-pub mod logexp;
-pub mod uniform;
-
 mod auto;
 mod elliptic;
 mod line;
+internal! {
+    /// Q8.24 log2, exp2 and division by 3.
+    mod logexp;
+}
+internal! {
+    /// The generated tables of the fixed-point core.
+    #[rustfmt::skip]
+    mod tables;
+}
+internal! {
+    /// Uniform Q8.24 tables with quadratic interpolation.
+    mod uniform;
+}
 
 pub use auto::{FixedAuto, FixedAutoEstimate, FixedContactDetails};
 pub use elliptic::{FixedDetails, FixedEllipticScene};
 pub use line::{FixedLineDetails, FixedLineScene};
+pub use logexp::EXP2_MAX_REL_ERROR;
 
 use crate::Error;
 use crate::reference::Regime;
@@ -69,7 +80,7 @@ impl Log2 {
     }
 
     /// The value as f32, by integer operations only (no libm, no soft-float exp2):
-    /// relative error at most [`logexp::EXP2_MAX_REL_ERROR`] plus half an f32 ulp;
+    /// relative error at most [`EXP2_MAX_REL_ERROR`] plus half an f32 ulp;
     /// below f32's normal range it is 0, above it +infinity.
     pub fn to_f32(self) -> f32 {
         let l = self.0;

@@ -1,13 +1,14 @@
 //! The elliptic contact (paper sections 5-7) in f32.
 
+use super::kernels::axial_force::axial_force_ratio_nonnegative;
+use super::kernels::cbrt::{cbrt, cbrt_normal};
+use super::kernels::small_theta;
+use super::octave::OctaveTable;
+use super::tables;
 use super::{DEFAULT_RISK_SLIP_RATIO, Estimate, check};
 use crate::estimator::check_risk;
-use crate::kernels::axial_force::axial_force_ratio_nonnegative;
-use crate::kernels::cbrt::{cbrt, cbrt_normal};
-use crate::kernels::octave::OctaveTable;
-use crate::kernels::small_theta;
 use crate::reference::hertz_scale;
-use crate::{Error, Scene, ThetaRelation, tables};
+use crate::{Error, Scene, ThetaRelation};
 use core::f32::consts::{FRAC_PI_2, PI};
 
 /// Below this theta (and g below `SMALL_G`) the small-theta asymptotics are exact in
@@ -25,7 +26,7 @@ const FRICTION_LIMIT: f64 = 128.0;
 /// The tables one elliptic scene reads per sample: g(theta) (eqs 5, 6, 16) and its
 /// inverse (eq 18). [`Tables::FULL`] covers theta from 0 to pi/2; a firmware whose
 /// scene declares a narrower range of misalignment can pass narrower ones (built at
-/// compile time with [`crate::kernels::octave::narrow_rows`]) and link only those rows.
+/// compile time with [`super::octave::narrow_rows`]) and link only those rows.
 #[derive(Debug, Clone, Copy)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Tables<'a> {

@@ -6,7 +6,7 @@
 //!
 //! - mu: `K = mu d/b` from the forward path (`g(theta)` table, eq 16), then s from
 //!   `f(s)/s = F/(K P)` by Newton steps on the axial-force kernel's polynomials
-//!   ([`crate::kernels::axial_force_inverse`]), `mu = K / s`; line contact in closed
+//!   ([`crate::float::kernels::axial_force_inverse`]), `mu = K / s`; line contact in closed
 //!   form (`mu = K / (2 - F/(K P))`, eqs 23, 27).
 //! - phi: s from `f(s) = F/(mu P)` by the same kernel inverse, then eq (16) solved for
 //!   `g = s P^(1/3) / A` and theta from the inverse table `theta(g)` that the critical
@@ -42,12 +42,12 @@
 
 use super::{Auto, EllipticScene, LineScene, check};
 use crate::Error;
-use crate::kernels::axial_force_inverse::{
+use crate::float::kernels::axial_force_inverse::{
     force_over_slip_limit, force_ratio_slope, slip_ratio_of_force_over_slip,
     slip_ratio_of_force_ratio,
 };
-use crate::kernels::cbrt::cbrt;
-use crate::kernels::sqrt::{inv_sqrt, sqrt};
+use crate::float::kernels::cbrt::cbrt;
+use crate::float::kernels::sqrt::{inv_sqrt, sqrt};
 use crate::reference::ContactModel;
 use crate::reference::inverse::{Inconsistency, Inverse, angle_trivial, friction_trivial};
 use core::f32::consts::FRAC_PI_2;

@@ -1,8 +1,8 @@
 //! Line contact (paper section 8) in f32: no table, one inverse square root per sample.
 
+use super::kernels::sqrt::inv_sqrt;
 use super::{DEFAULT_RISK_SLIP_RATIO, Estimate, check};
 use crate::estimator::check_risk;
-use crate::kernels::sqrt::inv_sqrt;
 use crate::{Error, Scene};
 use core::f32::consts::FRAC_PI_2;
 

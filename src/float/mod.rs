@@ -15,11 +15,24 @@
 mod auto;
 mod elliptic;
 pub mod inverse;
+internal! {
+    /// The f32 kernels of the per-sample path.
+    mod kernels;
+}
 mod line;
+pub mod octave;
+internal! {
+    /// The generated tables of the f32 core.
+    #[rustfmt::skip]
+    mod tables;
+}
 
 pub use auto::{Auto, AutoEstimate, ContactDetails};
 pub use elliptic::{Details, EllipticScene, Tables};
 pub use line::{LineDetails, LineScene};
+/// The generated tables over their whole range, the rows that [`octave::narrow_rows`]
+/// narrows for a [`Tables`] of a smaller range of misalignment.
+pub use tables::{G_OF_THETA, G_OF_THETA_ROWS, THETA_OF_G, THETA_OF_G_ROWS};
 
 use crate::estimator::Estimator;
 #[doc(no_inline)]

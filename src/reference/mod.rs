@@ -14,6 +14,8 @@ pub mod normal;
 mod solve;
 pub mod tangential;
 
+#[cfg(feature = "_internals")]
+#[doc(hidden)]
 pub use carlson::carlson_rd;
 pub use normal::EllipseShape;
 pub use tangential::Regime;

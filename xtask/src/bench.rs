@@ -1,66 +1,51 @@
 //! `cargo xtask bench [--csv] [--short]`: speed against error, in one run.
 //!
-//! Speed: the benchmark image (examples/bench) on the Cortex-M0, M3, M4F and M7 in
-//! QEMU with `-icount` (instructions per call, mean and maximum over the practical
-//! samples of benches/common/samples.rs). Error: the same code on the host against the
+//! Speed: the benchmark image (harness/src/bin/bench.rs) on the Cortex-M0, M3, M4F and
+//! M7 in QEMU with `-icount` (instructions per call, mean and maximum over the
+//! practical samples of `misalign_workload::samples`). Error: the same code on the host against the
 //! independent reference data (tests/data/vectors_scene.csv and
 //! vectors_line.csv, or `$MISALIGN_REFERENCE_DIR`). Writes docs/bench.csv, docs/speed-vs-error.svg and the README's
 //! "Accuracy and cost" table; `--csv` prints the CSV, else a readable table.
 
-#[path = "../../benches/common/hamrock_brewe.rs"]
-mod hamrock_brewe;
-
-use crate::cross;
+use crate::cross::{self, CPUS};
+use crate::figures::BenchRow;
 use misalign::Scene;
 use misalign::fixed::logexp::{exp2_fixed, log2_u32};
+use misalign::fixed::tables::{LOG_G_HIGH, LOG_G_LOW};
 use misalign::fixed::uniform::ONE;
 use misalign::fixed::{FixedEllipticScene, FixedLineScene, exact_lsb};
-use misalign::float::{EllipticScene, LineScene};
-use misalign::kernels::{axial_force::axial_force_ratio, cbrt::cbrt, sqrt::inv_sqrt};
+use misalign::float::kernels::{axial_force::axial_force_ratio, cbrt::cbrt, sqrt::inv_sqrt};
+use misalign::float::{EllipticScene, G_OF_THETA, LineScene, THETA_OF_G};
 use misalign::reference;
-use misalign::tables::{G_OF_THETA, LOG_G_HIGH, LOG_G_LOW, THETA_OF_G};
+use misalign_workload::hamrock_brewe::HamrockBrewe;
+use misalign_workload::{Model, Operation};
 use std::collections::HashMap;
 use std::fmt::Write;
 use std::process::ExitCode;
-
-struct Cpu {
-    name: &'static str,
-    target: &'static str,
-    machine: &'static str,
-}
-
-const CPUS: [Cpu; 4] = [
-    Cpu {
-        name: "cortex-m0",
-        target: "thumbv6m-none-eabi",
-        machine: "microbit",
-    },
-    Cpu {
-        name: "cortex-m3",
-        target: "thumbv7m-none-eabi",
-        machine: "mps2-an385",
-    },
-    Cpu {
-        name: "cortex-m4f",
-        target: "thumbv7em-none-eabihf",
-        machine: "mps2-an386",
-    },
-    Cpu {
-        name: "cortex-m7",
-        target: "thumbv7em-none-eabihf",
-        machine: "mps2-an500",
-    },
-];
 
 /// One measured row.
 #[derive(Clone)]
 pub struct Row {
     pub cpu: &'static str,
-    pub model: String,
-    pub operation: String,
+    pub model: Model,
+    pub operation: Operation,
     pub mean: u64,
     pub max: u64,
     pub error: f64,
+}
+
+impl Row {
+    /// The row as the figure takes it, its error as docs/bench.csv holds it (four
+    /// digits), so that `cargo xtask figures` redraws the same figure from the CSV.
+    fn plotted(&self) -> BenchRow {
+        BenchRow {
+            cpu: self.cpu.to_string(),
+            model: self.model.name().to_string(),
+            operation: self.operation.name().to_string(),
+            instructions: self.mean as f64,
+            error: format!("{:.3e}", self.error).parse().unwrap_or(f64::NAN),
+        }
+    }
 }
 
 fn rel(got: f64, want: f64) -> f64 {
@@ -71,9 +56,7 @@ fn rel(got: f64, want: f64) -> f64 {
     }
 }
 
-type Rows = Vec<HashMap<String, String>>;
-
-fn read(name: &str) -> Result<Rows, String> {
+fn read(name: &str) -> Result<Vec<Record>, String> {
     let dir = std::env::var_os("MISALIGN_REFERENCE_DIR").map_or_else(
         || crate::root().join("tests/data"),
         std::path::PathBuf::from,
@@ -93,11 +76,11 @@ fn read(name: &str) -> Result<Rows, String> {
         .collect()
 }
 
-fn num(row: &HashMap<String, String>, key: &str) -> f64 {
+fn num(row: &Record, key: &str) -> f64 {
     row[key].parse().unwrap_or(f64::NAN)
 }
 
-fn scene(row: &HashMap<String, String>) -> Scene {
+fn scene(row: &Record) -> Scene {
     Scene::new(
         num(row, "R1"),
         num(row, "R2"),
@@ -109,7 +92,7 @@ fn scene(row: &HashMap<String, String>) -> Scene {
 }
 
 /// Worst of d/b, F and phi0 against a reference row.
-fn worst3(got: (f64, f64, f64), row: &HashMap<String, String>) -> f64 {
+fn worst3(got: (f64, f64, f64), row: &Record) -> f64 {
     rel(got.0, num(row, "s"))
         .max(rel(got.1, num(row, "F")))
         .max(rel(got.2, num(row, "phi0")))
@@ -134,284 +117,241 @@ fn fixed3(x: &misalign::fixed::FixedEstimate) -> (f64, f64, f64) {
     )
 }
 
-/// Error of an inverse's answer against the true value: relative, divided by
-/// max(1, sensitivity) (issue 11's measure), counted where the sensitivity is below
-/// 1e3; 0 for a lower bound (tested elsewhere), +inf for a wrong `inconsistent`.
-fn inverse_error(answer: reference::inverse::Inverse<f64>, want: f64) -> f64 {
-    use reference::inverse::Inverse;
-    match answer {
-        Inverse::Exact { value, sensitivity } if sensitivity < 1e3 => {
-            rel(value, want) / sensitivity.max(1.0)
-        }
-        Inverse::Exact { .. } | Inverse::AtLeast { .. } => 0.0,
-        Inverse::Inconsistent(_) => f64::INFINITY,
-    }
+/// The worst relative error of every (model, operation) on the host.
+type Errors = HashMap<(Model, Operation), f64>;
+
+/// Keeps the worst of `x` (NaN counts as infinite) for `(model, op)`.
+fn put(e: &mut Errors, model: Model, op: Operation, x: f64) {
+    let slot = e.entry((model, op)).or_insert(0.0);
+    *slot = slot.max(if x.is_nan() { f64::INFINITY } else { x });
 }
 
 /// Errors of every (model, operation) on the host, over the reference files.
-pub fn errors() -> Result<HashMap<(String, String), f64>, String> {
-    let scenes = read("vectors_scene.csv")?;
-    let lines = read("vectors_line.csv")?;
-    let mut e: HashMap<(String, String), f64> = HashMap::new();
-    let mut put = |model: &str, op: &str, x: f64| {
-        let slot = e.entry((model.to_string(), op.to_string())).or_insert(0.0);
-        *slot = slot.max(if x.is_nan() { f64::INFINITY } else { x });
-    };
-    for row in &scenes {
-        let s = scene(row);
-        let (p, phi) = (num(row, "P"), num(row, "phi"));
-        let r = reference::elliptic(&s, p, phi).map_err(|e| e.to_string())?;
-        put(
-            "reference",
-            "estimate",
-            worst3(
-                (
-                    r.slip_ratio,
-                    r.axial_force,
-                    r.critical_angle.unwrap_or(f64::NAN),
-                ),
-                row,
-            ),
-        );
-        let f = EllipticScene::new(&s)
-            .map_err(|e| e.to_string())?
-            .estimate(p as f32, phi as f32)
-            .map_err(|e| e.to_string())?;
-        let f3 = (
-            f.slip_ratio as f64,
-            f.axial_force as f64,
-            f.critical_angle.map_or(f64::NAN, f64::from),
-        );
-        put("f32", "estimate", worst3(f3, row));
-        let mu = s.friction();
-        let inv = reference::inverse::friction_elliptic(&s, p, phi, r.axial_force);
-        put(
-            "reference",
-            "inverse:mu",
-            inv.map_or(f64::NAN, |a| inverse_error(a, mu)),
-        );
-        let inv = reference::inverse::angle_elliptic(&s, p, r.axial_force);
-        put(
-            "reference",
-            "inverse:phi",
-            inv.map_or(f64::NAN, |a| inverse_error(a, phi)),
-        );
-        let core = EllipticScene::new(&s).map_err(|e| e.to_string())?;
-        let (p32, phi32, f32_force) = (p as f32, phi as f32, f.axial_force);
-        let inv = core.friction_from_axial_force(p32, phi32, f32_force);
-        put(
-            "f32",
-            "inverse:mu",
-            inv.map_or(f64::NAN, |a| inverse_error(a.map(f64::from), mu)),
-        );
-        let inv = core.angle_from_axial_force(p32, f32_force);
-        put(
-            "f32",
-            "inverse:phi",
-            inv.map_or(f64::NAN, |a| inverse_error(a.map(f64::from), phi)),
-        );
-        let (load_lsb, pc) = exact_lsb(p, 1 << 30, 0.0);
-        let (angle_lsb, ac) = exact_lsb(phi, 1 << 30, FixedEllipticScene::min_angle_lsb(&s));
-        let x = FixedEllipticScene::new(&s, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
-        let x = x.estimate(pc, signed(ac, phi)).map_err(|e| e.to_string())?;
-        put("fixed", "estimate", worst3(fixed3(&x), row));
-        let hb = hamrock_brewe::HamrockBrewe::new(
-            s.r1(),
-            s.r2(),
-            s.shear_modulus(),
-            s.poisson_ratio(),
-            s.friction(),
-        );
-        let h = hb.estimate(p as f32, phi as f32);
-        put(
-            "hamrock-brewe",
-            "estimate",
-            worst3(
-                (
-                    h.slip_ratio as f64,
-                    h.axial_force as f64,
-                    h.critical_angle as f64,
-                ),
-                row,
-            ),
-        );
-        // Kernels, at the inputs these rows give them (their whole-domain sweep is
-        // `cargo xtask sweep`).
-        let theta = num(row, "theta");
-        let g = num(row, "m") * num(row, "n") * theta;
-        put(
-            "f32",
-            "table:g",
-            rel(G_OF_THETA.eval(theta as f32).map_or(f64::NAN, f64::from), g),
-        );
-        let theta0 = num(row, "theta0");
-        let g0 = reference::normal::ellipse_shape(theta0).map_or(f64::NAN, |sh| sh.g());
-        put(
-            "f32",
-            "table:theta_of_g",
-            rel(
-                THETA_OF_G.eval(g0 as f32).map_or(f64::NAN, f64::from),
-                theta0,
-            ),
-        );
-        put(
-            "f32",
-            "kernel:cbrt",
-            rel(cbrt(p as f32) as f64, (p as f32 as f64).cbrt()),
-        );
-        put(
-            "f32",
-            "kernel:libm_cbrtf",
-            rel(libm::cbrtf(p as f32) as f64, (p as f32 as f64).cbrt()),
-        );
-        put(
-            "f32",
-            "kernel:inv_sqrt",
-            rel(inv_sqrt(p as f32) as f64, 1.0 / (p as f32 as f64).sqrt()),
-        );
-        put(
-            "f32",
-            "kernel:libm_sqrtf",
-            rel(libm::sqrtf(p as f32) as f64, (p as f32 as f64).sqrt()),
-        );
-        let sr = num(row, "s");
-        if sr < 1.0 {
-            let want = num(row, "F").abs() / (s.friction() * p);
-            put(
-                "f32",
-                "kernel:axial_force",
-                rel(axial_force_ratio(sr as f32) as f64, want),
-            );
-        }
-        let pu = p.round().max(1.0) as u32;
-        let log_err = (log2_u32(pu) as f64 / ONE as f64 - (pu as f64).log2()).abs();
-        put("fixed", "kernel:log2", log_err * std::f64::consts::LN_2);
-        // 2^(5 + f) in Q8.24 keeps 29 significant bits: the error is the kernel's,
-        // not the output format's.
-        let l = ((5.0 + p.log2().abs().fract()) * ONE as f64) as i32;
-        put(
-            "fixed",
-            "kernel:exp2",
-            rel(
-                exp2_fixed(l, 24) as f64 / ONE as f64,
-                (l as f64 / ONE as f64).exp2(),
-            ),
-        );
-        let y = (theta.log2() * ONE as f64).round() as i32;
-        let table = if y < LOG_G_HIGH.start {
-            LOG_G_LOW
-        } else {
-            LOG_G_HIGH
-        };
-        let lg = table.eval(y).map_or(f64::NAN, |v| v as f64 / ONE as f64);
-        put(
-            "fixed",
-            "table:log_g",
-            (lg - g.log2()).abs() * std::f64::consts::LN_2,
-        );
+pub fn errors() -> Result<Errors, String> {
+    let mut e = Errors::new();
+    for row in &read("vectors_scene.csv")? {
+        elliptic_errors(&mut e, row)?;
+        kernel_errors(&mut e, row);
     }
-    for row in &lines {
-        let s = scene(row);
-        let (p, phi) = (num(row, "P"), num(row, "phi"));
-        let r = reference::line(&s, p, phi).map_err(|e| e.to_string())?;
-        put(
-            "reference",
-            "estimate:line",
-            worst3((r.slip_ratio, r.axial_force, r.critical_angle), row),
-        );
-        let f = LineScene::new(&s)
-            .map_err(|e| e.to_string())?
-            .estimate(p as f32, phi as f32)
-            .map_err(|e| e.to_string())?;
-        let f3 = (
-            f.slip_ratio as f64,
-            f.axial_force as f64,
-            f.critical_angle.map_or(f64::NAN, f64::from),
-        );
-        put("f32", "estimate:line", worst3(f3, row));
-        let (mu, core) = (s.friction(), LineScene::new(&s).map_err(|e| e.to_string())?);
-        let inv = reference::inverse::friction_line(&s, p, phi, r.axial_force);
-        put(
-            "reference",
-            "inverse:mu:line",
-            inv.map_or(f64::NAN, |a| inverse_error(a, mu)),
-        );
-        let inv = reference::inverse::angle_line(&s, p, r.axial_force);
-        put(
-            "reference",
-            "inverse:phi:line",
-            inv.map_or(f64::NAN, |a| inverse_error(a, phi)),
-        );
-        let inv = core.friction_from_axial_force(p as f32, phi as f32, f.axial_force);
-        let e = inv.map_or(f64::NAN, |a| inverse_error(a.map(f64::from), mu));
-        put("f32", "inverse:mu:line", e);
-        let inv = core.angle_from_axial_force(p as f32, f.axial_force);
-        let e = inv.map_or(f64::NAN, |a| inverse_error(a.map(f64::from), phi));
-        put("f32", "inverse:phi:line", e);
-        let ((load_lsb, pc), (angle_lsb, ac)) =
-            (exact_lsb(p, 1 << 30, 0.0), exact_lsb(phi, 1 << 30, 0.0));
-        let x = FixedLineScene::new(&s, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
-        let x = x.estimate(pc, signed(ac, phi)).map_err(|e| e.to_string())?;
-        put("fixed", "estimate:line", worst3(fixed3(&x), row));
+    for row in &read("vectors_line.csv")? {
+        line_errors(&mut e, row)?;
     }
     Ok(e)
 }
 
-/// Builds and runs the benchmark image on every CPU.
-/// `(cpu, model, operation, mean, max)` per measurement.
-type Measured = Vec<(&'static str, String, String, u64, u64)>;
+type Record = HashMap<String, String>;
 
-fn measure(samples: usize) -> Result<Measured, String> {
+/// The whole elliptic estimate of every model against one reference row.
+fn elliptic_errors(e: &mut Errors, row: &Record) -> Result<(), String> {
+    let s = scene(row);
+    let (p, phi) = (num(row, "P"), num(row, "phi"));
+    let r = reference::elliptic(&s, p, phi).map_err(|e| e.to_string())?;
+    let r3 = (
+        r.slip_ratio,
+        r.axial_force,
+        r.critical_angle.unwrap_or(f64::NAN),
+    );
+    put(e, Model::Reference, Operation::Estimate, worst3(r3, row));
+    let f = EllipticScene::new(&s)
+        .map_err(|e| e.to_string())?
+        .estimate(p as f32, phi as f32)
+        .map_err(|e| e.to_string())?;
+    put(e, Model::F32, Operation::Estimate, worst3(f32s(&f), row));
+    let (load_lsb, pc) = exact_lsb(p, 1 << 30, 0.0);
+    let (angle_lsb, ac) = exact_lsb(phi, 1 << 30, FixedEllipticScene::min_angle_lsb(&s));
+    let x = FixedEllipticScene::new(&s, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
+    let x = x.estimate(pc, signed(ac, phi)).map_err(|e| e.to_string())?;
+    put(
+        e,
+        Model::Fixed,
+        Operation::Estimate,
+        worst3(fixed3(&x), row),
+    );
+    let h = HamrockBrewe::of(&s).estimate(p as f32, phi as f32);
+    let h3 = (
+        h.slip_ratio as f64,
+        h.axial_force as f64,
+        h.critical_angle as f64,
+    );
+    put(e, Model::HamrockBrewe, Operation::Estimate, worst3(h3, row));
+    Ok(())
+}
+
+/// The line-contact estimate of every model against one reference row.
+fn line_errors(e: &mut Errors, row: &Record) -> Result<(), String> {
+    let s = scene(row);
+    let (p, phi) = (num(row, "P"), num(row, "phi"));
+    let r = reference::line(&s, p, phi).map_err(|e| e.to_string())?;
+    let r3 = (r.slip_ratio, r.axial_force, r.critical_angle);
+    put(
+        e,
+        Model::Reference,
+        Operation::EstimateLine,
+        worst3(r3, row),
+    );
+    let f = LineScene::new(&s)
+        .map_err(|e| e.to_string())?
+        .estimate(p as f32, phi as f32)
+        .map_err(|e| e.to_string())?;
+    put(
+        e,
+        Model::F32,
+        Operation::EstimateLine,
+        worst3(f32s(&f), row),
+    );
+    let ((load_lsb, pc), (angle_lsb, ac)) =
+        (exact_lsb(p, 1 << 30, 0.0), exact_lsb(phi, 1 << 30, 0.0));
+    let x = FixedLineScene::new(&s, load_lsb, angle_lsb).map_err(|e| e.to_string())?;
+    let x = x.estimate(pc, signed(ac, phi)).map_err(|e| e.to_string())?;
+    put(
+        e,
+        Model::Fixed,
+        Operation::EstimateLine,
+        worst3(fixed3(&x), row),
+    );
+    Ok(())
+}
+
+/// d/b, F and phi0 of an f32 estimate, as f64.
+fn f32s(f: &misalign::Estimate) -> (f64, f64, f64) {
+    (
+        f.slip_ratio as f64,
+        f.axial_force as f64,
+        f.critical_angle.map_or(f64::NAN, f64::from),
+    )
+}
+
+/// The kernels and tables at the inputs one reference row gives them (their
+/// whole-domain sweep is `cargo xtask sweep`).
+fn kernel_errors(e: &mut Errors, row: &Record) {
+    f32_kernel_errors(e, row);
+    fixed_kernel_errors(e, row);
+}
+
+fn f32_kernel_errors(e: &mut Errors, row: &Record) {
+    let p = num(row, "P");
+    let theta = num(row, "theta");
+    let g = num(row, "m") * num(row, "n") * theta;
+    let g_table = G_OF_THETA.eval(theta as f32).map_or(f64::NAN, f64::from);
+    put(e, Model::F32, Operation::TableG, rel(g_table, g));
+    let theta0 = num(row, "theta0");
+    let g0 = reference::normal::ellipse_shape(theta0).map_or(f64::NAN, |sh| sh.g());
+    let theta_table = THETA_OF_G.eval(g0 as f32).map_or(f64::NAN, f64::from);
+    put(
+        e,
+        Model::F32,
+        Operation::TableThetaOfG,
+        rel(theta_table, theta0),
+    );
+    let p32 = p as f32;
+    let exact_cbrt = (p32 as f64).cbrt();
+    put(
+        e,
+        Model::F32,
+        Operation::KernelCbrt,
+        rel(cbrt(p32) as f64, exact_cbrt),
+    );
+    let libm_cbrt = libm::cbrtf(p32) as f64;
+    put(
+        e,
+        Model::F32,
+        Operation::KernelLibmCbrtf,
+        rel(libm_cbrt, exact_cbrt),
+    );
+    let exact_inv_sqrt = 1.0 / (p32 as f64).sqrt();
+    put(
+        e,
+        Model::F32,
+        Operation::KernelInvSqrt,
+        rel(inv_sqrt(p32) as f64, exact_inv_sqrt),
+    );
+    let libm_sqrt = libm::sqrtf(p32) as f64;
+    put(
+        e,
+        Model::F32,
+        Operation::KernelLibmSqrtf,
+        rel(libm_sqrt, (p32 as f64).sqrt()),
+    );
+    let sr = num(row, "s");
+    if sr < 1.0 {
+        let want = num(row, "F").abs() / (scene(row).friction() * p);
+        let got = axial_force_ratio(sr as f32) as f64;
+        put(e, Model::F32, Operation::KernelAxialForce, rel(got, want));
+    }
+}
+
+fn fixed_kernel_errors(e: &mut Errors, row: &Record) {
+    let one = ONE as f64;
+    let p = num(row, "P");
+    let pu = p.round().max(1.0) as u32;
+    let log_err = (log2_u32(pu) as f64 / one - (pu as f64).log2()).abs();
+    put(
+        e,
+        Model::Fixed,
+        Operation::KernelLog2,
+        log_err * std::f64::consts::LN_2,
+    );
+    // 2^(5 + f) in Q8.24 keeps 29 significant bits: the error is the kernel's,
+    // not the output format's.
+    let l = ((5.0 + p.log2().abs().fract()) * one) as i32;
+    let exp_err = rel(exp2_fixed(l, 24) as f64 / one, (l as f64 / one).exp2());
+    put(e, Model::Fixed, Operation::KernelExp2, exp_err);
+    let theta = num(row, "theta");
+    let g = num(row, "m") * num(row, "n") * theta;
+    let y = (theta.log2() * one).round() as i32;
+    let table = if y < LOG_G_HIGH.start {
+        LOG_G_LOW
+    } else {
+        LOG_G_HIGH
+    };
+    let lg = table.eval(y).map_or(f64::NAN, |v| v as f64 / one);
+    let log_g_err = (lg - g.log2()).abs() * std::f64::consts::LN_2;
+    put(e, Model::Fixed, Operation::TableLogG, log_g_err);
+}
+
+/// One measurement of the benchmark image: `(cpu, model, operation, mean, max)`.
+type Measured = (&'static str, Model, Operation, u64, u64);
+
+/// Builds and runs the benchmark image on every CPU.
+fn measure(samples: usize) -> Result<Vec<Measured>, String> {
     crate::firmware::preflight()?;
     let mut out = Vec::new();
     let mut built: HashMap<&str, std::path::PathBuf> = HashMap::new();
     for cpu in &CPUS {
         if !built.contains_key(cpu.target) {
-            let mut cmd = cross::cargo();
+            let mut cmd = cross::harness_build(cpu.target);
             cmd.env("MISALIGN_BENCH_SAMPLES", samples.to_string())
-                .args([
-                    "build",
-                    "--profile",
-                    "firmware",
-                    "--target",
-                    cpu.target,
-                    "--features",
-                    "firmware",
-                    "--example",
-                    "bench",
-                    "--message-format=json-render-diagnostics",
-                ]);
+                .args(["--bin", "bench"]);
             let artifacts = cross::build(&mut cmd)?;
             built.insert(cpu.target, cross::artifact(&artifacts, "bench")?);
         }
         let (status, log) = cross::qemu(cpu.machine, &built[cpu.target])?;
         if status != Some(0) {
-            return Err(format!("bench on {} exited {status:?}:\n{log}", cpu.name));
+            return Err(format!("bench on {} exited {status:?}:\n{log}", cpu.id));
         }
-        for line in log.lines() {
-            let Some(rest) = line.find("bench model=").map(|i| &line[i + 6..]) else {
-                continue;
-            };
-            let field = |k: &str| {
-                rest.split_whitespace()
-                    .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
-            };
-            let (Some(model), Some(op), Some(mean), Some(max)) =
-                (field("model"), field("op"), field("mean"), field("max"))
-            else {
-                continue;
-            };
-            out.push((
-                cpu.name,
-                model.to_string(),
-                op.to_string(),
-                mean.parse().unwrap_or(0),
-                max.parse().unwrap_or(0),
-            ));
-        }
-        eprintln!("bench: {} done", cpu.name);
+        out.extend(
+            log.lines()
+                .filter_map(parse_bench_line)
+                .map(|(model, op, mean, max)| (cpu.id, model, op, mean, max)),
+        );
+        eprintln!("bench: {} done", cpu.id);
     }
     Ok(out)
+}
+
+/// `bench model=<m> op=<op> n=<calls> mean=<x> max=<y>`.
+fn parse_bench_line(line: &str) -> Option<(Model, Operation, u64, u64)> {
+    let rest = &line[line.find("bench model=")? + 6..];
+    let field = |k: &str| {
+        rest.split_whitespace()
+            .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
+    };
+    Some((
+        Model::from_name(field("model")?)?,
+        Operation::from_name(field("op")?)?,
+        field("mean")?.parse().unwrap_or(0),
+        field("max")?.parse().unwrap_or(0),
+    ))
 }
 
 fn csv_text(rows: &[Row]) -> String {
@@ -421,14 +361,19 @@ fn csv_text(rows: &[Row]) -> String {
         writeln!(
             s,
             "{},{},{},{},{},{:.3e}",
-            r.cpu, r.model, r.operation, r.mean, r.max, r.error
+            r.cpu,
+            r.model.name(),
+            r.operation.name(),
+            r.mean,
+            r.max,
+            r.error
         )
         .unwrap();
     }
     s
 }
 
-fn find<'a>(rows: &'a [Row], cpu: &str, model: &str, op: &str) -> Option<&'a Row> {
+fn find<'a>(rows: &'a [Row], cpu: &str, model: Model, op: Operation) -> Option<&'a Row> {
     rows.iter()
         .find(|r| r.cpu == cpu && r.model == model && r.operation == op)
 }
@@ -439,83 +384,92 @@ fn readable(rows: &[Row]) -> String {
     let mut s = String::new();
     writeln!(s, "| cpu | model | operation | instructions mean / max | max relative error | fewer instructions than the reference | more accurate than Hamrock & Brewe |").unwrap();
     writeln!(s, "|---|---|---|--:|--:|--:|--:|").unwrap();
-    for r in rows.iter().filter(|r| r.operation.starts_with("estimate")) {
-        let reference = find(rows, r.cpu, "reference", &r.operation);
-        let baseline = find(rows, r.cpu, "hamrock-brewe", &r.operation);
-        let faster = reference
-            .filter(|_| r.model != "reference")
-            .map_or(String::from("-"), |x| {
-                format!("{:.0}x", x.mean as f64 / r.mean.max(1) as f64)
-            });
-        let core = r.model == "f32" || r.model == "fixed";
-        let better = baseline.filter(|_| core).map_or(String::from("-"), |b| {
-            if r.error > 0.0 {
-                format!("{:.0}x", b.error / r.error)
-            } else {
-                "-".into()
-            }
-        });
+    for r in rows.iter().filter(|r| r.operation.is_estimate()) {
         writeln!(
             s,
             "| {} | {} | {} | {} / {} | {:.1e} | {} | {} |",
-            r.cpu, r.model, r.operation, r.mean, r.max, r.error, faster, better
+            r.cpu,
+            r.model.name(),
+            r.operation.name(),
+            r.mean,
+            r.max,
+            r.error,
+            fewer_instructions(rows, r),
+            more_accurate(rows, r)
         )
         .unwrap();
     }
     s
 }
 
-/// The README's "Accuracy and cost" table: per kernel and per core, error and
-/// instructions on the M0 and the M4F.
+/// How many times fewer instructions `r` takes than the reference on its CPU.
+fn fewer_instructions(rows: &[Row], r: &Row) -> String {
+    find(rows, r.cpu, Model::Reference, r.operation)
+        .filter(|_| r.model != Model::Reference)
+        .map_or(String::from("-"), |x| {
+            format!("{:.0}x", x.mean as f64 / r.mean.max(1) as f64)
+        })
+}
+
+/// How many times more accurate a core's `r` is than Hamrock & Brewe.
+fn more_accurate(rows: &[Row], r: &Row) -> String {
+    let core = matches!(r.model, Model::F32 | Model::Fixed);
+    find(rows, r.cpu, Model::HamrockBrewe, r.operation)
+        .filter(|_| core && r.error > 0.0)
+        .map_or(String::from("-"), |b| format!("{:.0}x", b.error / r.error))
+}
+
 /// Bytes of table data (flash) that an operation reads, from the generated tables
 /// themselves; `None` where it is code only or not ours (libm). Code sizes are in the
 /// firmware's table (`cargo xtask firmware`).
-fn table_bytes(model: &str, operation: &str) -> Option<usize> {
-    use misalign::tables as t;
+fn table_bytes(model: Model, operation: Operation) -> Option<usize> {
+    use misalign::fixed::tables as x;
+    use misalign::float::tables as t;
     use std::mem::size_of_val as size;
     let force = size(&t::AXIAL_FORCE_LOW) + size(&t::AXIAL_FORCE_HIGH);
-    let log_exp = size(t::LOG2_MANTISSA.values) + size(t::EXP2_FRACTION.values);
-    let log_g = size(t::LOG_G_LOW.values) + size(t::LOG_G_HIGH.values);
-    let log_theta = size(t::LOG_THETA_LOW.values) + size(t::LOG_THETA_HIGH.values);
+    let log_exp = size(x::LOG2_MANTISSA.values) + size(x::EXP2_FRACTION.values);
+    let log_g = size(x::LOG_G_LOW.values) + size(x::LOG_G_HIGH.values);
+    let log_theta = size(x::LOG_THETA_LOW.values) + size(x::LOG_THETA_HIGH.values);
+    use Operation as O;
     Some(match (model, operation) {
-        ("f32", "estimate") => size(&t::G_OF_THETA_ROWS) + size(&t::THETA_OF_G_ROWS) + force,
-        ("f32", "table:g") => size(&t::G_OF_THETA_ROWS),
-        ("f32", "table:theta_of_g") => size(&t::THETA_OF_G_ROWS),
-        ("f32", "kernel:axial_force") => force,
-        ("f32", "estimate:line" | "kernel:cbrt" | "kernel:inv_sqrt") => 0,
-        ("f32", "inverse:mu") => size(&t::G_OF_THETA_ROWS) + force,
-        ("f32", "inverse:phi") => size(&t::G_OF_THETA_ROWS) + size(&t::THETA_OF_G_ROWS) + force,
-        ("f32", "inverse:mu:line" | "inverse:phi:line") => 0,
-        ("fixed", "estimate") => log_exp + log_g + log_theta + size(t::LOG_FORCE_OVER_S.values),
-        ("fixed", "estimate:line") => log_exp,
-        ("fixed", "kernel:log2") => size(t::LOG2_MANTISSA.values),
-        ("fixed", "kernel:exp2") => size(t::EXP2_FRACTION.values),
-        ("fixed", "table:log_g") => log_g,
+        (Model::F32, O::Estimate) => size(&t::G_OF_THETA_ROWS) + size(&t::THETA_OF_G_ROWS) + force,
+        (Model::F32, O::TableG) => size(&t::G_OF_THETA_ROWS),
+        (Model::F32, O::TableThetaOfG) => size(&t::THETA_OF_G_ROWS),
+        (Model::F32, O::KernelAxialForce) => force,
+        (Model::F32, O::EstimateLine | O::KernelCbrt | O::KernelInvSqrt) => 0,
+        (Model::Fixed, O::Estimate) => {
+            log_exp + log_g + log_theta + size(x::LOG_FORCE_OVER_S.values)
+        }
+        (Model::Fixed, O::EstimateLine) => log_exp,
+        (Model::Fixed, O::KernelLog2) => size(x::LOG2_MANTISSA.values),
+        (Model::Fixed, O::KernelExp2) => size(x::EXP2_FRACTION.values),
+        (Model::Fixed, O::TableLogG) => log_g,
         _ => return None,
     })
 }
 
+/// The README's "Accuracy and cost" table: per kernel and per core, error and
+/// instructions on the M0 and the M4F.
 fn accuracy_and_cost(rows: &[Row]) -> String {
     let mut s = String::new();
     writeln!(s, "| model | operation | max relative error | instructions on Cortex-M0 (mean / max) | instructions on Cortex-M4F (mean / max) | table bytes |").unwrap();
     writeln!(s, "|---|---|--:|--:|--:|--:|").unwrap();
     let mut seen = Vec::new();
     for r in rows {
-        let key = (r.model.clone(), r.operation.clone());
-        if seen.contains(&key) {
+        if seen.contains(&(r.model, r.operation)) {
             continue;
         }
-        seen.push(key);
+        seen.push((r.model, r.operation));
         let on = |cpu: &str| {
-            find(rows, cpu, &r.model, &r.operation)
+            find(rows, cpu, r.model, r.operation)
                 .map_or("-".to_string(), |x| format!("{} / {}", x.mean, x.max))
         };
-        let bytes = table_bytes(&r.model, &r.operation).map_or("-".to_string(), |b| b.to_string());
+        let bytes = table_bytes(r.model, r.operation).map_or("-".to_string(), |b| b.to_string());
         writeln!(
             s,
             "| {} | `{}` | {:.1e} | {} | {} | {} |",
-            r.model,
-            r.operation,
+            r.model.name(),
+            r.operation.name(),
             r.error,
             on("cortex-m0"),
             on("cortex-m4f"),
@@ -526,90 +480,50 @@ fn accuracy_and_cost(rows: &[Row]) -> String {
     s
 }
 
-fn write_readme(table: &str) -> Result<(), String> {
-    let path = crate::root().join("README.md");
-    let text = std::fs::read_to_string(&path).map_err(|e| e.to_string())?;
-    let (begin, end) = ("<!-- bench:begin -->", "<!-- bench:end -->");
-    let (Some(a), Some(b)) = (text.find(begin), text.find(end)) else {
-        return Err("README.md has no bench markers".into());
-    };
-    std::fs::write(
-        &path,
-        format!("{}{begin}\n{table}{}", &text[..a], &text[b..]),
-    )
-    .map_err(|e| e.to_string())
+/// Errors on the host and instructions in QEMU, paired per (model, operation).
+fn rows(samples: usize) -> Result<Vec<Row>, String> {
+    let errors = errors()?;
+    let measured = measure(samples)?;
+    Ok(measured
+        .into_iter()
+        .map(|(cpu, model, operation, mean, max)| Row {
+            cpu,
+            model,
+            operation,
+            mean,
+            max,
+            error: errors.get(&(model, operation)).copied().unwrap_or(f64::NAN),
+        })
+        .collect())
+}
+
+/// docs/bench.csv, docs/speed-vs-error.svg and the README's tables.
+fn write_outputs(rows: &[Row]) -> Result<(), String> {
+    let docs = crate::root().join("docs");
+    std::fs::write(docs.join("bench.csv"), csv_text(rows)).map_err(|e| e.to_string())?;
+    let plotted: Vec<BenchRow> = rows.iter().map(Row::plotted).collect();
+    crate::figures::speed_vs_error(&plotted, &docs.join("speed-vs-error.svg"))
+        .map_err(|e| e.to_string())?;
+    let tables = format!("{}\n{}", readable(rows), accuracy_and_cost(rows));
+    crate::write_readme_section("bench", &tables)
 }
 
 pub fn run(csv: bool, short: bool) -> ExitCode {
     let samples = if short { 32 } else { 256 };
-    let result = (|| -> Result<Vec<Row>, String> {
-        let errors = errors()?;
-        let measured = measure(samples)?;
-        Ok(measured
-            .into_iter()
-            .map(|(cpu, model, operation, mean, max)| {
-                let error = errors
-                    .get(&(model.clone(), operation.clone()))
-                    .copied()
-                    .unwrap_or(f64::NAN);
-                Row {
-                    cpu,
-                    model,
-                    operation,
-                    mean,
-                    max,
-                    error,
-                }
-            })
-            .collect())
-    })();
-    let rows = match result {
+    let rows = match rows(samples) {
         Ok(rows) => rows,
         Err(e) => {
             eprintln!("xtask bench: {e}");
             return ExitCode::FAILURE;
         }
     };
-    let text = csv_text(&rows);
     if csv {
-        print!("{text}");
+        print!("{}", csv_text(&rows));
     } else {
         print!("{}", readable(&rows));
     }
     if !short {
-        let docs = crate::root().join("docs");
-        let csv_path = docs.join("bench.csv");
-        // The figure: every estimate, and the kernels where they run (f32 on the
-        // Cortex-M4F, fixed point on the Cortex-M0), so that the labels stay legible.
-        let shown: Vec<Row> = rows
-            .iter()
-            .filter(|r| {
-                r.operation == "estimate"
-                    || (r.model == "f32"
-                        && r.cpu == "cortex-m4f"
-                        && !r.operation.ends_with(":line"))
-                    || (r.model == "fixed"
-                        && r.cpu == "cortex-m0"
-                        && r.operation != "estimate:line")
-            })
-            .cloned()
-            .collect();
-        let figure_csv = std::env::temp_dir().join("misalign-bench-figure.csv");
-        let written = std::fs::write(&csv_path, &text)
-            .and_then(|_| std::fs::write(&figure_csv, csv_text(&shown)))
-            .map_err(|e| e.to_string())
-            .and_then(|_| {
-                crate::figures::speed_vs_error(&figure_csv, &docs.join("speed-vs-error.svg"))
-                    .map_err(|e| e.to_string())
-            })
-            .and_then(|_| {
-                write_readme(&format!(
-                    "{}\n{}",
-                    readable(&rows),
-                    accuracy_and_cost(&rows)
-                ))
-            });
-        if let Err(e) = written {
+        if let Err(e) = write_outputs(&rows) {
             eprintln!("xtask bench: {e}");
             return ExitCode::FAILURE;
         }

@@ -1,4 +1,5 @@
-//! What the firmware chores share: cargo for a Cortex-M target, the LLVM tools of the
+//! What the firmware chores share: the Cortex-M cores, cargo for a Cortex-M target
+//! (the harness's images and the root's firmware example), the LLVM tools of the
 //! toolchain, QEMU through `tools/qemu-run`.
 
 use std::path::{Path, PathBuf};
@@ -6,6 +7,80 @@ use std::process::{Command, Output, Stdio};
 
 /// defmt-print, pinned to the defmt wire format of the defmt in Cargo.lock (1.x).
 pub const DEFMT_PRINT_VERSION: &str = "1.2.0";
+
+/// A Cortex-M core the firmware chores run on.
+pub struct Cpu {
+    /// `cortex-m4f`: the benchmark's name.
+    pub id: &'static str,
+    /// `Cortex-M4F`: the firmware table's name.
+    pub name: &'static str,
+    /// The cargo target of its images.
+    pub target: &'static str,
+    /// The QEMU machine that runs them.
+    pub machine: &'static str,
+    /// Its images are measured (sizes, budget, no-panic proof): false for the
+    /// Cortex-M7, which runs the Cortex-M4F's images.
+    pub sizes: bool,
+}
+
+impl Cpu {
+    /// Whether the target has an FPU (the f32 core runs there, the fixed-point core
+    /// elsewhere).
+    pub fn has_fpu(&self) -> bool {
+        self.target.ends_with("eabihf")
+    }
+}
+
+/// The cores of every table: Cortex-M0, M3, M4F, M7.
+pub const CPUS: [Cpu; 4] = [
+    Cpu {
+        id: "cortex-m0",
+        name: "Cortex-M0",
+        target: "thumbv6m-none-eabi",
+        machine: "microbit",
+        sizes: true,
+    },
+    Cpu {
+        id: "cortex-m3",
+        name: "Cortex-M3",
+        target: "thumbv7m-none-eabi",
+        machine: "mps2-an385",
+        sizes: true,
+    },
+    Cpu {
+        id: "cortex-m4f",
+        name: "Cortex-M4F",
+        target: "thumbv7em-none-eabihf",
+        machine: "mps2-an386",
+        sizes: true,
+    },
+    Cpu {
+        id: "cortex-m7",
+        name: "Cortex-M7",
+        target: "thumbv7em-none-eabihf",
+        machine: "mps2-an500",
+        sizes: false,
+    },
+];
+
+/// `cargo build` of the harness's images (harness/, its own workspace) for `target`,
+/// profile `firmware`, into the root's target directory (`CARGO_TARGET_DIR` if set),
+/// with JSON messages for [`build`]; add `--bin` arguments.
+pub fn harness_build(target: &str) -> Command {
+    harness_build_with(target, "firmware")
+}
+
+/// [`harness_build`] with another profile of the harness (`nopanic`: overflow checks).
+pub fn harness_build_with(target: &str, profile: &str) -> Command {
+    let target_dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(|| crate::root().join("target"), PathBuf::from);
+    let mut cmd = cargo();
+    cmd.env("CARGO_TARGET_DIR", target_dir)
+        .args(["build", "--manifest-path", "harness/Cargo.toml"])
+        .args(["--profile", profile, "--target", target])
+        .arg("--message-format=json-render-diagnostics");
+    cmd
+}
 
 /// `cargo` as the one that runs this xtask, in the repository root. Without
 /// `RUSTFLAGS`: cargo would use it instead of the thumb targets' rustflags in

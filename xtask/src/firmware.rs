@@ -3,7 +3,7 @@
 //!
 //! Measured, per core (profile `firmware`: release with fat LTO, one codegen unit):
 //!
-//! - image flash and RAM of the minimal images (`examples/minimal`): flash is
+//! - image flash and RAM of the minimal images (`harness/src/bin/minimal_*.rs`): flash is
 //!   .vector_table + .text + .rodata + .data, RAM the statics (.data + .bss + .uninit)
 //!   as llvm-size counts them; the stack comes on top;
 //! - **estimator flash** (budgeted): `minimal_<model>` minus `minimal_<model>_prepare`,
@@ -16,65 +16,17 @@
 //!   the firmware's trace, by stack painting on the target (`examples/firmware`);
 //! - instructions per sample (reported): SysTick under QEMU's `-icount`.
 
-use crate::cross::{self, Artifacts, Sections};
+use crate::cross::{self, Artifacts, CPUS, Cpu, Sections};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
 /// Per-sample estimator budget: flash (code + tables) and stack, in bytes. Applied to
-/// the cores marked `budget` below; lower them when the estimator beats them.
+/// the cores whose images are measured (`Cpu::sizes`); lower them when the estimator
+/// beats them.
 pub const FLASH_BUDGET: u64 = 8 * 1024;
 pub const STACK_BUDGET: u64 = 256;
-
-struct Core {
-    name: &'static str,
-    target: &'static str,
-    machine: &'static str,
-    /// The number format of the estimator it runs.
-    number: &'static str,
-    /// Size table and budget for this core (the Cortex-M7 runs the Cortex-M4F's images).
-    sizes: bool,
-    budget: bool,
-}
-
-/// The cores: the f32 core with an FPU (Cortex-M4F, M7), the fixed-point core without
-/// one (Cortex-M3, M0); the budget holds for both (`cargo xtask bench` measures the
-/// f32 core in soft float there too).
-const CORES: [Core; 4] = [
-    Core {
-        name: "Cortex-M4F",
-        target: "thumbv7em-none-eabihf",
-        machine: "mps2-an386",
-        number: "f32",
-        sizes: true,
-        budget: true,
-    },
-    Core {
-        name: "Cortex-M7",
-        target: "thumbv7em-none-eabihf",
-        machine: "mps2-an500",
-        number: "f32",
-        sizes: false,
-        budget: false,
-    },
-    Core {
-        name: "Cortex-M3",
-        target: "thumbv7m-none-eabi",
-        machine: "mps2-an385",
-        number: "fixed",
-        sizes: true,
-        budget: true,
-    },
-    Core {
-        name: "Cortex-M0",
-        target: "thumbv6m-none-eabi",
-        machine: "microbit",
-        number: "fixed",
-        sizes: true,
-        budget: true,
-    },
-];
 
 const MODELS: [&str; 2] = ["elliptic", "line"];
 const MINIMAL: [&str; 5] = [
@@ -109,21 +61,18 @@ struct Row {
 /// `readme`: also write the table into README.md (between its firmware markers).
 pub fn run(readme: bool) -> ExitCode {
     let start = Instant::now();
-    let mut failures: Vec<String> = Vec::new();
-    if let Err(e) = preflight() {
-        eprintln!("firmware: {e}");
-        return ExitCode::FAILURE;
-    }
-    let llvm_size = match cross::llvm_tool("llvm-size") {
+    let llvm_size = match preflight().and_then(|()| cross::llvm_tool("llvm-size")) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("firmware: {e}");
             return ExitCode::FAILURE;
         }
     };
+    let mut failures: Vec<String> = Vec::new();
     let mut rows = Vec::new();
     let mut built: Vec<Built> = Vec::new();
-    for core in &CORES {
+    // The Cortex-M4F first: the README's table starts with the FPU core.
+    for core in CPUS.iter().rev() {
         step(
             start,
             &format!("{} ({}, QEMU {})", core.name, core.target, core.machine),
@@ -138,55 +87,10 @@ pub fn run(readme: bool) -> ExitCode {
                 }
             }
         }
-        let Built { images, test, .. } = built.iter().find(|b| b.target == core.target).unwrap();
-
-        // The firmware: every answer checked, stack and instructions measured.
-        let runs =
-            match cross::artifact(images, "firmware").and_then(|elf| run_firmware(core, &elf)) {
-                Ok(runs) => runs,
-                Err(e) => {
-                    failures.push(format!("{} firmware: {e}", core.name));
-                    Vec::new()
-                }
-            };
-
-        // The on-target tests.
-        match cross::qemu(core.machine, test) {
-            Ok((Some(0), log)) if log.contains("all tests passed!") => {
-                let n = log.lines().filter(|l| l.contains(") running `")).count();
-                println!("  on-target tests: {n} passed");
-            }
-            Ok((status, log)) => failures.push(format!(
-                "{} on-target tests failed (exit {status:?}):\n{log}",
-                core.name
-            )),
-            Err(e) => failures.push(format!("{} on-target tests: {e}", core.name)),
-        }
-
-        // The minimal images: they run, and their sizes.
-        if core.sizes {
-            match sizes(core, images, &llvm_size, &runs) {
-                Ok(mut r) => rows.append(&mut r),
-                Err(e) => failures.push(format!("{} sizes: {e}", core.name)),
-            }
-        }
+        let b = built.iter().find(|b| b.target == core.target).unwrap();
+        rows.extend(check_core(core, b, &llvm_size, &mut failures));
     }
-
-    step(start, "the README's command: cargo fw");
-    match fw_alias() {
-        Ok(()) => println!("  cargo fw: exit 0"),
-        Err(e) => failures.push(format!("cargo fw: {e}")),
-    }
-
-    step(
-        start,
-        "a real board's layout: MISALIGN_MEMORY_X=boards/stm32f4.x, --features rtt",
-    );
-    match board(&llvm_size) {
-        Ok(line) => println!("  {line}"),
-        Err(e) => failures.push(format!("board build: {e}")),
-    }
-
+    check_commands(start, &llvm_size, &mut failures);
     let (table, over) = table(&rows);
     println!(
         "\nEstimator on Cortex-M (profile `firmware`, bytes; budget per sample on the FPU core: \
@@ -194,22 +98,74 @@ pub fn run(readme: bool) -> ExitCode {
     );
     failures.extend(over);
     if readme && failures.is_empty() {
-        match write_readme(&table) {
+        match crate::write_readme_section("firmware", &table) {
             Ok(()) => println!("wrote the table into README.md"),
             Err(e) => failures.push(e),
         }
     }
     step(start, "done");
+    report(&failures)
+}
+
+/// On one core: the firmware (every answer checked, stack and instructions measured),
+/// the on-target tests, and the minimal images (they run; their sizes) where the core
+/// measures them. Returns the core's rows of the size table.
+fn check_core(core: &Cpu, built: &Built, llvm_size: &Path, failures: &mut Vec<String>) -> Vec<Row> {
+    let runs = match run_firmware(core, &built.firmware) {
+        Ok(runs) => runs,
+        Err(e) => {
+            failures.push(format!("{} firmware: {e}", core.name));
+            Vec::new()
+        }
+    };
+    match cross::qemu(core.machine, &built.test) {
+        Ok((Some(0), log)) if log.contains("all tests passed!") => {
+            let n = log.lines().filter(|l| l.contains(") running `")).count();
+            println!("  on-target tests: {n} passed");
+        }
+        Ok((status, log)) => failures.push(format!(
+            "{} on-target tests failed (exit {status:?}):\n{log}",
+            core.name
+        )),
+        Err(e) => failures.push(format!("{} on-target tests: {e}", core.name)),
+    }
+    if !core.sizes {
+        return Vec::new();
+    }
+    sizes(core, &built.harness, llvm_size, &runs).unwrap_or_else(|e| {
+        failures.push(format!("{} sizes: {e}", core.name));
+        Vec::new()
+    })
+}
+
+/// The README's command (`cargo fw`) and the real board's build.
+fn check_commands(start: Instant, llvm_size: &Path, failures: &mut Vec<String>) {
+    step(start, "the README's command: cargo fw");
+    match fw_alias() {
+        Ok(()) => println!("  cargo fw: exit 0"),
+        Err(e) => failures.push(format!("cargo fw: {e}")),
+    }
+    step(
+        start,
+        "a real board's layout: MISALIGN_MEMORY_X=harness/boards/stm32f4.x, --features rtt",
+    );
+    match board(llvm_size) {
+        Ok(line) => println!("  {line}"),
+        Err(e) => failures.push(format!("board build: {e}")),
+    }
+}
+
+/// Success if nothing failed, else every failure on stderr.
+fn report(failures: &[String]) -> ExitCode {
     if failures.is_empty() {
         println!("firmware: every image and on-target test passed, within budget");
-        ExitCode::SUCCESS
-    } else {
-        for f in &failures {
-            eprintln!("\nFAILED: {f}");
-        }
-        eprintln!("\nfirmware: {} failure(s)", failures.len());
-        ExitCode::FAILURE
+        return ExitCode::SUCCESS;
     }
+    for f in failures {
+        eprintln!("\nFAILED: {f}");
+    }
+    eprintln!("\nfirmware: {} failure(s)", failures.len());
+    ExitCode::FAILURE
 }
 
 fn step(start: Instant, what: &str) {
@@ -250,16 +206,17 @@ pub(crate) fn preflight() -> Result<(), String> {
 /// What one target's builds made.
 struct Built {
     target: &'static str,
-    /// The firmware and minimal images (profile `firmware`).
-    images: Artifacts,
+    /// The firmware example (profile `firmware`).
+    firmware: PathBuf,
+    /// The harness's minimal images (profile `firmware`).
+    harness: Artifacts,
     /// The on-target test (profile `test`).
     test: PathBuf,
 }
 
-/// Builds the firmware-profile images and the on-target test for `target`.
+/// Builds the firmware example, the minimal images and the on-target test for `target`.
 fn build_target(target: &'static str) -> Result<Built, String> {
-    let mut cmd = cross::cargo();
-    cmd.args([
+    let firmware = cross::build(cross::cargo().args([
         "build",
         "--profile",
         "firmware",
@@ -267,16 +224,15 @@ fn build_target(target: &'static str) -> Result<Built, String> {
         target,
         "--features",
         "firmware",
-    ])
-    .args([
-        "--message-format=json-render-diagnostics",
         "--example",
         "firmware",
-    ]);
+        "--message-format=json-render-diagnostics",
+    ]))?;
+    let mut minimal = cross::harness_build(target);
     for m in MINIMAL {
-        cmd.args(["--example", m]);
+        minimal.args(["--bin", m]);
     }
-    let images = cross::build(&mut cmd)?;
+    let harness = cross::build(&mut minimal)?;
     let tests = cross::build(cross::cargo().args([
         "test",
         "--no-run",
@@ -290,13 +246,14 @@ fn build_target(target: &'static str) -> Result<Built, String> {
     ]))?;
     Ok(Built {
         target,
-        images,
+        firmware: cross::artifact(&firmware, "firmware")?,
+        harness,
         test: cross::artifact(&tests, "on_target")?,
     })
 }
 
 /// Runs the firmware on `core`: exit 0 and one `result` line per contact model.
-fn run_firmware(core: &Core, elf: &Path) -> Result<Vec<(String, Run)>, String> {
+fn run_firmware(core: &Cpu, elf: &Path) -> Result<Vec<(String, Run)>, String> {
     let (status, log) = cross::qemu(core.machine, elf)?;
     let results: Vec<(String, Run)> = log.lines().filter_map(parse_result).collect();
     if status != Some(0) || results.len() != MODELS.len() {
@@ -336,7 +293,7 @@ fn parse_result(line: &str) -> Option<(String, Run)> {
 
 /// Runs the minimal images (each must exit 0) and measures them.
 fn sizes(
-    core: &Core,
+    core: &Cpu,
     images: &Artifacts,
     llvm_size: &Path,
     runs: &[(String, Run)],
@@ -359,7 +316,7 @@ fn sizes(
             let prepare = get(&format!("minimal_{model}_prepare"));
             Row {
                 core: core.name,
-                number: core.number,
+                number: if core.has_fpu() { "f32" } else { "fixed" },
                 model,
                 image_flash: full.flash(),
                 image_ram: full.ram(),
@@ -370,7 +327,7 @@ fn sizes(
                     .find(|(m, _)| m == model)
                     .map(|(_, r)| r.clone())
                     .unwrap_or_default(),
-                budget: core.budget,
+                budget: core.sizes,
             }
         })
         .collect())
@@ -402,7 +359,7 @@ fn fw_alias() -> Result<(), String> {
 fn board(llvm_size: &Path) -> Result<String, String> {
     let built = cross::build(
         cross::cargo()
-            .env("MISALIGN_MEMORY_X", "boards/stm32f4.x")
+            .env("MISALIGN_MEMORY_X", "harness/boards/stm32f4.x")
             .args(["build", "--release", "--target", "thumbv7em-none-eabihf"])
             .args(["--features", "rtt", "--example", "firmware"])
             .arg("--message-format=json-render-diagnostics"),
@@ -461,16 +418,4 @@ fn table(rows: &[Row]) -> (String, Vec<String>) {
         }
     }
     (t, over)
-}
-
-/// Writes `table` between the firmware markers of README.md.
-fn write_readme(table: &str) -> Result<(), String> {
-    let path = crate::root().join("README.md");
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("README.md: {e}"))?;
-    let (begin, end) = ("<!-- firmware:begin -->", "<!-- firmware:end -->");
-    let (Some(a), Some(b)) = (text.find(begin), text.find(end)) else {
-        return Err("README.md has no firmware markers".into());
-    };
-    let new = format!("{}{begin}\n{table}{}", &text[..a], &text[b..]);
-    std::fs::write(&path, new).map_err(|e| format!("README.md: {e}"))
 }

@@ -1,5 +1,5 @@
 //! The fixed-point core's tables (Q8.24, uniform spacing, quadratic interpolation),
-//! generated from the f64 reference into src/tables.rs beside the f32 core's.
+//! generated from the f64 reference into src/fixed/tables.rs, beside that core.
 
 use misalign::fixed::uniform::{ONE, UniformTable};
 use misalign::reference::{normal, tangential};
@@ -201,8 +201,14 @@ pub fn measure(spec: &UniformSpec, values: &[i32], samples: usize) -> (f64, i32)
     (worst, d2)
 }
 
-/// Appends the tables to the generated source.
-pub fn source(out: &mut String) {
+/// The fixed-point core's generated tables, `src/fixed/tables.rs`.
+pub fn source() -> String {
+    let mut out = String::from(
+        "//! Tables of the fixed-point core (Q8.24, uniform spacing, quadratic interpolation),\n\
+         //! generated from the f64 reference by `cargo xtask tables` (xtask/src/fixed_tables.rs).\n\
+         //! Do not edit: a test regenerates this file and fails on any drift.\n\n\
+         use super::uniform::UniformTable;\n\n",
+    );
     for spec in specs() {
         let v = values(&spec);
         let (worst, d2) = measure(&spec, &v, 16);
@@ -233,6 +239,8 @@ pub fn source(out: &mut String) {
         }
         out.push_str("    ],\n};\n\n");
     }
+    out.pop();
+    out
 }
 
 /// `--explore-fixed`: worst error and size by spacing.

@@ -10,6 +10,7 @@ mod fuzz;
 mod nopanic;
 mod sweep;
 mod tables;
+mod trace;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -18,8 +19,9 @@ const USAGE: &str = "\
 usage: cargo xtask <task>
 
 tasks:
-    tables [--check]               generate src/tables.rs from the f64 reference
-                                   (--check: fail if the committed file differs)
+    tables [--check]               generate src/float/tables.rs, src/fixed/tables.rs and the
+                                   firmware's trace (examples/firmware/trace.rs) from the
+                                   f64 reference (--check: fail if a committed file differs)
     fuzz [--seconds N | --runs N]  every fuzz target for N seconds (default 60), or for N
                                    inputs from a fixed seed (repeatable; CI); nightly
     sweep [--quick] [--readme]     every f32 kernel over every input of its domain against
@@ -84,7 +86,7 @@ fn main() -> ExitCode {
             print!("{table}");
             eprintln!("swept in {:.0} s", start.elapsed().as_secs_f64());
             if flag("--readme") {
-                sweep::write_readme(&root().join("README.md"), &table).expect("write README.md");
+                write_readme_section("sweep", &table).expect("write README.md");
             }
             ExitCode::SUCCESS
         }
@@ -100,25 +102,7 @@ fn main() -> ExitCode {
             tables::explore();
             ExitCode::SUCCESS
         }
-        Some("tables") => {
-            let path = root().join("src/tables.rs");
-            let text = tables::source();
-            if flag("--check") {
-                let committed = std::fs::read_to_string(&path).unwrap_or_default();
-                if committed != text {
-                    eprintln!(
-                        "{} differs from the reference: run `cargo xtask tables`",
-                        path.display()
-                    );
-                    return ExitCode::FAILURE;
-                }
-                println!("{} matches the reference", path.display());
-            } else {
-                std::fs::write(&path, text).expect("write src/tables.rs");
-                println!("wrote {}", path.display());
-            }
-            ExitCode::SUCCESS
-        }
+        Some("tables") => tables_task(flag("--check")),
         Some("figures") => figures::run(&root().join("docs"), flag("--check")),
         Some("bench") => bench::run(flag("--csv"), flag("--short")),
         Some("firmware") => firmware::run(flag("--readme")),
@@ -130,16 +114,59 @@ fn main() -> ExitCode {
     }
 }
 
+/// `cargo xtask tables [--check]`: writes (or checks) every generated file.
+fn tables_task(check: bool) -> ExitCode {
+    let mut stale = false;
+    for (path, text) in tables::generated() {
+        let full = root().join(path);
+        if check {
+            if std::fs::read_to_string(&full).ok().as_deref() == Some(text.as_str()) {
+                println!("{path} matches the reference");
+            } else {
+                eprintln!("{path} differs from the reference: run `cargo xtask tables`");
+                stale = true;
+            }
+        } else {
+            std::fs::write(&full, text).unwrap_or_else(|e| panic!("write {path}: {e}"));
+            println!("wrote {path}");
+        }
+    }
+    if stale {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// Writes `section` between the markers `<!-- {name}:begin -->` and
+/// `<!-- {name}:end -->` of README.md.
+pub fn write_readme_section(name: &str, section: &str) -> Result<(), String> {
+    let path = root().join("README.md");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("README.md: {e}"))?;
+    let (begin, end) = (
+        format!("<!-- {name}:begin -->"),
+        format!("<!-- {name}:end -->"),
+    );
+    let (Some(a), Some(b)) = (text.find(&begin), text.find(&end)) else {
+        return Err(format!("README.md has no {name} markers"));
+    };
+    let new = format!("{}{begin}\n{section}{}", &text[..a], &text[b..]);
+    std::fs::write(&path, new).map_err(|e| format!("README.md: {e}"))
+}
+
 #[cfg(test)]
 mod tests {
-    /// The committed tables are exactly what the reference generates today: any
-    /// change to the reference or the fit that moves a coefficient fails here.
+    /// The committed tables and firmware trace are exactly what the reference generates
+    /// today: any change to the reference or the fit that moves a coefficient or an
+    /// expected answer fails here.
     #[test]
-    fn committed_tables_match_the_reference() {
-        let committed = std::fs::read_to_string(super::root().join("src/tables.rs")).unwrap();
-        assert!(
-            committed == super::tables::source(),
-            "src/tables.rs drifted from the reference: run `cargo xtask tables`"
-        );
+    fn committed_generated_files_match_the_reference() {
+        for (path, text) in super::tables::generated() {
+            let committed = std::fs::read_to_string(super::root().join(path)).unwrap();
+            assert!(
+                committed == text,
+                "{path} drifted from the reference: run `cargo xtask tables`"
+            );
+        }
     }
 }

@@ -1,23 +1,17 @@
 //! `cargo xtask nopanic`: the compiler's proof that the estimator cannot panic.
 //!
-//! `examples/nopanic` holds every per-sample path of the estimator and the scene
+//! `harness/src/bin/nopanic.rs` holds every per-sample path of the estimator and the scene
 //! preparation, with panic-never as its panic handler: a handler that calls a symbol
 //! which does not exist. The image links only if optimisation (profile `nopanic`: the
 //! firmware profile, release with fat LTO, plus overflow checks) removed every call to
 //! it, i.e. every panic path, an integer overflow included. Built for each
-//! Cortex-M class; run in QEMU where it is installed. `examples/nopanic/canary.rs`
+//! Cortex-M class; run in QEMU where it is installed. `harness/src/bin/nopanic_canary.rs`
 //! has a panic path on purpose and must fail to link with panic-never's message,
-//! or the proof proves nothing in this setup; `overflow_canary.rs` likewise, with an
+//! or the proof proves nothing in this setup; `nopanic_overflow_canary.rs` likewise, with an
 //! integer overflow as its one panic path, or the proof is blind to overflow.
 
-use crate::cross;
+use crate::cross::{self, CPUS};
 use std::process::ExitCode;
-
-const TARGETS: [(&str, &str); 3] = [
-    ("thumbv7em-none-eabihf", "mps2-an386"),
-    ("thumbv7m-none-eabi", "mps2-an385"),
-    ("thumbv6m-none-eabi", "microbit"),
-];
 
 /// What panic-never's undefined symbol says in the linker's error.
 const PANIC_NEVER: &str = "error(panic-never)";
@@ -25,7 +19,8 @@ const PANIC_NEVER: &str = "error(panic-never)";
 pub fn run() -> ExitCode {
     let qemu = cross::have("qemu-system-arm");
     let mut failed = false;
-    for (target, machine) in TARGETS {
+    for cpu in CPUS.iter().filter(|c| c.sizes) {
+        let (target, machine) = (cpu.target, cpu.machine);
         let built = cross::build(&mut image(target, "nopanic"));
         match built.and_then(|b| cross::artifact(&b, "nopanic")) {
             Ok(elf) if qemu => match cross::qemu(machine, &elf) {
@@ -86,21 +81,8 @@ pub fn run() -> ExitCode {
     }
 }
 
-fn image(target: &str, example: &str) -> std::process::Command {
-    let mut cmd = cross::cargo();
-    cmd.args([
-        "build",
-        "--profile",
-        "nopanic",
-        "--target",
-        target,
-        "--features",
-        "firmware",
-    ])
-    .args([
-        "--example",
-        example,
-        "--message-format=json-render-diagnostics",
-    ]);
+fn image(target: &str, bin: &str) -> std::process::Command {
+    let mut cmd = cross::harness_build_with(target, "nopanic");
+    cmd.args(["--bin", bin]);
     cmd
 }

@@ -6,11 +6,11 @@
 
 use misalign::fixed::logexp::{exp2_fixed, log2_u32};
 use misalign::fixed::uniform::ONE;
-use misalign::kernels::axial_force::axial_force_ratio;
-use misalign::kernels::cbrt::cbrt;
-use misalign::kernels::sqrt::inv_sqrt;
+use misalign::float::kernels::axial_force::axial_force_ratio;
+use misalign::float::kernels::cbrt::cbrt;
+use misalign::float::kernels::sqrt::inv_sqrt;
+use misalign::float::tables::{G_OF_THETA, INV_M_OF_THETA, THETA_OF_G};
 use misalign::reference::{normal, tangential};
-use misalign::tables::{G_OF_THETA, INV_M_OF_THETA, THETA_OF_G};
 use std::fmt::Write;
 
 /// One row of the result.
@@ -226,15 +226,4 @@ pub fn markdown(rows: &[Row], quick: bool) -> String {
         writeln!(out, "\n(quick pass: the f32 kernels strided)").unwrap();
     }
     out
-}
-
-/// Replaces the text between `<!-- sweep:begin -->` and `<!-- sweep:end -->` in README.md.
-pub fn write_readme(readme: &std::path::Path, table: &str) -> std::io::Result<()> {
-    let text = std::fs::read_to_string(readme)?;
-    let (begin, end) = ("<!-- sweep:begin -->", "<!-- sweep:end -->");
-    let (Some(a), Some(b)) = (text.find(begin), text.find(end)) else {
-        return Err(std::io::Error::other("README.md has no sweep markers"));
-    };
-    let new = format!("{}{begin}\n{table}{}", &text[..a], &text[b..]);
-    std::fs::write(readme, new)
 }

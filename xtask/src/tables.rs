@@ -200,14 +200,23 @@ fn write_coeffs(out: &mut String, coeffs: &[Vec<f32>]) {
     }
 }
 
-/// The whole generated source file.
+/// The generated files: `(path under the repository root, text)`.
+pub fn generated() -> [(&'static str, String); 3] {
+    [
+        ("src/float/tables.rs", source()),
+        ("src/fixed/tables.rs", crate::fixed_tables::source()),
+        ("examples/firmware/trace.rs", crate::trace::source()),
+    ]
+}
+
+/// The f32 core's generated tables, `src/float/tables.rs`.
 pub fn source() -> String {
     let mut out = String::new();
     out.push_str(
-        "//! Tables of the f32 core, generated from the f64 reference by `cargo xtask tables`.\n\
+        "//! Tables of the f32 core (octave polynomials; the axial force's two pieces),\n\
+         //! generated from the f64 reference by `cargo xtask tables` (xtask/src/tables.rs).\n\
          //! Do not edit: a test regenerates this file and fails on any drift.\n\n\
-         use crate::fixed::uniform::UniformTable;\n\
-         use crate::kernels::octave::{OctaveTable, Row};\n\n",
+         use super::octave::{OctaveTable, Row};\n\n",
     );
     for spec in specs() {
         assert_eq!(
@@ -262,7 +271,6 @@ pub fn source() -> String {
         }
         out.push_str("];\n\n");
     }
-    crate::fixed_tables::source(&mut out);
     out.pop();
     out
 }

@@ -1,0 +1,183 @@
+//! The benchmark image (`cargo xtask bench`): per model and per operation, the
+//! instructions per call (mean and maximum over the practical samples of
+//! `misalign_workload::samples`), counted by SysTick under QEMU's `-icount`. One line
+//! per measurement: `bench model=<m> op=<op> n=<calls> mean=<x> max=<y>`; the host
+//! pairs it with the error of the same code against the reference.
+//!
+//! Models: the f64 reference (soft float on every Cortex-M here), the f32 core (soft
+//! float on the M0 and M3), the fixed-point core and the Hamrock & Brewe baseline.
+#![no_std]
+#![no_main]
+
+use misalign_harness::support;
+use misalign_logger as _;
+
+misalign_harness::log_panics_and_faults!();
+
+mod run {
+    use core::hint::black_box;
+    use misalign::fixed::logexp::{exp2_fixed, log2_u32};
+    use misalign::fixed::tables::LOG_G_HIGH;
+    use misalign::fixed::{FixedEllipticScene, FixedLineScene};
+    use misalign::float::kernels::{axial_force::axial_force_ratio, cbrt::cbrt, sqrt::inv_sqrt};
+    use misalign::float::{EllipticScene, G_OF_THETA, LineScene, THETA_OF_G};
+    use misalign::{Scene, reference};
+    use misalign_harness::support::counter::{Counter, SystClkSource};
+    use misalign_workload::{Model, Operation, hamrock_brewe::HamrockBrewe, samples};
+
+    /// Samples per operation (the reference, a thousand times slower, gets an eighth).
+    const SAMPLES: usize = match option_env!("MISALIGN_BENCH_SAMPLES") {
+        Some(s) => parse(s),
+        None => 256,
+    };
+
+    const fn parse(s: &str) -> usize {
+        let b = s.as_bytes();
+        let mut i = 0;
+        let mut n = 0;
+        while i < b.len() {
+            n = n * 10 + (b[i] - b'0') as usize;
+            i += 1;
+        }
+        n
+    }
+
+    /// The angle LSB of the fixed-point core in the benchmark (rad per count).
+    const ANGLE_LSB: f64 = 1e-8;
+
+    struct Stats {
+        n: u32,
+        sum: u64,
+        max: u32,
+    }
+
+    impl Stats {
+        fn new() -> Self {
+            Stats {
+                n: 0,
+                sum: 0,
+                max: 0,
+            }
+        }
+        fn add(&mut self, x: u32) {
+            self.n += 1;
+            self.sum += x as u64;
+            self.max = self.max.max(x);
+        }
+        fn print(&self, model: Model, op: Operation) {
+            let mean = (self.sum + self.n as u64 / 2) / (self.n as u64).max(1);
+            defmt::println!(
+                "bench model={=str} op={=str} n={=u32} mean={=u64} max={=u32}",
+                model.name(),
+                op.name(),
+                self.n,
+                mean,
+                self.max
+            );
+        }
+    }
+
+    /// Measures `f(x)` for every x, black-boxing input and output.
+    fn each<T: Copy, R>(c: &Counter, xs: impl Iterator<Item = T>, f: impl Fn(T) -> R) -> Stats {
+        let mut s = Stats::new();
+        for x in xs {
+            let x = black_box(x);
+            let (r, n) = c.measure(|| f(x));
+            black_box(r);
+            s.add(n);
+        }
+        s
+    }
+
+    pub fn main(counter: Counter) -> i32 {
+        // Opaque to the optimiser, as a scene read from a configuration block: nothing
+        // of it is folded into the per-sample code.
+        let scene = black_box(Scene::DEMO);
+        let (Ok(core), Ok(line)) = (EllipticScene::new(&scene), LineScene::new(&scene)) else {
+            return 2;
+        };
+        let load_lsb = samples::LOAD_MAX / (1u64 << 30) as f64;
+        let (Ok(fixed), Ok(fixed_line)) = (
+            FixedEllipticScene::new(&scene, load_lsb, ANGLE_LSB),
+            FixedLineScene::new(&scene, load_lsb, ANGLE_LSB),
+        ) else {
+            return 2;
+        };
+        let baseline = HamrockBrewe::of(&scene);
+        let f32s = || samples::practical(SAMPLES).map(|(p, phi)| (p as f32, phi as f32));
+        let counts = || {
+            samples::practical(SAMPLES)
+                .map(|(p, phi)| ((p / load_lsb) as u32, (phi / ANGLE_LSB) as i32))
+        };
+        let c = &counter;
+
+        // The full per-sample estimate (d/b, regime, F, phi0), every model.
+        each(c, f32s(), |(p, phi)| core.estimate(p, phi)).print(Model::F32, Operation::Estimate);
+        each(c, counts(), |(p, a)| fixed.estimate(p, a)).print(Model::Fixed, Operation::Estimate);
+        each(c, f32s(), |(p, phi)| baseline.estimate(p, phi))
+            .print(Model::HamrockBrewe, Operation::Estimate);
+        // Line contact.
+        each(c, f32s(), |(p, phi)| line.estimate(p, phi))
+            .print(Model::F32, Operation::EstimateLine);
+        each(c, counts(), |(p, a)| fixed_line.estimate(p, a))
+            .print(Model::Fixed, Operation::EstimateLine);
+        // The f32 kernels, on what they see in these estimates.
+        let thetas = || f32s().map(|(_, phi)| phi.abs());
+        each(c, thetas(), |t| G_OF_THETA.eval(t)).print(Model::F32, Operation::TableG);
+        each(c, f32s().map(|(p, _)| 0.93 * libm::cbrtf(p) * 1e-4), |g| {
+            THETA_OF_G.eval(g)
+        })
+        .print(Model::F32, Operation::TableThetaOfG);
+        each(c, f32s().map(|(p, _)| p), cbrt).print(Model::F32, Operation::KernelCbrt);
+        each(c, f32s().map(|(p, _)| p), libm::cbrtf).print(Model::F32, Operation::KernelLibmCbrtf);
+        each(c, f32s().map(|(p, _)| p), inv_sqrt).print(Model::F32, Operation::KernelInvSqrt);
+        each(c, f32s().map(|(p, _)| p), libm::sqrtf).print(Model::F32, Operation::KernelLibmSqrtf);
+        let slips = || (0..SAMPLES).map(|i| (i as f32 + 0.5) / SAMPLES as f32);
+        each(c, slips(), axial_force_ratio).print(Model::F32, Operation::KernelAxialForce);
+        // The fixed-point kernels.
+        each(c, counts().map(|(p, _)| p), log2_u32).print(Model::Fixed, Operation::KernelLog2);
+        each(c, counts().map(|(p, _)| (p as i32) >> 8), |l| {
+            exp2_fixed(-l, 24)
+        })
+        .print(Model::Fixed, Operation::KernelExp2);
+        each(
+            c,
+            counts().map(|(_, a)| -(a.unsigned_abs() as i32 >> 6)),
+            |y| LOG_G_HIGH.eval(y),
+        )
+        .print(Model::Fixed, Operation::TableLogG);
+
+        // The f64 reference, a thousand times slower: on SysTick's reference clock,
+        // whose 24 bits last long enough (the core clock's would wrap on a Cortex-M0).
+        let slow = Counter::with_clock(counter.release(), SystClkSource::External, 1 << 20);
+        defmt::println!(
+            "bench reference_clock_ticks_per_1000={=u32}",
+            slow.ticks_per_1000()
+        );
+        let c = if slow.ticks_per_1000() > 0 {
+            &slow
+        } else {
+            return 0;
+        };
+        let few = (SAMPLES / 8).max(4);
+        each(c, samples::practical(few), |(p, phi)| {
+            reference::elliptic(&scene, p, phi)
+        })
+        .print(Model::Reference, Operation::Estimate);
+        each(c, samples::practical(few), |(p, phi)| {
+            reference::line(&scene, p, phi)
+        })
+        .print(Model::Reference, Operation::EstimateLine);
+        0
+    }
+}
+
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    let Some(peripherals) = cortex_m::Peripherals::take() else {
+        support::exit(3)
+    };
+    let counter = support::counter::Counter::new(peripherals.SYST);
+    defmt::println!("bench ticks_per_1000={=u32}", counter.ticks_per_1000());
+    support::exit(run::main(counter))
+}

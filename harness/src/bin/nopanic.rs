@@ -1,0 +1,142 @@
+//! The no-panic proof (`cargo xtask nopanic`): an image with every public entry point a
+//! firmware calls, fed from volatile reads so that nothing is known at compile time:
+//! the f32 core (`EllipticScene` with the full and with narrowed tables, `LineScene`,
+//! the inverses, the model choice `Auto` per sample, the risk-threshold setters,
+//! `load_range`), the
+//! fixed-point core (`FixedEllipticScene::estimate`, `details`, `FixedLineScene`, their
+//! risk setters), the f64 reference (`reference::elliptic`, `line`, `estimate`,
+//! `critical_angle`, traction, stick zones, pressure) and the scene (`Scene::new`,
+//! `with_length`, the exact theta relation). Its panic handler is panic-never's, which
+//! refers to a symbol that does not exist: the image links only if the optimiser
+//! (profile `nopanic`: release, fat LTO, overflow checks on) removed every path to a
+//! panic, an integer overflow included. It also runs: in QEMU it exits with 0.
+#![no_std]
+#![no_main]
+
+use panic_never as _;
+
+use misalign_harness::io;
+
+/// What the scene and the cores are configured with besides the demo scene: a contact
+/// length (m), the d/b risk threshold and
+/// a point of the contact (m), as a configuration block would hold them.
+static SETTINGS: [f64; 4] = [0.02, 0.8, 1e-4, 2e-5];
+/// Whether the scene uses the exact theta relation (the reference only).
+static EXACT_THETA: bool = false;
+
+/// Which paths run.
+mod paths {
+    use misalign::fixed::FixedAuto;
+    use misalign::fixed::{FixedEllipticScene, FixedLineScene};
+    use misalign::float::octave::{OctaveTable, Row, narrow_rows};
+    use misalign::float::{Auto, EllipticScene, LineScene, Tables};
+    use misalign::float::{G_OF_THETA_ROWS, THETA_OF_G_ROWS};
+    use misalign::{Error, Scene, ThetaRelation, reference};
+    use misalign_harness::io;
+
+    // Narrowed tables (theta from 2^-20 to 2^-6), as in tests/narrow_tables.rs.
+    static G_ROWS: [Row; 14] = narrow_rows(&G_OF_THETA_ROWS, 20);
+    static THETA_ROWS: [Row; 10] = narrow_rows(&THETA_OF_G_ROWS, 13);
+    const NARROW: Tables<'static> = Tables {
+        g: OctaveTable::new(-20, &G_ROWS),
+        theta_of_g: OctaveTable::new(-14, &THETA_ROWS),
+    };
+
+    pub fn fixed_core(scene: &Scene, load: u32, angle: i32, risk: f32) -> Result<(), Error> {
+        let (lsb_p, lsb_a) = (io::LOAD_LSB, io::ANGLE_LSB);
+        let elliptic = FixedEllipticScene::new(scene, lsb_p, lsb_a)?.with_risk_slip_ratio(risk)?;
+        let line = FixedLineScene::new(scene, lsb_p, lsb_a)?.with_risk_slip_ratio(risk)?;
+        io::emit(elliptic.input_range());
+        io::emit(elliptic.estimate(load, angle));
+        io::emit(elliptic.details(load, angle));
+        io::emit(line.estimate(load, angle));
+        Ok(())
+    }
+
+    pub fn f32_core(scene: &Scene, load: f32, phi: f32, risk: f32) -> Result<(), Error> {
+        let elliptic = EllipticScene::new(scene)?.with_risk_slip_ratio(risk)?;
+        let narrow = EllipticScene::with_tables(scene, NARROW)?;
+        let line = LineScene::new(scene)?.with_risk_slip_ratio(risk)?;
+        io::emit(elliptic.estimate(load, phi));
+        io::emit(elliptic.details(load, phi));
+        io::emit(narrow.estimate(load, phi));
+        io::emit(line.load_range());
+        io::emit(line.estimate(load, phi));
+        // The inverses (issue 11), with a force as unknown as the sample.
+        let force = load * phi;
+        io::emit(elliptic.friction_from_axial_force(load, phi, force));
+        io::emit(elliptic.angle_from_axial_force(load, force));
+        io::emit(line.friction_from_axial_force(load, phi, force));
+        io::emit(line.angle_from_axial_force(load, force));
+        Ok(())
+    }
+
+    /// Section 9's model choice per sample, in both cores, and the f32 inverses
+    /// through it.
+    pub fn model_choice(
+        scene: &Scene,
+        sample: (f32, f32),
+        counts: (u32, i32),
+        risk: f32,
+    ) -> Result<(), Error> {
+        let (load, phi) = sample;
+        let (lsb_p, lsb_a) = (io::LOAD_LSB, io::ANGLE_LSB);
+        let auto = Auto::new(scene)?.with_risk_slip_ratio(risk)?;
+        io::emit(auto.estimate(load, phi));
+        io::emit(auto.details(load, phi));
+        io::emit(auto.friction_from_axial_force(load, phi, load * phi));
+        io::emit(auto.angle_from_axial_force(load, load * phi));
+        let fixed = FixedAuto::new(scene, lsb_p, lsb_a)?.with_risk_slip_ratio(risk)?;
+        io::emit(fixed.estimate(counts.0, counts.1));
+        io::emit(fixed.details(counts.0, counts.1));
+        Ok(())
+    }
+
+    /// The f64 reference, with the scene's length and theta relation as configured.
+    pub fn reference(
+        scene: &Scene,
+        length: f64,
+        exact: bool,
+        sample: (f64, f64),
+        point: (f64, f64),
+    ) -> Result<(), Error> {
+        let (load, phi) = sample;
+        let (x, y) = point;
+        let relation = if exact {
+            ThetaRelation::Exact
+        } else {
+            ThetaRelation::SmallAngle
+        };
+        let scene = scene.with_length(length)?.with_theta_relation(relation);
+        let e = reference::elliptic(&scene, load, phi)?;
+        io::emit((e.pressure(x, y), e.traction(&scene, x, y), e.stick_zone(x)));
+        io::emit((e.rolling_resistance(), e.dissipated_power(phi)));
+        let l = reference::line(&scene, load, phi)?;
+        io::emit((l.traction(&scene, y), l.stick_zone()));
+        io::emit(reference::estimate(&scene, load, phi)?.axial_force(&scene));
+        io::emit(reference::critical_angle(&scene, load));
+        Ok(())
+    }
+}
+
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    let (r1, r2, g, nu, mu) = io::scene();
+    let (load, phi) = io::sample();
+    let (load_counts, angle_counts) = io::counts();
+    let [length, risk, x, y] = io::read(&SETTINGS);
+    let exact = io::read(&EXACT_THETA);
+    let result = misalign::Scene::new(r1, r2, g, nu, mu).and_then(|scene| {
+        paths::f32_core(&scene, load, phi, risk as f32)?;
+        paths::fixed_core(&scene, load_counts, angle_counts, risk as f32)?;
+        let with_length = scene.with_length(length)?;
+        paths::model_choice(
+            &with_length,
+            (load, phi),
+            (load_counts, angle_counts),
+            risk as f32,
+        )?;
+        paths::reference(&scene, length, exact, (load as f64, phi as f64), (x, y))
+    });
+    semihosting::process::exit(if result.is_ok() { 0 } else { 1 })
+}

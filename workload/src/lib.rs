@@ -1,0 +1,141 @@
+//! What the measurements share, on the host and on the target (`no_std`): the
+//! benchmark's samples ([`samples`]), the operations and models it measures
+//! ([`Operation`], [`Model`]: the benchmark image prints their names, `cargo xtask
+//! bench` reads them back), and the Hamrock & Brewe baseline ([`hamrock_brewe`]).
+//! Used by the benchmark image (`harness/`), the host benchmark (`benches/host.rs`)
+//! and `cargo xtask bench`.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod hamrock_brewe;
+pub mod samples;
+
+/// What a benchmark row estimates with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Model {
+    /// The f64 reference (`misalign::reference`).
+    Reference,
+    /// The f32 core (`misalign::float`).
+    F32,
+    /// The fixed-point core (`misalign::fixed`).
+    Fixed,
+    /// The Hamrock & Brewe baseline ([`hamrock_brewe`]).
+    HamrockBrewe,
+}
+
+/// What a benchmark row measures: a whole estimate or one kernel or table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Operation {
+    /// The full per-sample estimate of elliptic contact (d/b, regime, F, phi0).
+    Estimate,
+    /// The same for line contact.
+    EstimateLine,
+    /// The f32 table g(theta).
+    TableG,
+    /// The f32 table theta(g).
+    TableThetaOfG,
+    /// The f32 cube root kernel.
+    KernelCbrt,
+    /// libm's `cbrtf`, for comparison.
+    KernelLibmCbrtf,
+    /// The f32 inverse square root kernel.
+    KernelInvSqrt,
+    /// libm's `sqrtf`, for comparison.
+    KernelLibmSqrtf,
+    /// The f32 F/(mu P) of eq (21).
+    KernelAxialForce,
+    /// The fixed-point log2.
+    KernelLog2,
+    /// The fixed-point exp2.
+    KernelExp2,
+    /// The Q8.24 table log2 g(log2 theta).
+    TableLogG,
+}
+
+impl Model {
+    /// Every model, in the order of the tables.
+    pub const ALL: [Model; 4] = [
+        Model::Reference,
+        Model::F32,
+        Model::Fixed,
+        Model::HamrockBrewe,
+    ];
+
+    /// The name in the benchmark's log, CSV and tables.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Model::Reference => "reference",
+            Model::F32 => "f32",
+            Model::Fixed => "fixed",
+            Model::HamrockBrewe => "hamrock-brewe",
+        }
+    }
+
+    /// The model of `name` ([`Model::name`]).
+    pub fn from_name(name: &str) -> Option<Model> {
+        Model::ALL.into_iter().find(|m| m.name() == name)
+    }
+}
+
+impl Operation {
+    /// Every operation, in the order the benchmark image measures them.
+    pub const ALL: [Operation; 12] = [
+        Operation::Estimate,
+        Operation::EstimateLine,
+        Operation::TableG,
+        Operation::TableThetaOfG,
+        Operation::KernelCbrt,
+        Operation::KernelLibmCbrtf,
+        Operation::KernelInvSqrt,
+        Operation::KernelLibmSqrtf,
+        Operation::KernelAxialForce,
+        Operation::KernelLog2,
+        Operation::KernelExp2,
+        Operation::TableLogG,
+    ];
+
+    /// The name in the benchmark's log, CSV and tables.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Operation::Estimate => "estimate",
+            Operation::EstimateLine => "estimate:line",
+            Operation::TableG => "table:g",
+            Operation::TableThetaOfG => "table:theta_of_g",
+            Operation::KernelCbrt => "kernel:cbrt",
+            Operation::KernelLibmCbrtf => "kernel:libm_cbrtf",
+            Operation::KernelInvSqrt => "kernel:inv_sqrt",
+            Operation::KernelLibmSqrtf => "kernel:libm_sqrtf",
+            Operation::KernelAxialForce => "kernel:axial_force",
+            Operation::KernelLog2 => "kernel:log2",
+            Operation::KernelExp2 => "kernel:exp2",
+            Operation::TableLogG => "table:log_g",
+        }
+    }
+
+    /// The operation of `name` ([`Operation::name`]).
+    pub fn from_name(name: &str) -> Option<Operation> {
+        Operation::ALL.into_iter().find(|o| o.name() == name)
+    }
+
+    /// A whole per-sample estimate (not a kernel or a table).
+    pub const fn is_estimate(self) -> bool {
+        matches!(self, Operation::Estimate | Operation::EstimateLine)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_read_back() {
+        for m in Model::ALL {
+            assert_eq!(Model::from_name(m.name()), Some(m));
+        }
+        for o in Operation::ALL {
+            assert_eq!(Operation::from_name(o.name()), Some(o));
+        }
+        assert_eq!(Operation::from_name("estimate:plane"), None);
+    }
+}
