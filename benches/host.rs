@@ -3,9 +3,7 @@
 //! over the practical domain, and estimates per second for a batch through the CSV
 //! estimator. `cargo bench --bench host`.
 
-#[path = "../examples/estimate/cli.rs"]
-#[allow(dead_code)]
-mod cli;
+use misalign_cli::estimate as cli;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use misalign::fixed::{FixedEllipticScene, exact_lsb};

@@ -1,8 +1,7 @@
 //! The CSV estimator (examples/estimate) reproduces the reference data files row by
 //! row within 1e-12 relative, and handles bad rows and bad input as documented.
 
-#[path = "../examples/estimate/cli.rs"]
-mod cli;
+use misalign_cli::estimate as cli;
 mod common;
 
 use common::{Row, Worst, num, read_rows, reference_dir};

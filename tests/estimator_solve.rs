@@ -4,8 +4,7 @@
 //! sensitivity where it exceeds 1, wherever it is below 1e3), says `at_least` exactly
 //! where the forward map saturates, and turns bad rows into their `error`.
 
-#[path = "../examples/estimate/cli.rs"]
-mod cli;
+use misalign_cli::estimate as cli;
 mod common;
 
 use common::{Row, num, read_rows, rel_err};

@@ -1,7 +1,6 @@
-//! The monitor example's input files (`examples/monitor/input.rs`): scene and trace.
+//! The monitor example's input files (`misalign_cli::monitor_input`): scene and trace.
 
-#[path = "../examples/monitor/input.rs"]
-mod input;
+use misalign_cli::monitor_input as input;
 
 #[test]
 fn a_trace_becomes_samples_on_the_nodes_wrapping_clock() {

@@ -1,7 +1,7 @@
 //! CSV estimator for engineers: one row of scene and sample in, one row of results
 //! out. `cargo run --release --example estimate -- --help` says how.
 
-mod cli;
+use misalign_cli::estimate as cli;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();

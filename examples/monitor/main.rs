@@ -6,8 +6,9 @@
 //! trace through `misalign::monitor::Monitor`; prints every event as it happens and a
 //! summary table. See `--help`.
 
-mod input;
 mod plot;
+
+use misalign_cli::monitor_input as input;
 
 use clap::{Parser, ValueEnum};
 use misalign::fixed::{FixedAuto, FixedEllipticScene};

@@ -3,9 +3,7 @@
 //! without a usable header (1).
 #![no_main]
 
-#[path = "../../examples/estimate/cli.rs"]
-#[allow(dead_code)]
-mod cli;
+use misalign_cli::estimate as cli;
 
 use libfuzzer_sys::fuzz_target;
 

@@ -4,11 +4,9 @@
 //! above 0 no result that stands for 0 or infinity, with F <= mu P.
 #![no_main]
 
-#[path = "extreme.rs"]
-mod extreme;
 
 use arbitrary::Arbitrary;
-use extreme::{Angle, Count, X64};
+use misalign_fuzz::{Angle, Count, X64};
 use libfuzzer_sys::fuzz_target;
 use misalign::Scene;
 use misalign::fixed::logexp::{div3, exp2_fixed, log2_u32};

@@ -3,11 +3,9 @@
 //! |F| <= mu P, a normal phi0 and a finite margin; never NaN.
 #![no_main]
 
-#[path = "extreme.rs"]
-mod extreme;
 
 use arbitrary::Arbitrary;
-use extreme::{X32, X64};
+use misalign_fuzz::{X32, X64};
 use libfuzzer_sys::fuzz_target;
 use misalign::Scene;
 use misalign::float::kernels::{axial_force, cbrt, sqrt};

@@ -3,11 +3,9 @@
 //! in any field, |F| <= mu P and d <= b (infinities only where documented).
 #![no_main]
 
-#[path = "extreme.rs"]
-mod extreme;
 
 use arbitrary::Arbitrary;
-use extreme::X64;
+use misalign_fuzz::X64;
 use libfuzzer_sys::fuzz_target;
 use misalign::reference::{self, normal, tangential};
 use misalign::{Scene, ThetaRelation};

@@ -1,5 +1,5 @@
-//! The estimator's logic, shared by `examples/estimate/main.rs`, the tests, the host
-//! benchmark and the fuzz target.
+//! The CSV estimator (`cargo run --example estimate`), shared by
+//! `examples/estimate/main.rs`, the tests, the host benchmark and the fuzz target.
 //!
 //! Arguments through clap; every output row is one typed [`OutRow`] (with `--solve`,
 //! a `solve::SolveRow`) written through csv's serde support, so that the header and
@@ -19,7 +19,6 @@ use misalign::{Error, Scene};
 use serde::Serialize;
 use std::io::{Read, Write};
 
-#[path = "solve.rs"]
 mod solve;
 
 const ABOUT: &str = "Misalignment, microslip and axial force for each row of a CSV file, \

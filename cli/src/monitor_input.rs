@@ -1,4 +1,5 @@
-//! The monitor example's input files: the scene and a recorded trace (CSV).
+//! The monitor example's input files (`cargo run --example monitor -- --scene ...
+//! --trace ...`): the scene and a recorded trace (CSV).
 
 use misalign::Scene;
 use misalign::monitor::Sample;
