@@ -37,6 +37,7 @@ pub mod kernels;
 pub mod monitor;
 pub mod reference;
 pub mod scene;
+mod sensor_fault;
 #[cfg(feature = "sensors")]
 pub mod sensors;
 #[cfg(feature = "sequential-storage")]

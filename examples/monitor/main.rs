@@ -250,7 +250,7 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         s.events_dropped
     );
     say!(
-        "faults {}: non-finite {}, out of range {}, stuck {}, gap {}, time backwards {}, driver {}, estimator {}",
+        "faults {}: non-finite {}, out of range {}, stuck {}, gap {}, time backwards {}, driver {}, estimator {}, sensors {}",
         f.total(),
         f.non_finite,
         f.out_of_range,
@@ -258,7 +258,8 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         f.gap,
         f.time_backwards,
         f.driver,
-        f.estimator
+        f.estimator,
+        f.sensors.iter().map(|&c| u64::from(c)).sum::<u64>()
     );
     say!(
         "max d/b {:.3}  max |F| {:.1} N  min margin {}",

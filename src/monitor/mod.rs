@@ -24,7 +24,11 @@
 //! switch per sample: not for a monitor.)
 //!
 //! **Sensor faults are never slip.** A faulted sample is not estimated; its
-//! candidate state is `SensorFault`, and leaving that state waits the off-delay.
+//! candidate state is `SensorFault`, and leaving that state waits the off-delay. A
+//! fault the sensors' own detection found ([`Sample::sensor_fault`]; with the
+//! `sensors` feature [`Sample::from_sensors`] carries it over) is counted per sensor
+//! and the state change names the sensor and the reason
+//! ([`FaultCause::Sensor`]).
 //!
 //! ```
 //! use misalign::monitor::{Config, Monitor, RiskState, Sample, model_for_range};
@@ -74,6 +78,9 @@ pub use state::{MonitorState, STATE_BUDGET_BYTES, Saved, Status};
 pub use stats::{FaultCounts, Statistics};
 pub use trend::{TrendInterval, TrendPoint, time_to_critical};
 pub use wear::{EnergySum, dissipated_power};
+// Which sensor failed and why, as the sensors report it (feature `sensors`) and as
+// the monitor's events name it (always).
+pub use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 
 use crate::Estimator;
 use sample::Step;
@@ -236,6 +243,7 @@ impl<E: Estimator> Monitor<E> {
         // Sensor checks, the first fault found wins.
         let speed = sample.speed.unwrap_or(config.nominal_speed);
         fault = fault
+            .or(sample.sensor_fault.map(FaultCause::Sensor))
             .or(sample.driver_fault.map(FaultCause::Driver))
             .or_else(|| check(sample.load, config.load_min, config.load_max, Channel::Load))
             .or_else(|| {

@@ -71,6 +71,7 @@ impl Status {
                     time_backwards: 0,
                     driver: 0,
                     estimator: 0,
+                    sensors: [0; 4],
                 },
                 events_dropped: 0,
                 time_in_state_ms: [0; 5],

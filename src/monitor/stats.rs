@@ -21,6 +21,10 @@ pub struct FaultCounts {
     pub driver: u32,
     /// Samples the estimator refused.
     pub estimator: u32,
+    /// Faults the sensors' own detection reported, per sensor (indexed by
+    /// [`SensorId::index`](crate::monitor::SensorId::index): load, probe 1, probe 2,
+    /// speed).
+    pub sensors: [u32; 4],
 }
 
 impl FaultCounts {
@@ -34,6 +38,7 @@ impl FaultCounts {
             FaultCause::TimeBackwards => &mut self.time_backwards,
             FaultCause::Driver(_) => &mut self.driver,
             FaultCause::Estimator => &mut self.estimator,
+            FaultCause::Sensor(s) => &mut self.sensors[s.sensor.index()],
         };
         *c = c.saturating_add(1);
     }
@@ -50,6 +55,7 @@ impl FaultCounts {
             self.estimator,
         ]
         .iter()
+        .chain(self.sensors.iter())
         .map(|&c| u64::from(c))
         .sum()
     }
