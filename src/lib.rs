@@ -46,7 +46,7 @@ pub mod storage;
 pub mod tables;
 
 pub use error::Error;
-pub use estimator::{Estimate, Estimator};
+pub use estimator::{Estimate, Estimator, FrictionInverse};
 
 /// The README's examples run as doctests.
 #[cfg(doctest)]

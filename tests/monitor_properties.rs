@@ -157,6 +157,9 @@ fn check<E: Estimator>(core: E, config: Config, samples: &[Sample]) -> Result<()
                 EventKind::Approaching { time_to_critical_s } => {
                     prop_assert!(time_to_critical_s >= 0.0)
                 }
+                EventKind::Friction { .. } => {
+                    prop_assert!(false, "no friction without process_with_friction")
+                }
             }
         }
         prop_assert_eq!(changed, before != after, "every change has its event");

@@ -102,6 +102,10 @@ fn event_line(e: &Event) -> String {
                 time_to_critical_s / 60.0
             )
         }
+        EventKind::Friction { mu, changed } => {
+            let what = if changed { "changed" } else { "back in band" };
+            format!("friction {what}: mu {mu:.3}")
+        }
     };
     format!(
         "{:>9.1} s  #{:<3} {what:<42} d/b {:.3}  F {:.1} N  P {:.0} N  phi {:.3} mrad  phi0 {} mrad  margin {} mrad",
@@ -133,6 +137,20 @@ fn event_row(e: &Event) -> String {
             String::new(),
             time_to_critical_s.to_string(),
         ),
+        // The filtered mu in the state column.
+        EventKind::Friction { mu, changed } => {
+            let kind = if changed {
+                "friction_changed"
+            } else {
+                "friction_cleared"
+            };
+            return format!(
+                "{},{},mu={mu},,{kind},,,,,,,,,{}",
+                e.elapsed_ms as f64 / 1e3,
+                e.seq,
+                e.time_ms
+            );
+        }
     };
     let r = &e.reading;
     format!(
@@ -259,7 +277,7 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         f.time_backwards,
         f.driver,
         f.estimator,
-        f.sensors.iter().map(|&c| u64::from(c)).sum::<u64>()
+        f.sensor
     );
     say!(
         "max d/b {:.3}  max |F| {:.1} N  min margin {}",

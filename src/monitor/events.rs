@@ -91,6 +91,15 @@ pub enum EventKind {
         /// Estimated time until gross slip at the current drift (s).
         time_to_critical_s: f32,
     },
+    /// The filtered friction coefficient left the band around its baseline
+    /// (`changed`), or came back within it (`!changed`): lubrication or contamination.
+    /// The baseline is [`Monitor::friction_baseline`](super::Monitor::friction_baseline).
+    Friction {
+        /// The filtered mu.
+        mu: f32,
+        /// Whether the change is raised (false: cleared).
+        changed: bool,
+    },
 }
 
 /// One event. Sequence numbers are consecutive from 0, so a consumer sees a dropped

@@ -21,10 +21,9 @@ pub struct FaultCounts {
     pub driver: u32,
     /// Samples the estimator refused.
     pub estimator: u32,
-    /// Faults the sensors' own detection reported, per sensor (indexed by
-    /// [`SensorId::index`](crate::monitor::SensorId::index): load, probe 1, probe 2,
-    /// speed).
-    pub sensors: [u32; 4],
+    /// Faults the sensors' own detection reported (the events name the sensor; the
+    /// sensors count their faults per kind themselves).
+    pub sensor: u32,
 }
 
 impl FaultCounts {
@@ -38,7 +37,7 @@ impl FaultCounts {
             FaultCause::TimeBackwards => &mut self.time_backwards,
             FaultCause::Driver(_) => &mut self.driver,
             FaultCause::Estimator => &mut self.estimator,
-            FaultCause::Sensor(s) => &mut self.sensors[s.sensor.index()],
+            FaultCause::Sensor(_) => &mut self.sensor,
         };
         *c = c.saturating_add(1);
     }
@@ -53,9 +52,9 @@ impl FaultCounts {
             self.time_backwards,
             self.driver,
             self.estimator,
+            self.sensor,
         ]
         .iter()
-        .chain(self.sensors.iter())
         .map(|&c| u64::from(c))
         .sum()
     }
