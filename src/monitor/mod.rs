@@ -63,6 +63,8 @@
 //! # Ok::<(), misalign::Error>(())
 //! ```
 
+#[cfg(feature = "sequential-storage")]
+mod checkpoint;
 mod condition;
 mod config;
 mod events;

@@ -120,7 +120,7 @@ impl<T: Copy, const N: usize> Saved<T, N> {
     }
 }
 
-const NO_EVENT: Event = Event {
+pub(crate) const NO_EVENT: Event = Event {
     seq: 0,
     time_ms: 0,
     elapsed_ms: 0,
