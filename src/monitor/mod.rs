@@ -26,7 +26,7 @@
 //! **Sensor faults are never slip.** A faulted sample is not estimated; its
 //! candidate state is `SensorFault`, and leaving that state waits the off-delay. A
 //! fault the sensors' own detection found ([`Sample::sensor_fault`]; with the
-//! `sensors` feature [`Sample::from_sensors`] carries it over) is counted and the
+//! `sensors` feature `Sample::from_sensors` carries it over) is counted and the
 //! state change names the sensor and the reason
 //! ([`FaultCause::Sensor`]).
 //!
