@@ -371,3 +371,34 @@ fn state_configuration_and_calibration_through_the_mock_flash() {
     assert_eq!(again.process(sample), m.process(sample));
     assert_eq!(again.snapshot(), m.snapshot());
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
+
+    /// A valid payload with up to 8 bytes overwritten, and any bytes at all: refused,
+    /// or a value that encodes to exactly those bytes; never a panic.
+    #[test]
+    fn any_payload_is_refused_or_canonical(
+        edits in proptest::collection::vec(
+            (0..MonitorState::SIZE, proptest::prelude::any::<u8>()),
+            1..8,
+        ),
+        garbage in proptest::collection::vec(proptest::prelude::any::<u8>(), MonitorState::SIZE),
+        config in proptest::collection::vec(proptest::prelude::any::<u8>(), Config::SIZE),
+    ) {
+        let fresh = Monitor::new(core(0.3), Config::default()).unwrap().snapshot();
+        let mut edited = payload(&fresh);
+        for (at, v) in edits {
+            edited[at] = v;
+        }
+        for bytes in [edited, garbage] {
+            if let Ok(state) = decode::<MonitorState>(&bytes) {
+                proptest::prop_assert_eq!(payload(&state), bytes);
+            }
+        }
+        if let Ok(c) = decode::<Config>(&config) {
+            proptest::prop_assert_eq!(payload(&c), config);
+            proptest::prop_assert!(c.validate().is_ok());
+        }
+    }
+}
