@@ -9,9 +9,8 @@ use misalign::monitor::{
 };
 use misalign::sensors::sim::{SimAdc, SimClock, SimDelay, SimDout, SimHx711, SimSck, TraceEncoder};
 use misalign::sensors::{
-    FaultKind, Hx711, Hx711Channel, LoadCalibration, LoadCell, Misalignment,
-    MisalignmentCalibration, ProbeCalibration, ProbeSpec, Rails, RawLimits, SensorFault, SensorId,
-    SensorSample, Timeout,
+    FaultKind, Hx711, Hx711Channel, LoadCalibration, LoadCell, Misalignment, Rails, RawLimits,
+    SensorFault, SensorId, SensorSample, Timeout,
 };
 use misalign::{Scene, float::Auto};
 
@@ -21,11 +20,9 @@ const PERIOD_NS: u64 = 100_000_000;
 const LOAD_N: f32 = 2000.0;
 const PHI_RAD: f32 = 1e-4;
 
-const PROBE: ProbeSpec = ProbeSpec {
-    min_m: 0.0,
-    max_m: 2e-3,
-    linearity_m: 4e-6,
-};
+#[path = "common/probes.rs"]
+mod probes;
+use probes::probe_calibration;
 
 type Cell<'c> = LoadCell<Hx711<SimDout<'c, 'c>, SimSck<'c, 'c>, SimDelay<'c>>>;
 
@@ -53,14 +50,7 @@ impl<'c> Node<'c> {
             RawLimits::new(Rails::signed_bits(24).unwrap()),
         )
         .unwrap();
-        let p1 = ProbeCalibration::two_point((800.0, 0.0), (20_800.0, 2e-3), PROBE).unwrap();
-        let p2 = ProbeCalibration::two_point((-400.0, 0.0), (15_600.0, 2e-3), PROBE).unwrap();
-        let cal = MisalignmentCalibration {
-            probe1: p1,
-            probe2: p2,
-            span_m: 0.4,
-            zero_offset_m: 0.0,
-        };
+        let cal = probe_calibration(0.0);
         let adc = SimAdc::new(Rails::signed_bits(16).unwrap(), [&[], &[]]);
         let limits = RawLimits::new(Rails::signed_bits(16).unwrap());
         let probes = Misalignment::new(adc, (0, 1), cal, limits).unwrap();

@@ -9,16 +9,16 @@ use misalign::monitor::{
     MonitorState, RiskState, SPIKE_WINDOW_CAPACITY, Sample, SensorFault, SensorId, TREND_CAPACITY,
     Thresholds, model_for_range,
 };
-use misalign::sensors::{
-    Hx711Channel, LoadCalibration, MisalignmentCalibration, ProbeCalibration, ProbeSpec,
-    SpeedCalibration,
-};
+use misalign::sensors::{Hx711Channel, LoadCalibration, SpeedCalibration};
 use misalign::storage::codec::{self, CodecError};
 use misalign::storage::{
     BlockingFlash, Checkpoint, MockFlash, Reader, RestoreOutcome, SensorCalibration, Store, Writer,
     block_on, kind,
 };
 use misalign::{Estimator, Scene, float::Auto};
+
+#[path = "common/probes.rs"]
+mod probes;
 
 fn core(mu: f64) -> Auto {
     let s = Scene::new(0.05, 0.05, 79.3e9, 0.3, mu).unwrap();
@@ -305,19 +305,9 @@ type Flash = MockFlash<4, 4096, 4>;
 const BUF: usize = Store::<BlockingFlash<Flash>, 1024>::buffer_len::<MonitorState>();
 
 fn sensor_calibration() -> SensorCalibration {
-    let spec = ProbeSpec {
-        min_m: 0.0,
-        max_m: 2e-3,
-        linearity_m: 4e-6,
-    };
     SensorCalibration {
         load: LoadCalibration::from_rated_output(Hx711Channel::A128, 2.0, 5000.0).unwrap(),
-        misalignment: MisalignmentCalibration {
-            probe1: ProbeCalibration::two_point((800.0, 0.0), (20_800.0, 2e-3), spec).unwrap(),
-            probe2: ProbeCalibration::two_point((-400.0, 0.0), (15_600.0, 2e-3), spec).unwrap(),
-            span_m: 0.4,
-            zero_offset_m: -30e-6,
-        },
+        misalignment: probes::probe_calibration(-30e-6),
         speed: Some(SpeedCalibration {
             pulses_per_rev: 60,
             radius_m: 0.05,
