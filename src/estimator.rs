@@ -118,3 +118,28 @@ pub(crate) fn check_risk(slip_ratio: f32) -> Result<f32, Error> {
         Err(Error::OutOfRange)
     }
 }
+
+/// The friction coefficient mu from a measured axial force, per sample: the inverse of
+/// eqs (16, 21) for the ellipse and (23, 27) for line contact (issue 11). Implemented by
+/// the f32 core's scenes ([`EllipticScene`](crate::float::EllipticScene),
+/// [`LineScene`](crate::float::LineScene), [`Auto`](crate::float::Auto)), which answer
+/// it from the forward path's tables; the fixed-point core has no inverse, so a
+/// condition monitor over it never tracks mu
+/// ([`Monitor::process_with_friction`](crate::monitor::Monitor::process_with_friction)
+/// needs this trait).
+pub trait FrictionInverse {
+    /// mu from load `load` (N; N/m for line contact without a length), misalignment
+    /// `phi` (rad, signed) and measured axial force `force` (N, like the load): exact
+    /// with its sensitivity `d ln mu / d ln F`, a lower bound where F has saturated
+    /// (gross slip, or the no-slip limit), or inconsistent with the reason.
+    ///
+    /// # Errors
+    /// The scene's input errors ([`Error::Load`], [`Error::Angle`],
+    /// [`Error::OutOfRange`]) and [`Error::Force`] for a NaN or infinite F.
+    fn friction_from_axial_force(
+        &self,
+        load: f32,
+        phi: f32,
+        force: f32,
+    ) -> Result<crate::reference::inverse::Inverse<f32>, Error>;
+}

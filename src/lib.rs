@@ -55,13 +55,14 @@ pub mod float;
 pub mod monitor;
 pub mod reference;
 pub mod scene;
+mod sensor_fault;
 #[cfg(feature = "sensors")]
 pub mod sensors;
 #[cfg(feature = "sequential-storage")]
 pub mod storage;
 
 pub use error::Error;
-pub use estimator::{Estimate, Estimator};
+pub use estimator::{Estimate, Estimator, FrictionInverse};
 
 /// The README's examples run as doctests.
 #[cfg(doctest)]

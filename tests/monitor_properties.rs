@@ -50,7 +50,7 @@ prop_compose! {
             t = t.wrapping_add(d);
             let channel = drivers[i].map(|c| [misalign::monitor::Channel::Load, misalign::monitor::Channel::Angle,
                 misalign::monitor::Channel::Speed, misalign::monitor::Channel::AxialForce][usize::from(c)]);
-            Sample { time_ms: t, load: loads[i], phi: phis[i], speed: speeds[i], axial_force: forces[i], driver_fault: channel }
+            Sample { time_ms: t, load: loads[i], phi: phis[i], speed: speeds[i], axial_force: forces[i], driver_fault: channel, sensor_fault: None }
         }).collect()
     }
 }
@@ -156,6 +156,9 @@ fn check<E: Estimator>(core: E, config: Config, samples: &[Sample]) -> Result<()
                 }
                 EventKind::Approaching { time_to_critical_s } => {
                     prop_assert!(time_to_critical_s >= 0.0)
+                }
+                EventKind::Friction { .. } => {
+                    prop_assert!(false, "no friction without process_with_friction")
                 }
             }
         }

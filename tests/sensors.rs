@@ -8,9 +8,8 @@ use embedded_hal_mock::eh1::digital::{Mock as PinMock, State, Transaction as Pin
 use misalign::sensors::sim::{SimAdc, SimClock, SimHx711};
 use misalign::sensors::{
     Adc, AdcError, CalibrationError, FaultKind, Hx711, Hx711Channel, LoadCalibration, LoadCell,
-    Misalignment, MisalignmentCalibration, ProbeCalibration, ProbeSpec, Rails, RawLimits,
-    STANDARD_GRAVITY, SensorFault, SensorId, SensorSample, SpeedCalibration, Tachometer, Timeout,
-    weight_newtons,
+    Misalignment, ProbeCalibration, Rails, RawLimits, STANDARD_GRAVITY, SensorFault, SensorId,
+    SensorSample, SpeedCalibration, Tachometer, Timeout, weight_newtons,
 };
 use proptest::prelude::*;
 
@@ -382,11 +381,9 @@ fn garbage_from_the_load_cell_ends_as_counted_faults() {
     assert_eq!(c.total(), c.stuck + c.saturated + c.jump + c.out_of_range);
 }
 
-const PROBE: ProbeSpec = ProbeSpec {
-    min_m: 0.0,
-    max_m: 2e-3,
-    linearity_m: 4e-6,
-};
+#[path = "common/probes.rs"]
+mod probes;
+use probes::{PROBE, probe_calibration};
 
 /// An ADS1115-like ADC with two probes; probe 1 reads 1e-7 m per count from 800 counts
 /// at 0 m, probe 2 1.25e-7 m per count from -400 counts.
@@ -398,16 +395,8 @@ fn probe2_counts(m: f32) -> i32 {
 }
 
 fn calibrated_probes<'a>(adc: SimAdc<'a, 2>) -> Misalignment<SimAdc<'a, 2>> {
-    let p1 = ProbeCalibration::two_point((800.0, 0.0), (20_800.0, 2e-3), PROBE).unwrap();
-    let p2 = ProbeCalibration::two_point((-400.0, 0.0), (15_600.0, 2e-3), PROBE).unwrap();
-    let cal = MisalignmentCalibration {
-        probe1: p1,
-        probe2: p2,
-        span_m: 0.4,
-        zero_offset_m: 0.0,
-    };
     let limits = RawLimits::new(Rails::signed_bits(16).unwrap());
-    Misalignment::new(adc, (0, 1), cal, limits).unwrap()
+    Misalignment::new(adc, (0, 1), probe_calibration(0.0), limits).unwrap()
 }
 
 fn noisy_at(counts: i32) -> Vec<i32> {

@@ -103,6 +103,10 @@ fn event_line(e: &Event) -> String {
                 time_to_critical_s / 60.0
             )
         }
+        EventKind::Friction { mu, changed } => {
+            let what = if changed { "changed" } else { "back in band" };
+            format!("friction {what}: mu {mu:.3}")
+        }
     };
     format!(
         "{:>9.1} s  #{:<3} {what:<42} d/b {:.3}  F {:.1} N  P {:.0} N  phi {:.3} mrad  phi0 {} mrad  margin {} mrad",
@@ -134,6 +138,20 @@ fn event_row(e: &Event) -> String {
             String::new(),
             time_to_critical_s.to_string(),
         ),
+        // The filtered mu in the state column.
+        EventKind::Friction { mu, changed } => {
+            let kind = if changed {
+                "friction_changed"
+            } else {
+                "friction_cleared"
+            };
+            return format!(
+                "{},{},mu={mu},,{kind},,,,,,,,,{}",
+                e.elapsed_ms as f64 / 1e3,
+                e.seq,
+                e.time_ms
+            );
+        }
     };
     let r = &e.reading;
     format!(
@@ -157,8 +175,13 @@ struct Replay<E> {
     points: Vec<Point>,
 }
 
+/// How a monitor takes a sample: `Monitor::process_with_friction` on the f32 core
+/// (mu from a measured F), `Monitor::process` on the fixed-point core (no inverse).
+type Step<E> = fn(&mut Monitor<E>, Sample) -> RiskState;
+
 fn replay<E: Estimator>(
     mut monitor: Monitor<E>,
+    step: Step<E>,
     samples: impl Iterator<Item = Sample>,
     total: usize,
 ) -> Replay<E> {
@@ -168,7 +191,7 @@ fn replay<E: Estimator>(
     let mut last_percent = usize::MAX;
     let mut last_reading = None;
     for (i, sample) in samples.enumerate() {
-        let state = monitor.process(sample);
+        let state = step(&mut monitor, sample);
         while let Some(e) = monitor.pop_event() {
             say!("{}", event_line(&e));
             events.push(e);
@@ -251,7 +274,7 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         s.events_dropped
     );
     say!(
-        "faults {}: non-finite {}, out of range {}, stuck {}, gap {}, time backwards {}, driver {}, estimator {}",
+        "faults {}: non-finite {}, out of range {}, stuck {}, gap {}, time backwards {}, driver {}, estimator {}, sensors {}",
         f.total(),
         f.non_finite,
         f.out_of_range,
@@ -259,7 +282,8 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         f.gap,
         f.time_backwards,
         f.driver,
-        f.estimator
+        f.estimator,
+        f.sensor
     );
     say!(
         "max d/b {:.3}  max |F| {:.1} N  min margin {}",
@@ -268,6 +292,18 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         s.min_margin
             .map_or("-".into(), |m| format!("{:.3} mrad", m * 1e3))
     );
+    // Only with a measured F on the f32 core.
+    if let Some(mu) = m.friction() {
+        let fs = m.friction_status();
+        say!(
+            "friction mu {mu:.4}  baseline {}  {} estimates used, {} ill-posed{}",
+            m.friction_baseline()
+                .map_or("- (not captured yet)".into(), |b| format!("{b:.4}")),
+            fs.accepted,
+            fs.rejected,
+            if fs.changed { "  CHANGED" } else { "" }
+        );
+    }
     say!(
         "final state {}  time to critical {}",
         m.state().as_str(),
@@ -340,7 +376,13 @@ fn thresholds<E: Estimator>(core: &E, config: &Config, load_max: f32) -> Vec<Thr
         .collect()
 }
 
-fn run<E: Estimator>(core: E, args: &Args, samples: Vec<Sample>, builtin: bool) -> Res<()> {
+fn run<E: Estimator>(
+    core: E,
+    step: Step<E>,
+    args: &Args,
+    samples: Vec<Sample>,
+    builtin: bool,
+) -> Res<()> {
     let config = Config::default();
     let total = samples.len();
     let table = args.thresholds.as_ref().map(|_| {
@@ -366,7 +408,7 @@ fn run<E: Estimator>(core: E, args: &Args, samples: Vec<Sample>, builtin: bool) 
         );
     }
     say!("{:>9}    {:<4} {:<42}", "t", "seq", "event");
-    let r = replay(monitor, samples.into_iter(), total);
+    let r = replay(monitor, step, samples.into_iter(), total);
     summary(&r.monitor);
     if let Some(path) = &args.events {
         let mut out = String::from(
@@ -439,7 +481,13 @@ fn main() -> std::process::ExitCode {
         // One model for the trace's operating range (section 9, decided once).
         let choice = model_for_range(&scene, load_max, scenario::ANGLE_MIN)?;
         match args.model {
-            Model::F32 => run(Auto::with_choice(&scene, choice)?, &args, samples, builtin),
+            Model::F32 => run(
+                Auto::with_choice(&scene, choice)?,
+                Monitor::process_with_friction,
+                &args,
+                samples,
+                builtin,
+            ),
             Model::Fixed => {
                 // 10 mN per count; the finest angle LSB the tables allow, at least 0.1 nrad.
                 let angle_lsb = match choice {
@@ -447,7 +495,7 @@ fn main() -> std::process::ExitCode {
                     _ => 1e-10,
                 };
                 let core = FixedAuto::with_choice(&scene, 1e-2, angle_lsb, choice)?;
-                run(core, &args, samples, builtin)
+                run(core, Monitor::process, &args, samples, builtin)
             }
         }
     })();

@@ -72,7 +72,9 @@ pub fn timeline(path: &Path, points: &[Point], events: &[Event]) -> Res<()> {
             let t = e.elapsed_ms as f64 / 3.6e6;
             let style = match e.kind {
                 EventKind::StateChange { .. } => GREY.stroke_width(1),
-                EventKind::Approaching { .. } => VERMILION.stroke_width(2),
+                EventKind::Approaching { .. } | EventKind::Friction { .. } => {
+                    VERMILION.stroke_width(2)
+                }
             };
             chart.draw_series(std::iter::once(PathElement::new(
                 vec![(t, lo - pad), (t, hi + pad)],

@@ -381,3 +381,21 @@ impl Auto {
         )
     }
 }
+
+/// The inverses above through the trait a condition monitor is generic over (each
+/// call resolves to the scene's own method).
+macro_rules! friction_inverse {
+    ($($scene:ty),*) => {$(
+        impl crate::FrictionInverse for $scene {
+            fn friction_from_axial_force(
+                &self,
+                load: f32,
+                phi: f32,
+                force: f32,
+            ) -> Result<Inverse<f32>, Error> {
+                <$scene>::friction_from_axial_force(self, load, phi, force)
+            }
+        }
+    )*};
+}
+friction_inverse!(EllipticScene<'_>, LineScene, Auto);

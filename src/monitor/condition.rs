@@ -9,7 +9,8 @@ use heapless::{Deque, Vec};
 #[derive(Debug, Clone)]
 pub(crate) struct Window {
     fifo: Deque<f32, SPIKE_WINDOW_CAPACITY>,
-    sorted: Vec<f32, SPIKE_WINDOW_CAPACITY>,
+    // A u8 length: the window holds at most 7 (RAM budget of the live monitor).
+    sorted: Vec<f32, SPIKE_WINDOW_CAPACITY, u8>,
 }
 
 impl Window {

@@ -1,5 +1,6 @@
 //! The monitor's configuration: one value, validated when the monitor is built.
 
+use super::friction::FrictionConfig;
 use core::fmt;
 
 /// Capacity of the spike filter's window (samples).
@@ -111,6 +112,10 @@ pub struct Config {
     pub gap_ms: u32,
     /// Time to critical; `None`: off.
     pub trend: Option<TrendConfig>,
+    /// Friction tracking from a measured axial force (f32 scenes, through
+    /// [`Monitor::process_with_friction`](super::Monitor::process_with_friction));
+    /// `None`: off.
+    pub friction: Option<FrictionConfig>,
 }
 
 impl Default for Config {
@@ -147,6 +152,7 @@ impl Default for Config {
                 points: 16,
                 horizon_s: 3_600.0,
             }),
+            friction: Some(FrictionConfig::default()),
         }
     }
 }
@@ -178,6 +184,10 @@ pub enum ConfigError {
     /// The trend has a zero interval, points outside 3..=[`TREND_CAPACITY`], or a
     /// horizon that is not positive and finite.
     Trend,
+    /// Friction tracking with a sensitivity cap, time constant or band that is not
+    /// positive and finite, a deadband outside `0..band`, or a baseline after no
+    /// estimate.
+    Friction,
 }
 
 impl fmt::Display for ConfigError {
@@ -192,6 +202,9 @@ impl fmt::Display for ConfigError {
             ConfigError::SpikeWindow => "spike window must be 3..=7 with k, floors > 0",
             ConfigError::Smoothing => "smoothing time constant must be finite and >= 0",
             ConfigError::Trend => "trend needs interval > 0, 3..=16 points, horizon > 0",
+            ConfigError::Friction => {
+                "friction needs sensitivity cap, tau, band > 0, 0 <= deadband < band, >= 1 estimate"
+            }
         })
     }
 }
@@ -270,6 +283,9 @@ impl Config {
             if !(t.interval_ms > 0 && points_ok && positive(t.horizon_s)) {
                 return Err(ConfigError::Trend);
             }
+        }
+        if self.friction.is_some_and(|f| !f.is_valid()) {
+            return Err(ConfigError::Friction);
         }
         Ok(())
     }

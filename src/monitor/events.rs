@@ -2,6 +2,8 @@
 //! fixed-capacity queue that drops the oldest when full and counts what it dropped.
 
 use super::risk::RiskState;
+use crate::sensor_fault::SensorFault;
+use core::fmt;
 use heapless::Deque;
 
 /// Capacity of the event queue.
@@ -25,6 +27,31 @@ pub enum FaultCause {
     Driver(super::Channel),
     /// The estimator refused the sample (outside the prepared scene's range).
     Estimator,
+    /// A sensor's own fault detection refused its reading: the sensor (load cell,
+    /// probe 1 or 2, tachometer) and the reason (disconnected, bus error, saturated,
+    /// stuck, a jump, out of the calibrated range). Never a slip alarm.
+    Sensor(SensorFault),
+}
+
+impl fmt::Display for FaultCause {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let channel = |c: &super::Channel| match c {
+            super::Channel::Load => "load",
+            super::Channel::Angle => "angle",
+            super::Channel::Speed => "speed",
+            super::Channel::AxialForce => "axial force",
+        };
+        match self {
+            FaultCause::NonFinite(c) => write!(f, "{}: not finite", channel(c)),
+            FaultCause::OutOfRange(c) => write!(f, "{}: out of the accepted range", channel(c)),
+            FaultCause::Stuck(c) => write!(f, "{}: stuck", channel(c)),
+            FaultCause::Gap => f.write_str("gap: no sample for too long"),
+            FaultCause::TimeBackwards => f.write_str("timestamp went backwards"),
+            FaultCause::Driver(c) => write!(f, "{}: the driver reported a fault", channel(c)),
+            FaultCause::Estimator => f.write_str("the estimator refused the sample"),
+            FaultCause::Sensor(s) => write!(f, "{s}"),
+        }
+    }
 }
 
 /// The values behind an event: the last valid estimate (for a `SensorFault` event,
@@ -63,6 +90,15 @@ pub enum EventKind {
     Approaching {
         /// Estimated time until gross slip at the current drift (s).
         time_to_critical_s: f32,
+    },
+    /// The filtered friction coefficient left the band around its baseline
+    /// (`changed`), or came back within it (`!changed`): lubrication or contamination.
+    /// The baseline is [`Monitor::friction_baseline`](super::Monitor::friction_baseline).
+    Friction {
+        /// The filtered mu.
+        mu: f32,
+        /// Whether the change is raised (false: cleared).
+        changed: bool,
     },
 }
 

@@ -24,7 +24,21 @@
 //! switch per sample: not for a monitor.)
 //!
 //! **Sensor faults are never slip.** A faulted sample is not estimated; its
-//! candidate state is `SensorFault`, and leaving that state waits the off-delay.
+//! candidate state is `SensorFault`, and leaving that state waits the off-delay. A
+//! fault the sensors' own detection found ([`Sample::sensor_fault`]; with the
+//! `sensors` feature `Sample::from_sensors` carries it over) is counted and the
+//! state change names the sensor and the reason
+//! ([`FaultCause::Sensor`]).
+//!
+//! **Friction from a measured axial force (issue 11).** With an f32 scene (which
+//! implements [`FrictionInverse`]) and samples carrying a measured F,
+//! [`Monitor::process_with_friction`] also tracks mu: the inverse of eqs (16, 21) or
+//! (23, 27) at the conditioned load and angle, only where it is well-posed (exact, its
+//! sensitivity at most [`FrictionConfig::sensitivity_max`]), filtered over the time
+//! step, against a baseline captured at commissioning (or on demand,
+//! [`Monitor::capture_friction_baseline`]); an [`EventKind::Friction`] when it leaves
+//! the band, with deadband and delay. The fixed-point core has no inverse: its monitor
+//! has only [`Monitor::process`] and never tracks mu.
 //!
 //! ```
 //! use misalign::monitor::{Config, Monitor, RiskState, Sample, model_for_range};
@@ -49,9 +63,12 @@
 //! # Ok::<(), misalign::Error>(())
 //! ```
 
+#[cfg(feature = "sequential-storage")]
+mod checkpoint;
 mod condition;
 mod config;
 mod events;
+mod friction;
 mod model;
 mod risk;
 mod sample;
@@ -67,6 +84,7 @@ pub use config::{
     TrendConfig,
 };
 pub use events::{EVENT_CAPACITY, Event, EventKind, FaultCause, Reading};
+pub use friction::{FrictionConfig, FrictionStatus};
 pub use model::model_for_range;
 pub use risk::{Alarm, RiskState};
 pub use sample::{Channel, Clock, Sample};
@@ -74,9 +92,21 @@ pub use state::{MonitorState, STATE_BUDGET_BYTES, Saved, Status};
 pub use stats::{FaultCounts, Statistics};
 pub use trend::{TrendInterval, TrendPoint, time_to_critical};
 pub use wear::{EnergySum, dissipated_power};
+// Which sensor failed and why, as the sensors report it (feature `sensors`) and as
+// the monitor's events name it (always).
+pub use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 
-use crate::Estimator;
+use crate::{Estimator, FrictionInverse};
 use sample::Step;
+
+/// A sample that was estimated: its conditioned load (N) and angle (rad) and its time
+/// step (ms), for the friction inverse.
+#[derive(Clone, Copy)]
+struct Estimated {
+    load: f32,
+    phi: f32,
+    dt_ms: u32,
+}
 
 /// The condition monitor over one prepared scene of either core.
 #[derive(Debug, Clone)]
@@ -203,10 +233,53 @@ impl<E: Estimator> Monitor<E> {
         self.status.smoothed = None;
     }
 
+    /// The filtered friction coefficient mu, `None` before the first well-posed
+    /// estimate (always, over the fixed-point core: see
+    /// [`process_with_friction`](Self::process_with_friction)).
+    pub fn friction(&self) -> Option<f32> {
+        self.status.friction.filtered()
+    }
+
+    /// The friction baseline captured at commissioning, if any.
+    pub fn friction_baseline(&self) -> Option<f32> {
+        self.status.friction.baseline()
+    }
+
+    /// The friction tracker's whole state (counts of accepted and rejected estimates,
+    /// whether a change is raised).
+    pub fn friction_status(&self) -> &FrictionStatus {
+        &self.status.friction
+    }
+
+    /// Takes the filtered mu as the friction baseline now (commissioning on demand,
+    /// e.g. after a change of lubricant); a raised friction change is cleared, with its
+    /// event. Returns the baseline, `None` (nothing changes) before the first
+    /// well-posed estimate.
+    pub fn capture_friction_baseline(&mut self) -> Option<f32> {
+        let (baseline, cleared) = self.status.friction.capture()?;
+        if cleared {
+            let time_ms = self.status.clock.last_time_ms.unwrap_or(0);
+            self.emit(
+                EventKind::Friction {
+                    mu: baseline,
+                    changed: false,
+                },
+                time_ms,
+            );
+        }
+        Some(baseline)
+    }
+
     /// Processes one sample and returns the state after it. Never panics; whatever
     /// the input, bad values are counted as faults and reported as `SensorFault`,
-    /// never as slip.
+    /// never as slip. A measured axial force is checked and used in the wear integral;
+    /// mu is tracked from it only by [`process_with_friction`](Self::process_with_friction).
     pub fn process(&mut self, sample: Sample) -> RiskState {
+        self.step(sample).0
+    }
+
+    /// [`process`](Self::process), and the sample that was estimated, if it was.
+    fn step(&mut self, sample: Sample) -> (RiskState, Option<Estimated>) {
         let config = self.config;
         let st = &mut self.status;
         st.stats.samples = st.stats.samples.saturating_add(1);
@@ -218,7 +291,7 @@ impl<E: Estimator> Monitor<E> {
             Step::Repeated => {
                 let r = &mut st.stats.repeated_timestamps;
                 *r = r.saturating_add(1);
-                return held;
+                return (held, None);
             }
             Step::Backwards => {
                 fault = Some(FaultCause::TimeBackwards);
@@ -236,6 +309,7 @@ impl<E: Estimator> Monitor<E> {
         // Sensor checks, the first fault found wins.
         let speed = sample.speed.unwrap_or(config.nominal_speed);
         fault = fault
+            .or(sample.sensor_fault.map(FaultCause::Sensor))
             .or(sample.driver_fault.map(FaultCause::Driver))
             .or_else(|| check(sample.load, config.load_min, config.load_max, Channel::Load))
             .or_else(|| {
@@ -261,13 +335,21 @@ impl<E: Estimator> Monitor<E> {
                 fault = Some(FaultCause::Stuck(Channel::Angle));
             }
         }
+        let mut estimated = None;
         let candidate = match fault {
             Some(_) => RiskState::SensorFault,
             None if !running => RiskState::Stopped,
             None => {
                 st.alarm.note_running(now);
                 match self.estimate(sample, dt_ms, held, now) {
-                    Ok(c) => c,
+                    Ok(c) => {
+                        estimated = self.status.reading.map(|r| Estimated {
+                            load: r.load,
+                            phi: r.phi,
+                            dt_ms,
+                        });
+                        c
+                    }
                     Err(f) => {
                         fault = Some(f);
                         RiskState::SensorFault
@@ -305,7 +387,7 @@ impl<E: Estimator> Monitor<E> {
             );
         }
         self.approaching(sample.time_ms);
-        self.status.alarm.state
+        (self.status.alarm.state, estimated)
     }
 
     /// Conditioning, estimate, wear and trend of a valid running sample; the slip
@@ -437,5 +519,44 @@ impl<E: Estimator> Monitor<E> {
             Some(t) if t < 1.5 * tc.horizon_s => {}
             _ => st.approaching_armed = true,
         }
+    }
+}
+
+impl<E: Estimator + FrictionInverse> Monitor<E> {
+    /// [`process`](Self::process), and with a measured axial force F on a sample that
+    /// was estimated, the friction coefficient mu from it (issue 11 item 4): the
+    /// inverse of eqs (16, 21) or (23, 27) at the conditioned load and angle
+    /// ([`FrictionInverse`], the f32 scenes only). Only a well-posed answer counts (an
+    /// exact mu with its sensitivity at most the configured cap; never a lower bound,
+    /// as in gross slip where F = mu P only bounds it, nor an inconsistent one); it is
+    /// filtered with the weight of its time step, the baseline is captured once the
+    /// machine has run and enough estimates were accepted
+    /// ([`FrictionConfig`]), and a [`EventKind::Friction`] event is raised when the
+    /// filtered mu leaves the band around it for the delay, and cleared when it comes
+    /// back inside the band less the deadband for the delay.
+    ///
+    /// A monitor over the fixed-point core (no inverse) has only `process` and never
+    /// tracks mu.
+    pub fn process_with_friction(&mut self, sample: Sample) -> RiskState {
+        let (state, estimated) = self.step(sample);
+        let (Some(config), Some(force), Some(at)) =
+            (self.config.friction, sample.axial_force, estimated)
+        else {
+            return state;
+        };
+        let answer = self
+            .estimator
+            .friction_from_axial_force(at.load, at.phi, force)
+            .ok();
+        let st = &mut self.status;
+        let running_ms = st
+            .alarm
+            .started_ms
+            .map_or(0, |s| st.clock.elapsed_ms.saturating_sub(s));
+        if let Some(changed) = st.friction.offer(&config, answer, at.dt_ms, running_ms) {
+            let mu = st.friction.mu;
+            self.emit(EventKind::Friction { mu, changed }, sample.time_ms);
+        }
+        state
     }
 }

@@ -1,5 +1,7 @@
 //! One sample of the roller pair and the node's free-running millisecond clock.
 
+use crate::sensor_fault::SensorFault;
+
 /// A measured channel, named in sensor faults.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -33,6 +35,9 @@ pub struct Sample {
     /// A fault a sensor driver reported for this sample, naming the channel: the
     /// sample counts as a sensor fault whatever its values.
     pub driver_fault: Option<Channel>,
+    /// A fault a sensor's own detection found (which sensor, what kind): the sample
+    /// counts as a sensor fault naming that sensor, whatever its values.
+    pub sensor_fault: Option<SensorFault>,
 }
 
 impl Sample {
@@ -45,7 +50,31 @@ impl Sample {
             speed: None,
             axial_force: None,
             driver_fault: None,
+            sensor_fault: None,
         }
+    }
+
+    /// The sample the sensors gave (feature `sensors`), stamped `time_ms`: load P (N),
+    /// misalignment phi (rad), the measured speed V (m/s) if any, and the sensors'
+    /// first fault, which makes the sample a sensor fault naming the sensor (its
+    /// faulty quantity holds 0 and is never estimated).
+    #[cfg(feature = "sensors")]
+    pub const fn from_sensors(time_ms: u32, sensors: &crate::sensors::SensorSample) -> Self {
+        Sample {
+            time_ms,
+            load: sensors.load_n,
+            phi: sensors.phi_rad,
+            speed: sensors.speed_m_s,
+            axial_force: None,
+            driver_fault: None,
+            sensor_fault: sensors.fault,
+        }
+    }
+
+    /// The same sample with a sensor's fault: a sensor fault naming the sensor.
+    pub const fn with_sensor_fault(mut self, fault: SensorFault) -> Self {
+        self.sensor_fault = Some(fault);
+        self
     }
 
     /// The same sample with a measured rolling speed (m/s).

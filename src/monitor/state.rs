@@ -3,6 +3,7 @@
 
 use super::config::{Config, ConfigError, SPIKE_WINDOW_CAPACITY, TREND_CAPACITY};
 use super::events::{EVENT_CAPACITY, Event, EventKind, Reading};
+use super::friction::FrictionStatus;
 use super::{
     Alarm, Clock, Monitor, RiskState, Statistics, StuckTracker, TrendInterval, TrendPoint,
 };
@@ -34,6 +35,8 @@ pub struct Status {
     pub energy_step: f32,
     /// Counters, extremes, time and energy per state.
     pub stats: Statistics,
+    /// Friction tracking: the filtered mu, its baseline, the change state.
+    pub friction: FrictionStatus,
 }
 
 impl Status {
@@ -71,6 +74,7 @@ impl Status {
                     time_backwards: 0,
                     driver: 0,
                     estimator: 0,
+                    sensor: 0,
                 },
                 events_dropped: 0,
                 time_in_state_ms: [0; 5],
@@ -82,6 +86,7 @@ impl Status {
                 max_axial_force: 0.0,
                 min_margin: None,
             },
+            friction: FrictionStatus::new(),
         }
     }
 }
@@ -115,7 +120,7 @@ impl<T: Copy, const N: usize> Saved<T, N> {
     }
 }
 
-const NO_EVENT: Event = Event {
+pub(crate) const NO_EVENT: Event = Event {
     seq: 0,
     time_ms: 0,
     elapsed_ms: 0,

@@ -21,6 +21,9 @@ pub struct FaultCounts {
     pub driver: u32,
     /// Samples the estimator refused.
     pub estimator: u32,
+    /// Faults the sensors' own detection reported (the events name the sensor; the
+    /// sensors count their faults per kind themselves).
+    pub sensor: u32,
 }
 
 impl FaultCounts {
@@ -34,6 +37,7 @@ impl FaultCounts {
             FaultCause::TimeBackwards => &mut self.time_backwards,
             FaultCause::Driver(_) => &mut self.driver,
             FaultCause::Estimator => &mut self.estimator,
+            FaultCause::Sensor(_) => &mut self.sensor,
         };
         *c = c.saturating_add(1);
     }
@@ -48,6 +52,7 @@ impl FaultCounts {
             self.time_backwards,
             self.driver,
             self.estimator,
+            self.sensor,
         ]
         .iter()
         .map(|&c| u64::from(c))

@@ -41,9 +41,9 @@
 //!
 //! Each sector is erased once every `k * s` checkpoints (`k` checkpoints per sector,
 //! `s` sectors; the arithmetic is in [`wear`]). For the [`wear::REFERENCE`] geometry
-//! (an 896-byte payload, about the monitor's whole state; eight 4 KiB sectors; 4-byte
-//! words: 4 checkpoints per sector) at the default interval of one hour
-//! ([`wear::DEFAULT_INTERVAL_S`]):
+//! (a 792-byte payload, the monitor's whole state, `MonitorState`, version 1; eight
+//! 4 KiB sectors; 4-byte words: 4 checkpoints per sector) at the default interval of
+//! one hour ([`wear::DEFAULT_INTERVAL_S`]):
 //!
 //! | interval | checkpoints a year | erase cycles per sector a year | years to 10 000 cycles |
 //! | --- | --- | --- | --- |

@@ -46,12 +46,13 @@ pub struct Geometry {
     pub word: usize,
 }
 
-/// The geometry of the figures in the docs: a 896-byte payload (the condition
-/// monitor's whole state, events and trend included, encodes to some 850 bytes) in
+/// The geometry of the figures in the docs: a 792-byte payload (the condition
+/// monitor's whole state, events and trend included: `MonitorState`'s
+/// `Checkpoint::SIZE`, version 1, held equal by `tests/monitor_storage.rs`) in
 /// eight 4 KiB sectors (a 32 KiB region) of 4-byte words. Recompute with your type's
 /// [`Checkpoint::SIZE`](super::Checkpoint::SIZE) and your region.
 pub const REFERENCE: Geometry = Geometry {
-    payload: 896,
+    payload: 792,
     sector: 4096,
     sectors: 8,
     word: 4,

@@ -1,0 +1,673 @@
+//! The monitor's state and configuration as stored checkpoints (feature
+//! `sequential-storage`, issue 13): [`MonitorState`] under
+//! [`kind::MONITOR_STATE`] and [`Config`] under [`kind::MONITOR_CONFIG`], field by
+//! field, little-endian, in a fixed order and size.
+//!
+//! Decoding refuses ([`CodecError::InvalidValue`]) whatever no monitor can hold: an
+//! unknown state, channel, sensor, fault or event code, a flag byte other than 0 or 1,
+//! a buffer length above its capacity, the bytes of an absent value or of padding
+//! other than zero, a NaN or infinite value where the monitor keeps finite ones, and a
+//! configuration that fails [`Config::validate`]. So a restored state is one the
+//! monitor could have reached, never a wrong value.
+
+use super::config::{SPIKE_WINDOW_CAPACITY, TREND_CAPACITY};
+use super::events::EVENT_CAPACITY;
+use super::{
+    Alarm, Channel, Clock, Config, EnergySum, Event, EventKind, FaultCause, FaultCounts,
+    FrictionConfig, FrictionStatus, MonitorState, Reading, RiskState, Saved, SpikeFilter,
+    Statistics, Status, StuckTracker, Thresholds, TrendConfig, TrendInterval, TrendPoint,
+};
+use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
+use crate::storage::{Checkpoint, CodecError, Reader, Writer, kind};
+
+const INVALID: CodecError = CodecError::InvalidValue;
+
+/// `Ok(x)` if `ok`, else [`CodecError::InvalidValue`].
+fn require<T>(ok: bool, x: T) -> Result<T, CodecError> {
+    if ok { Ok(x) } else { Err(INVALID) }
+}
+
+/// A finite f32.
+fn finite(r: &mut Reader<'_>) -> Result<f32, CodecError> {
+    let x = r.f32()?;
+    require(x.is_finite(), x)
+}
+
+/// An f32 that is not NaN and not negative (a slip ratio: +inf at P = 0, eq 16).
+fn ratio(r: &mut Reader<'_>) -> Result<f32, CodecError> {
+    let x = r.f32()?;
+    require(x >= 0.0, x)
+}
+
+/// An optional value: a flag byte, then the value's bytes (zeros when absent).
+fn put_option<T: Copy>(
+    w: &mut Writer<'_>,
+    x: Option<T>,
+    absent: T,
+    put: impl Fn(&mut Writer<'_>, T) -> Result<(), CodecError>,
+) -> Result<(), CodecError> {
+    w.bool(x.is_some())?;
+    put(w, x.unwrap_or(absent))
+}
+
+/// Reads what [`put_option`] wrote; an absent value's bytes must be zeros.
+fn get_option<T, const N: usize>(
+    r: &mut Reader<'_>,
+    get: impl Fn(&mut Reader<'_>) -> Result<T, CodecError>,
+) -> Result<Option<T>, CodecError> {
+    if r.bool()? {
+        get(r).map(Some)
+    } else {
+        let bytes: [u8; N] = r.array()?;
+        require(bytes == [0; N], None)
+    }
+}
+
+fn put_opt_f32(w: &mut Writer<'_>, x: Option<f32>) -> Result<(), CodecError> {
+    put_option(w, x, 0.0, |w, x| w.f32(x))
+}
+
+fn get_opt_finite(r: &mut Reader<'_>) -> Result<Option<f32>, CodecError> {
+    get_option::<_, 4>(r, finite)
+}
+
+fn put_opt_u64(w: &mut Writer<'_>, x: Option<u64>) -> Result<(), CodecError> {
+    put_option(w, x, 0, |w, x| w.u64(x))
+}
+
+fn get_opt_u64(r: &mut Reader<'_>) -> Result<Option<u64>, CodecError> {
+    get_option::<_, 8>(r, |r| r.u64())
+}
+
+/// Zero padding of `n` bytes, refused when not zero.
+fn put_zeros(w: &mut Writer<'_>, n: usize) -> Result<(), CodecError> {
+    (0..n).try_for_each(|_| w.u8(0))
+}
+
+fn get_zeros(r: &mut Reader<'_>, n: usize) -> Result<(), CodecError> {
+    (0..n).try_for_each(|_| require(r.u8()? == 0, ()))
+}
+
+/// A code from `all`, by its position.
+fn code_of<T: Copy + PartialEq>(all: &[T], x: T) -> u8 {
+    all.iter().position(|&a| a == x).unwrap_or(0) as u8
+}
+
+fn from_code<T: Copy>(all: &[T], code: u8) -> Result<T, CodecError> {
+    all.get(usize::from(code)).copied().ok_or(INVALID)
+}
+
+const CHANNELS: [Channel; 4] = [
+    Channel::Load,
+    Channel::Angle,
+    Channel::Speed,
+    Channel::AxialForce,
+];
+
+fn put_state(w: &mut Writer<'_>, s: RiskState) -> Result<(), CodecError> {
+    w.u8(code_of(&RiskState::ALL, s))
+}
+
+fn get_state(r: &mut Reader<'_>) -> Result<RiskState, CodecError> {
+    from_code(&RiskState::ALL, r.u8()?)
+}
+
+/// A fault cause: a tag and two bytes (the channel, or the sensor and the kind).
+const FAULT_SIZE: usize = 3;
+
+fn put_fault(w: &mut Writer<'_>, f: FaultCause) -> Result<(), CodecError> {
+    let ch = |c| code_of(&CHANNELS, c);
+    let (tag, a, b) = match f {
+        FaultCause::NonFinite(c) => (0, ch(c), 0),
+        FaultCause::OutOfRange(c) => (1, ch(c), 0),
+        FaultCause::Stuck(c) => (2, ch(c), 0),
+        FaultCause::Gap => (3, 0, 0),
+        FaultCause::TimeBackwards => (4, 0, 0),
+        FaultCause::Driver(c) => (5, ch(c), 0),
+        FaultCause::Estimator => (6, 0, 0),
+        FaultCause::Sensor(s) => (
+            7,
+            code_of(&SensorId::ALL, s.sensor),
+            code_of(&FaultKind::ALL, s.kind),
+        ),
+    };
+    w.u8(tag)?;
+    w.u8(a)?;
+    w.u8(b)
+}
+
+fn get_fault(r: &mut Reader<'_>) -> Result<FaultCause, CodecError> {
+    let (tag, a, b) = (r.u8()?, r.u8()?, r.u8()?);
+    let ch = || from_code(&CHANNELS, a);
+    // Bytes a variant does not use are zero.
+    let unused = |used_a: bool| require(b == 0 && (used_a || a == 0), ());
+    Ok(match tag {
+        0 => unused(true).and(ch().map(FaultCause::NonFinite))?,
+        1 => unused(true).and(ch().map(FaultCause::OutOfRange))?,
+        2 => unused(true).and(ch().map(FaultCause::Stuck))?,
+        3 => unused(false).map(|()| FaultCause::Gap)?,
+        4 => unused(false).map(|()| FaultCause::TimeBackwards)?,
+        5 => unused(true).and(ch().map(FaultCause::Driver))?,
+        6 => unused(false).map(|()| FaultCause::Estimator)?,
+        7 => FaultCause::Sensor(SensorFault {
+            sensor: from_code(&SensorId::ALL, a)?,
+            kind: from_code(&FaultKind::ALL, b)?,
+        }),
+        _ => return Err(INVALID),
+    })
+}
+
+const READING_SIZE: usize = 4 * 4 + 2 * 5;
+
+fn put_reading(w: &mut Writer<'_>, r: &Reading) -> Result<(), CodecError> {
+    w.f32(r.load)?;
+    w.f32(r.phi)?;
+    w.f32(r.slip_ratio)?;
+    w.f32(r.axial_force)?;
+    put_opt_f32(w, r.critical_angle)?;
+    put_opt_f32(w, r.margin)
+}
+
+fn get_reading(r: &mut Reader<'_>) -> Result<Reading, CodecError> {
+    Ok(Reading {
+        load: finite(r)?,
+        phi: finite(r)?,
+        slip_ratio: ratio(r)?,
+        axial_force: finite(r)?,
+        critical_angle: get_opt_finite(r)?,
+        margin: get_opt_finite(r)?,
+    })
+}
+
+/// An event's kind: a tag and 8 bytes whatever the variant (zeros where unused).
+const KIND_SIZE: usize = 1 + 8;
+
+fn put_kind(w: &mut Writer<'_>, k: &EventKind) -> Result<(), CodecError> {
+    match *k {
+        EventKind::StateChange { from, to, fault } => {
+            w.u8(0)?;
+            put_state(w, from)?;
+            put_state(w, to)?;
+            w.bool(fault.is_some())?;
+            match fault {
+                Some(f) => put_fault(w, f)?,
+                None => put_zeros(w, FAULT_SIZE)?,
+            }
+            put_zeros(w, 2)
+        }
+        EventKind::Approaching { time_to_critical_s } => {
+            w.u8(1)?;
+            w.f32(time_to_critical_s)?;
+            put_zeros(w, 4)
+        }
+        EventKind::Friction { mu, changed } => {
+            w.u8(2)?;
+            w.f32(mu)?;
+            w.bool(changed)?;
+            put_zeros(w, 3)
+        }
+    }
+}
+
+fn get_kind(r: &mut Reader<'_>) -> Result<EventKind, CodecError> {
+    let kind = match r.u8()? {
+        0 => {
+            let (from, to) = (get_state(r)?, get_state(r)?);
+            let fault = if r.bool()? {
+                Some(get_fault(r)?)
+            } else {
+                get_zeros(r, FAULT_SIZE)?;
+                None
+            };
+            get_zeros(r, 2)?;
+            EventKind::StateChange { from, to, fault }
+        }
+        1 => {
+            let t = ratio(r)?;
+            get_zeros(r, 4)?;
+            EventKind::Approaching {
+                time_to_critical_s: require(t.is_finite(), t)?,
+            }
+        }
+        2 => {
+            let mu = finite(r)?;
+            let changed = r.bool()?;
+            get_zeros(r, 3)?;
+            EventKind::Friction { mu, changed }
+        }
+        _ => return Err(INVALID),
+    };
+    Ok(kind)
+}
+
+const EVENT_SIZE: usize = 4 + 4 + 8 + KIND_SIZE + READING_SIZE;
+
+fn put_event(w: &mut Writer<'_>, e: &Event) -> Result<(), CodecError> {
+    w.u32(e.seq)?;
+    w.u32(e.time_ms)?;
+    w.u64(e.elapsed_ms)?;
+    put_kind(w, &e.kind)?;
+    put_reading(w, &e.reading)
+}
+
+fn get_event(r: &mut Reader<'_>) -> Result<Event, CodecError> {
+    Ok(Event {
+        seq: r.u32()?,
+        time_ms: r.u32()?,
+        elapsed_ms: r.u64()?,
+        kind: get_kind(r)?,
+        reading: get_reading(r)?,
+    })
+}
+
+/// A saved buffer: every slot (used or not, so that a round trip is exact), then the
+/// length, refused above the capacity.
+fn put_saved<T: Copy, const N: usize>(
+    w: &mut Writer<'_>,
+    s: &Saved<T, N>,
+    put: impl Fn(&mut Writer<'_>, &T) -> Result<(), CodecError>,
+) -> Result<(), CodecError> {
+    s.items.iter().try_for_each(|x| put(w, x))?;
+    w.u8(s.len)
+}
+
+fn get_saved<T: Copy, const N: usize>(
+    r: &mut Reader<'_>,
+    fill: T,
+    get: impl Fn(&mut Reader<'_>) -> Result<T, CodecError>,
+) -> Result<Saved<T, N>, CodecError> {
+    let mut items = [fill; N];
+    for slot in &mut items {
+        *slot = get(r)?;
+    }
+    let len = r.u8()?;
+    require(usize::from(len) <= N, Saved { items, len })
+}
+
+const CLOCK_SIZE: usize = 5 + 8;
+const ALARM_SIZE: usize = 1 + 8 + (1 + 1 + 8) + 9;
+const STATS_SIZE: usize = 8 + 4 + 4 + 8 * 4 + 4 + 5 * 8 + 5 * 8 + 4 + 4 + 5;
+const FRICTION_SIZE: usize = 4 + 4 + 1 + 4 + 4 + 4 + 1;
+const STATUS_SIZE: usize = CLOCK_SIZE
+    + ALARM_SIZE
+    + (1 + 8)
+    + 2 * (4 + 8)
+    + (8 + 4 + 4)
+    + 5
+    + 1
+    + 4
+    + (1 + READING_SIZE)
+    + 4
+    + STATS_SIZE
+    + FRICTION_SIZE;
+
+fn put_status(w: &mut Writer<'_>, s: &Status) -> Result<(), CodecError> {
+    put_option(w, s.clock.last_time_ms, 0, |w, t| w.u32(t))?;
+    w.u64(s.clock.elapsed_ms)?;
+    let a = &s.alarm;
+    put_state(w, a.state)?;
+    w.u64(a.since_ms)?;
+    put_option(w, a.pending, (RiskState::Stopped, 0), |w, (p, t)| {
+        put_state(w, p)?;
+        w.u64(t)
+    })?;
+    put_opt_u64(w, a.started_ms)?;
+    put_option(w, s.smoothed, [0.0; 2], |w, x| w.each(&x, |w, v| w.f32(*v)))?;
+    w.each(&s.stuck, |w, t| {
+        w.u32(t.bits)?;
+        w.u64(t.since_ms)
+    })?;
+    let iv = &s.trend_interval;
+    w.u64(iv.start_ms)?;
+    w.f32(iv.sum)?;
+    w.u32(iv.count)?;
+    put_opt_f32(w, s.time_to_critical_s)?;
+    w.bool(s.approaching_armed)?;
+    w.u32(s.next_seq)?;
+    put_option(w, s.reading, Reading::default(), |w, r| put_reading(w, &r))?;
+    w.f32(s.energy_step)?;
+    put_stats(w, &s.stats)?;
+    let f = &s.friction;
+    w.f32(f.mu)?;
+    w.f32(f.baseline)?;
+    w.bool(f.baseline_captured)?;
+    w.u32(f.accepted)?;
+    w.u32(f.rejected)?;
+    w.u32(f.pending_ms)?;
+    w.bool(f.changed)
+}
+
+fn get_status(r: &mut Reader<'_>) -> Result<Status, CodecError> {
+    let clock = Clock {
+        last_time_ms: get_option::<_, 4>(r, |r| r.u32())?,
+        elapsed_ms: r.u64()?,
+    };
+    let alarm = Alarm {
+        state: get_state(r)?,
+        since_ms: r.u64()?,
+        pending: get_option::<_, 9>(r, |r| Ok((get_state(r)?, r.u64()?)))?,
+        started_ms: get_opt_u64(r)?,
+    };
+    let smoothed = get_option::<_, 8>(r, |r| Ok([finite(r)?, finite(r)?]))?;
+    let stuck = r.array_of(|r| {
+        Ok(StuckTracker {
+            bits: r.u32()?,
+            since_ms: r.u64()?,
+        })
+    })?;
+    let trend_interval = TrendInterval {
+        start_ms: r.u64()?,
+        sum: finite(r)?,
+        count: r.u32()?,
+    };
+    let time_to_critical_s = get_opt_finite(r)?;
+    let approaching_armed = r.bool()?;
+    let next_seq = r.u32()?;
+    let reading = get_option::<_, READING_SIZE>(r, get_reading)?;
+    let energy_step = finite(r)?;
+    let stats = get_stats(r)?;
+    let friction = FrictionStatus {
+        mu: finite(r)?,
+        baseline: finite(r)?,
+        baseline_captured: r.bool()?,
+        accepted: r.u32()?,
+        rejected: r.u32()?,
+        pending_ms: r.u32()?,
+        changed: r.bool()?,
+    };
+    // A captured baseline divides the band test: it is positive.
+    if friction.baseline_captured && friction.baseline <= 0.0 {
+        return Err(INVALID);
+    }
+    Ok(Status {
+        clock,
+        alarm,
+        smoothed,
+        stuck,
+        trend_interval,
+        time_to_critical_s,
+        approaching_armed,
+        next_seq,
+        reading,
+        energy_step,
+        stats,
+        friction,
+    })
+}
+
+fn put_stats(w: &mut Writer<'_>, s: &Statistics) -> Result<(), CodecError> {
+    w.u64(s.samples)?;
+    w.u32(s.repeated_timestamps)?;
+    w.u32(s.spikes)?;
+    let f = &s.faults;
+    for c in [
+        f.non_finite,
+        f.out_of_range,
+        f.stuck,
+        f.gap,
+        f.time_backwards,
+        f.driver,
+        f.estimator,
+        f.sensor,
+    ] {
+        w.u32(c)?;
+    }
+    w.u32(s.events_dropped)?;
+    w.each(&s.time_in_state_ms, |w, t| w.u64(*t))?;
+    w.each(&s.energy, |w, e| {
+        w.f32(e.sum)?;
+        w.f32(e.compensation)
+    })?;
+    w.f32(s.max_slip_ratio)?;
+    w.f32(s.max_axial_force)?;
+    put_opt_f32(w, s.min_margin)
+}
+
+fn get_stats(r: &mut Reader<'_>) -> Result<Statistics, CodecError> {
+    let (samples, repeated_timestamps, spikes) = (r.u64()?, r.u32()?, r.u32()?);
+    let [
+        non_finite,
+        out_of_range,
+        stuck,
+        gap,
+        time_backwards,
+        driver,
+        estimator,
+        sensor,
+    ] = r.array_of(|r| r.u32())?;
+    Ok(Statistics {
+        samples,
+        repeated_timestamps,
+        spikes,
+        faults: FaultCounts {
+            non_finite,
+            out_of_range,
+            stuck,
+            gap,
+            time_backwards,
+            driver,
+            estimator,
+            sensor,
+        },
+        events_dropped: r.u32()?,
+        time_in_state_ms: r.array_of(|r| r.u64())?,
+        energy: r.array_of(|r| {
+            Ok(EnergySum {
+                sum: finite(r)?,
+                compensation: finite(r)?,
+            })
+        })?,
+        max_slip_ratio: ratio(r)?,
+        max_axial_force: finite(r)?,
+        min_margin: get_opt_finite(r)?,
+    })
+}
+
+/// The state of a monitor, stored under [`kind::MONITOR_STATE`]: everything
+/// [`Monitor::restore`](super::Monitor::restore) needs to go on identically (energy
+/// and time per state, counters, the clock, the state machine, the buffers, the
+/// undelivered events, the friction baseline and filter).
+impl Checkpoint for MonitorState {
+    const KIND: u8 = kind::MONITOR_STATE;
+    const VERSION: u16 = 1;
+    const SIZE: usize = STATUS_SIZE
+        + 2 * (SPIKE_WINDOW_CAPACITY * 4 + 1)
+        + (TREND_CAPACITY * 8 + 1)
+        + (EVENT_CAPACITY * EVENT_SIZE + 1);
+
+    fn encode(&self, w: &mut Writer<'_>) -> Result<(), CodecError> {
+        put_status(w, &self.status)?;
+        put_saved(w, &self.load_window, |w, x| w.f32(*x))?;
+        put_saved(w, &self.angle_window, |w, x| w.f32(*x))?;
+        put_saved(w, &self.trend, |w, p| {
+            w.u32(p.time_ms)?;
+            w.f32(p.margin)
+        })?;
+        put_saved(w, &self.events, put_event)
+    }
+
+    fn decode(r: &mut Reader<'_>) -> Result<Self, CodecError> {
+        Ok(MonitorState {
+            status: get_status(r)?,
+            load_window: get_saved(r, 0.0, finite)?,
+            angle_window: get_saved(r, 0.0, finite)?,
+            trend: get_saved(r, TrendPoint::default(), |r| {
+                Ok(TrendPoint {
+                    time_ms: r.u32()?,
+                    margin: finite(r)?,
+                })
+            })?,
+            events: get_saved(r, super::state::NO_EVENT, get_event)?,
+        })
+    }
+}
+
+/// The monitor's configuration, stored under [`kind::MONITOR_CONFIG`]; a decoded one
+/// must pass [`Config::validate`].
+impl Checkpoint for Config {
+    const KIND: u8 = kind::MONITOR_CONFIG;
+    const VERSION: u16 = 1;
+    const SIZE: usize = 13 + 4 * 4 + 8 * 4 + (1 + 1 + 3 * 4) + 4 + 2 * 4 + (1 + 4 + 1 + 4) + 29;
+
+    fn encode(&self, w: &mut Writer<'_>) -> Result<(), CodecError> {
+        let (tag, a, b, c) = match self.thresholds {
+            Thresholds::SlipRatio {
+                warning,
+                alarm,
+                deadband,
+            } => (0, warning, alarm, deadband),
+            Thresholds::Margin {
+                warning,
+                alarm,
+                deadband,
+            } => (1, warning, alarm, deadband),
+        };
+        w.u8(tag)?;
+        w.each(&[a, b, c], |w, x| w.f32(*x))?;
+        w.each(
+            &[
+                self.on_delay_ms,
+                self.off_delay_ms,
+                self.fault_delay_ms,
+                self.inhibit_ms,
+            ],
+            |w, x| w.u32(*x),
+        )?;
+        w.each(
+            &[
+                self.stop_load,
+                self.stop_speed,
+                self.nominal_speed,
+                self.load_min,
+                self.load_max,
+                self.angle_max,
+                self.speed_max,
+                self.force_max,
+            ],
+            |w, x| w.f32(*x),
+        )?;
+        let no_spikes = SpikeFilter {
+            window: 0,
+            k: 0.0,
+            load_floor: 0.0,
+            angle_floor: 0.0,
+        };
+        put_option(w, self.spikes, no_spikes, |w, s| {
+            w.u8(s.window)?;
+            w.each(&[s.k, s.load_floor, s.angle_floor], |w, x| w.f32(*x))
+        })?;
+        w.f32(self.smoothing_tau_s)?;
+        w.u32(self.stuck_ms)?;
+        w.u32(self.gap_ms)?;
+        let no_trend = TrendConfig {
+            interval_ms: 0,
+            points: 0,
+            horizon_s: 0.0,
+        };
+        put_option(w, self.trend, no_trend, |w, t| {
+            w.u32(t.interval_ms)?;
+            w.u8(t.points)?;
+            w.f32(t.horizon_s)
+        })?;
+        let no_friction = FrictionConfig {
+            sensitivity_max: 0.0,
+            tau_s: 0.0,
+            baseline_after_ms: 0,
+            baseline_after_estimates: 0,
+            band: 0.0,
+            deadband: 0.0,
+            delay_ms: 0,
+        };
+        put_option(w, self.friction, no_friction, |w, f| {
+            w.f32(f.sensitivity_max)?;
+            w.f32(f.tau_s)?;
+            w.u32(f.baseline_after_ms)?;
+            w.u32(f.baseline_after_estimates)?;
+            w.f32(f.band)?;
+            w.f32(f.deadband)?;
+            w.u32(f.delay_ms)
+        })
+    }
+
+    fn decode(r: &mut Reader<'_>) -> Result<Self, CodecError> {
+        let tag = r.u8()?;
+        let [warning, alarm, deadband] = r.array_of(|r| r.f32())?;
+        let thresholds = match tag {
+            0 => Thresholds::SlipRatio {
+                warning,
+                alarm,
+                deadband,
+            },
+            1 => Thresholds::Margin {
+                warning,
+                alarm,
+                deadband,
+            },
+            _ => return Err(INVALID),
+        };
+        let [on_delay_ms, off_delay_ms, fault_delay_ms, inhibit_ms] = r.array_of(|r| r.u32())?;
+        let [
+            stop_load,
+            stop_speed,
+            nominal_speed,
+            load_min,
+            load_max,
+            angle_max,
+            speed_max,
+            force_max,
+        ] = r.array_of(|r| r.f32())?;
+        let spikes = get_option::<_, 13>(r, |r| {
+            let window = r.u8()?;
+            let [k, load_floor, angle_floor] = r.array_of(|r| r.f32())?;
+            Ok(SpikeFilter {
+                window,
+                k,
+                load_floor,
+                angle_floor,
+            })
+        })?;
+        let smoothing_tau_s = r.f32()?;
+        let (stuck_ms, gap_ms) = (r.u32()?, r.u32()?);
+        let trend = get_option::<_, 9>(r, |r| {
+            Ok(TrendConfig {
+                interval_ms: r.u32()?,
+                points: r.u8()?,
+                horizon_s: r.f32()?,
+            })
+        })?;
+        let friction = get_option::<_, 28>(r, |r| {
+            Ok(FrictionConfig {
+                sensitivity_max: r.f32()?,
+                tau_s: r.f32()?,
+                baseline_after_ms: r.u32()?,
+                baseline_after_estimates: r.u32()?,
+                band: r.f32()?,
+                deadband: r.f32()?,
+                delay_ms: r.u32()?,
+            })
+        })?;
+        let config = Config {
+            thresholds,
+            on_delay_ms,
+            off_delay_ms,
+            fault_delay_ms,
+            inhibit_ms,
+            stop_load,
+            stop_speed,
+            nominal_speed,
+            load_min,
+            load_max,
+            angle_max,
+            speed_max,
+            force_max,
+            spikes,
+            smoothing_tau_s,
+            stuck_ms,
+            gap_ms,
+            trend,
+            friction,
+        };
+        config.validate().map_err(|_| INVALID)?;
+        Ok(config)
+    }
+}

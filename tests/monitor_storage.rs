@@ -1,0 +1,394 @@
+//! The monitor's state and configuration as stored checkpoints (issue 13): field by
+//! field through the storage codec, a frozen version-1 record that every later firmware
+//! must read, corrupted payloads refused, and the whole through a store on the mock
+//! flash beside the sensors' calibration.
+
+use misalign::monitor::scenario::Scenario;
+use misalign::monitor::{
+    Channel, Config, EVENT_CAPACITY, EventKind, FaultCause, FaultKind, FrictionConfig, Monitor,
+    MonitorState, RiskState, SPIKE_WINDOW_CAPACITY, Sample, SensorFault, SensorId, TREND_CAPACITY,
+    Thresholds, model_for_range,
+};
+use misalign::sensors::{Hx711Channel, LoadCalibration, SpeedCalibration};
+use misalign::storage::codec::{self, CodecError};
+use misalign::storage::{
+    BlockingFlash, Checkpoint, MockFlash, Reader, RestoreOutcome, SensorCalibration, Store, Writer,
+    block_on, kind,
+};
+use misalign::{Estimator, Scene, float::Auto};
+
+#[path = "common/probes.rs"]
+mod probes;
+
+fn core(mu: f64) -> Auto {
+    let s = Scene::new(0.05, 0.05, 79.3e9, 0.3, mu).unwrap();
+    Auto::with_choice(&s, model_for_range(&s, 5e3, 1e-5).unwrap()).unwrap()
+}
+
+/// The built-in scenario's samples with a measured axial force from the forward model
+/// at mu = 0.3 (none where the forward model refuses the sample, e.g. at rest).
+fn scenario_with_force() -> impl Iterator<Item = Sample> {
+    let forward = core(0.3);
+    Scenario::new().map(move |s| match forward.estimate_si(s.load.max(0.0), s.phi) {
+        Ok(e) if e.axial_force.is_finite() => s.with_axial_force(e.axial_force),
+        _ => s,
+    })
+}
+
+/// The payload of a value, as its `encode` writes it.
+fn payload<T: Checkpoint>(value: &T) -> Vec<u8> {
+    let mut out = vec![0u8; T::SIZE];
+    let mut w = Writer::new(&mut out);
+    value.encode(&mut w).unwrap();
+    assert_eq!(w.written(), T::SIZE);
+    out
+}
+
+/// Decodes a payload, every byte of it.
+fn decode<T: Checkpoint>(bytes: &[u8]) -> Result<T, CodecError> {
+    let mut r = Reader::new(bytes);
+    let value = T::decode(&mut r)?;
+    r.finish()?;
+    Ok(value)
+}
+
+/// The state four hours into the scenario (trend, events, faults, energy, friction
+/// all in use), the monitor that holds it, and the rest of the samples.
+fn mid_scenario() -> (Monitor<Auto>, Vec<Sample>) {
+    let mut m = Monitor::new(core(0.3), Config::default()).unwrap();
+    let mut samples = scenario_with_force();
+    for s in samples.by_ref().take(4 * 3600) {
+        m.process_with_friction(s);
+    }
+    (m, samples.collect())
+}
+
+#[test]
+fn a_restored_state_goes_on_identically() {
+    let (mut original, rest) = mid_scenario();
+    let state = original.snapshot();
+    // The state is a real one: every part is in use.
+    assert!(state.status.friction.baseline_captured);
+    assert!(state.trend.len > 0 && state.events.len > 0);
+    assert!(state.status.stats.faults.total() > 0);
+    let mut record = vec![0u8; codec::record_len(MonitorState::SIZE)];
+    let n = codec::encode(&state, 41, &mut record).unwrap();
+    let decoded = codec::decode::<MonitorState>(&record[..n]).unwrap();
+    assert_eq!((decoded.sequence, decoded.version), (41, 1));
+    assert_eq!(decoded.value, state);
+    let config = decode::<Config>(&payload(original.config())).unwrap();
+    let mut restored = Monitor::restore(core(0.3), config, &decoded.value).unwrap();
+    for s in rest {
+        assert_eq!(
+            original.process_with_friction(s),
+            restored.process_with_friction(s)
+        );
+        assert_eq!(original.pop_event(), restored.pop_event());
+    }
+    assert_eq!(original.snapshot(), restored.snapshot());
+    assert_eq!(original.statistics().samples, 8 * 3600 - 180);
+}
+
+/// A version-1 record of a monitor's state, written once by the version-1 encoder
+/// (checkpoint 7): 342 s of samples at 2 kN with a measured F, a saturated probe 2, a
+/// driver's fault on the speed, a friction baseline taken on demand and a fall of mu
+/// to 0.2. A newer firmware must go on reading it (migrate, once VERSION is raised).
+const V1_RECORD: &[&str] = &[
+    "4d534c4701010100180300000700000001f0370500083405000000000001a00302000000000000000000000000000000",
+    "010000000000000000018095fb44cde551390040fc440834050000000000c7ec51390834050000000000c89704000000",
+    "0000c885813c2900000000000000000106000000018095fb44cde5513905befe3e0790c2430157b7193a01c87bca3900",
+    "000000560100000000000000000000000000000000000000000000000000000000000000000000010000000000000001",
+    "000000000000000000000000000000d8410400000000000000000000000000000000000000000030f200000000000000",
+    "00000000000000efd63942000064b500000000000000000000000000000000d87b3b410000f8b41c17ff3e63d1f44301",
+    "12c3c9396578503e959d993e01540100000000000000000000010000fa440060fa4400c0fa440020fb440080fb4400e0",
+    "fb440040fc4407efd15139c7ec51399f0752397722523917b75139efd15139c7ec513907e09304008f2fca3900000000",
+    "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+    "00000000000000000000000000000000000000000100000000e803000000000000000000000000010000000000000060",
+    "fa44efd151391c17ff3e3635f343010556193a0112c3c9390100000048ee000060ea0000000000000001040107020200",
+    "00e519fb44cee95139f8eafe3e180cf443017f90193a01172cca39020000006067010078630100000000000004010000",
+    "000000006aebfa44cde5513988f7fe3ebe40f34301e281193a01de10ca3903000000708e0100888a0100000000000001",
+    "0401050200000080f1fa440ae351394af3fe3e39ccf34301cc83193a011316ca390400000088070200a0030200000000",
+    "000004010000000000009022fb4463ef513970ecfe3eac00f343013993193a01c02eca390500000000e8030018e40300",
+    "00000000024c1a5c3e01000000e519fb440ae351399de5fe3edd04c243017f90193a01792fca3906baf52f32",
+];
+
+fn v1_record() -> Vec<u8> {
+    let hex = V1_RECORD.concat();
+    (0..hex.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&hex[i..i + 2], 16).unwrap())
+        .collect()
+}
+
+#[test]
+fn newer_firmware_reads_the_version_1_record() {
+    let record = v1_record();
+    assert_eq!(record.len(), codec::record_len(MonitorState::SIZE));
+    let decoded = codec::decode::<MonitorState>(&record).unwrap();
+    assert_eq!((decoded.sequence, decoded.version), (7, 1));
+    let s = decoded.value;
+    assert_eq!(s.status.clock.elapsed_ms, 341_000);
+    assert_eq!(s.status.clock.last_time_ms, Some(342_000));
+    assert_eq!(s.status.alarm.state, RiskState::Normal);
+    assert_eq!(s.status.stats.samples, 342);
+    assert_eq!(
+        (s.status.stats.faults.driver, s.status.stats.faults.sensor),
+        (1, 1)
+    );
+    let f = s.status.friction;
+    assert!(f.baseline_captured && f.changed);
+    assert_eq!((f.accepted, f.rejected), (340, 0));
+    assert_eq!((f.baseline, f.mu), (0.30003038, 0.20358427));
+    let kinds: Vec<EventKind> = s.events.items[..usize::from(s.events.len)]
+        .iter()
+        .map(|e| e.kind)
+        .collect();
+    let change = |from, to, fault| EventKind::StateChange { from, to, fault };
+    let probe2 = SensorFault {
+        sensor: SensorId::Probe2,
+        kind: FaultKind::Saturated,
+    };
+    use RiskState::{Normal, SensorFault as Fault, Stopped};
+    assert_eq!(
+        kinds,
+        [
+            change(Stopped, Normal, None),
+            change(Normal, Fault, Some(FaultCause::Sensor(probe2))),
+            change(Fault, Normal, None),
+            change(Normal, Fault, Some(FaultCause::Driver(Channel::Speed))),
+            change(Fault, Normal, None),
+            EventKind::Friction {
+                mu: 0.21494406,
+                changed: true
+            },
+        ]
+    );
+    // The version-1 encoder still writes exactly these bytes.
+    let mut again = vec![0u8; record.len()];
+    codec::encode(&s, 7, &mut again).unwrap();
+    assert_eq!(again, record);
+    // And a monitor goes on from it.
+    let mut m = Monitor::restore(core(0.3), Config::default(), &s).unwrap();
+    assert_eq!(m.friction_baseline(), Some(0.30003038));
+    let next = Sample::new(343_000, 2000.0, 2e-4).with_speed(2.0);
+    assert_eq!(m.process(next), RiskState::Normal);
+}
+
+/// Where the fields sit in the version-1 payload (the layout `checkpoint.rs` writes).
+const CLOCK: usize = 1 + 4 + 8;
+const EVENT: usize = 4 + 4 + 8 + 9 + 26;
+const BUFFERS: usize =
+    2 * (SPIKE_WINDOW_CAPACITY * 4 + 1) + TREND_CAPACITY * 8 + 1 + EVENT_CAPACITY * EVENT + 1;
+
+#[test]
+fn corrupted_payloads_are_refused() {
+    let (m, _) = mid_scenario();
+    let good = payload(&m.snapshot());
+    let status = MonitorState::SIZE - BUFFERS;
+    let windows = status;
+    let events = status + 2 * (SPIKE_WINDOW_CAPACITY * 4 + 1) + TREND_CAPACITY * 8 + 1;
+    let smoothed = CLOCK + 1 + 8 + 10 + 9;
+    assert_eq!(
+        good[smoothed], 1,
+        "the state mid-run holds a smoothed value"
+    );
+    let nan = f32::NAN.to_le_bytes();
+    let inf = f32::INFINITY.to_le_bytes();
+    let cases: [(&str, usize, &[u8]); 9] = [
+        ("a flag byte of 2 (the clock's)", 0, &[2]),
+        ("an unknown risk state", CLOCK, &[5]),
+        ("a NaN smoothed load", smoothed + 1, &nan),
+        ("an infinite smoothed angle", smoothed + 5, &inf),
+        (
+            "a load window longer than its capacity",
+            windows + SPIKE_WINDOW_CAPACITY * 4,
+            &[8],
+        ),
+        (
+            "an event queue longer than its capacity",
+            MonitorState::SIZE - 1,
+            &[7],
+        ),
+        ("an unknown event kind", events + 16, &[3]),
+        ("an unknown state in an event", events + 17, &[9]),
+        ("a NaN in an event's reading", events + 25, &nan),
+    ];
+    for (what, at, bytes) in cases {
+        let mut bad = good.clone();
+        bad[at..at + bytes.len()].copy_from_slice(bytes);
+        assert_eq!(
+            decode::<MonitorState>(&bad),
+            Err(CodecError::InvalidValue),
+            "{what}"
+        );
+    }
+    // Every byte set to a few values: refused, or decoded to a value that encodes to
+    // exactly those bytes (nothing read is dropped or changed), and a monitor goes on
+    // from it without a panic.
+    let mut accepted = 0;
+    for at in 0..good.len() {
+        for v in [0x00, 0x01, 0x02, 0x7F, 0x80, 0xFF] {
+            let mut bad = good.clone();
+            bad[at] = v;
+            if let Ok(state) = decode::<MonitorState>(&bad) {
+                accepted += 1;
+                assert_eq!(payload(&state), bad, "byte {at} = {v:#x}");
+                let mut m = Monitor::restore(core(0.3), Config::default(), &state).unwrap();
+                m.process_with_friction(Sample::new(0, 2000.0, 2e-4).with_axial_force(480.0));
+            }
+        }
+    }
+    assert!(accepted > 0);
+    // A record whose bytes were damaged on the flash fails its CRC first.
+    let mut record = vec![0u8; codec::record_len(MonitorState::SIZE)];
+    codec::encode(&m.snapshot(), 1, &mut record).unwrap();
+    record[100] ^= 0x10;
+    assert_eq!(
+        codec::decode::<MonitorState>(&record),
+        Err(CodecError::Checksum)
+    );
+}
+
+#[test]
+fn the_configuration_round_trips_and_is_validated_on_decode() {
+    let custom = Config {
+        thresholds: Thresholds::Margin {
+            warning: 1e-4,
+            alarm: 0.0,
+            deadband: 2e-5,
+        },
+        spikes: None,
+        trend: None,
+        friction: Some(FrictionConfig {
+            band: 0.1,
+            deadband: 0.02,
+            ..FrictionConfig::default()
+        }),
+        ..Config::default()
+    };
+    let no_friction = Config {
+        friction: None,
+        ..Config::default()
+    };
+    for config in [Config::default(), custom, no_friction] {
+        assert_eq!(decode::<Config>(&payload(&config)), Ok(config));
+    }
+    assert_eq!(Config::KIND, kind::MONITOR_CONFIG);
+    // The docs' wear figures are those of the monitor's real record.
+    assert_eq!(
+        misalign::storage::wear::REFERENCE.payload,
+        MonitorState::SIZE
+    );
+    assert_eq!(MonitorState::KIND, kind::MONITOR_STATE);
+    // An inconsistent configuration encodes (encode does not judge) but never decodes.
+    let inconsistent = Config {
+        friction: Some(FrictionConfig {
+            band: 0.0,
+            ..FrictionConfig::default()
+        }),
+        ..Config::default()
+    };
+    let bad = payload(&inconsistent);
+    assert_eq!(decode::<Config>(&bad), Err(CodecError::InvalidValue));
+    // An unknown threshold kind; bytes behind an absent option.
+    let mut bad = payload(&Config::default());
+    bad[0] = 2;
+    assert_eq!(decode::<Config>(&bad), Err(CodecError::InvalidValue));
+    let mut bad = payload(&no_friction);
+    let last = bad.len() - 1;
+    bad[last] = 1;
+    assert_eq!(decode::<Config>(&bad), Err(CodecError::InvalidValue));
+}
+
+type Flash = MockFlash<4, 4096, 4>;
+const BUF: usize = Store::<BlockingFlash<Flash>, 1024>::buffer_len::<MonitorState>();
+
+fn sensor_calibration() -> SensorCalibration {
+    SensorCalibration {
+        load: LoadCalibration::from_rated_output(Hx711Channel::A128, 2.0, 5000.0).unwrap(),
+        misalignment: probes::probe_calibration(-30e-6),
+        speed: Some(SpeedCalibration {
+            pulses_per_rev: 60,
+            radius_m: 0.05,
+            max_speed_m_s: 50.0,
+        }),
+    }
+}
+
+#[test]
+fn state_configuration_and_calibration_through_the_mock_flash() {
+    assert!(BUF >= Store::<BlockingFlash<Flash>, 1024>::buffer_len::<Config>());
+    assert!(BUF >= Store::<BlockingFlash<Flash>, 1024>::buffer_len::<SensorCalibration>());
+    let open =
+        |flash: Flash| Store::<_, BUF>::new(BlockingFlash(flash), 0..4 * 4096, 3600).unwrap();
+    let (mut m, rest) = mid_scenario();
+    let config = *m.config();
+    let calibration = sensor_calibration();
+    let mut store = open(Flash::new());
+    block_on(store.checkpoint(&calibration)).unwrap();
+    block_on(store.checkpoint(&config)).unwrap();
+    // A checkpoint a minute (4 records fit a sector): many turns of the ring.
+    let mut last = m.snapshot();
+    for (i, s) in rest.iter().enumerate() {
+        m.process_with_friction(*s);
+        if i % 60 == 59 {
+            last = m.snapshot();
+            block_on(store.checkpoint(&last)).unwrap();
+        }
+    }
+    // A reset: everything comes back.
+    let mut store = open(store.into_flash().0);
+    let state = block_on(store.restore::<MonitorState>()).unwrap();
+    assert!(
+        matches!(state.outcome, RestoreOutcome::Restored { .. }),
+        "{:?}",
+        state.outcome
+    );
+    assert_eq!(state.value, Some(last));
+    let restored_config = block_on(store.restore::<Config>()).unwrap().value;
+    assert_eq!(restored_config, Some(config));
+    let restored_calibration = block_on(store.restore::<SensorCalibration>())
+        .unwrap()
+        .value;
+    assert_eq!(restored_calibration, Some(calibration));
+    // The last checkpoint was of the last sample: the restored monitor goes on as the
+    // one that never stopped.
+    assert_eq!(m.snapshot(), last);
+    let mut again = Monitor::restore(core(0.3), config, &last).unwrap();
+    let next = last.status.clock.last_time_ms.unwrap().wrapping_add(1000);
+    let sample = Sample::new(next, 2000.0, 2e-4).with_speed(2.0);
+    assert_eq!(again.process(sample), m.process(sample));
+    assert_eq!(again.snapshot(), m.snapshot());
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
+
+    /// A valid payload with up to 8 bytes overwritten, and any bytes at all: refused,
+    /// or a value that encodes to exactly those bytes; never a panic.
+    #[test]
+    fn any_payload_is_refused_or_canonical(
+        edits in proptest::collection::vec(
+            (0..MonitorState::SIZE, proptest::prelude::any::<u8>()),
+            1..8,
+        ),
+        garbage in proptest::collection::vec(proptest::prelude::any::<u8>(), MonitorState::SIZE),
+        config in proptest::collection::vec(proptest::prelude::any::<u8>(), Config::SIZE),
+    ) {
+        let fresh = Monitor::new(core(0.3), Config::default()).unwrap().snapshot();
+        let mut edited = payload(&fresh);
+        for (at, v) in edits {
+            edited[at] = v;
+        }
+        for bytes in [edited, garbage] {
+            if let Ok(state) = decode::<MonitorState>(&bytes) {
+                proptest::prop_assert_eq!(payload(&state), bytes);
+            }
+        }
+        if let Ok(c) = decode::<Config>(&config) {
+            proptest::prop_assert_eq!(payload(&c), config);
+            proptest::prop_assert!(c.validate().is_ok());
+        }
+    }
+}
