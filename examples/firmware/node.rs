@@ -66,7 +66,7 @@ pub fn run<E: Estimator>(core: E, number: &str, counter: &Counter) -> Option<Mea
     let mut monitor = match Monitor::new(core, Config::default()) {
         Ok(m) => m,
         Err(e) => {
-            defmt::error!("node: configuration refused: {}", defmt::Debug2Format(&e));
+            defmt::error!("node: configuration refused: {}", e);
             return None;
         }
     };
