@@ -38,10 +38,9 @@ const MINIMAL: [&str; 5] = [
     "minimal_line",
 ];
 
-/// The monitoring node through the simulated sensors runs on this core (and its
-/// target is built with them).
-const SENSORS_CPU: &str = "cortex-m4f";
-const SENSORS_TARGET: &str = "thumbv7em-none-eabihf";
+/// The monitoring node through the simulated sensors runs on these cores (their
+/// targets are built with them): the FPU core, and the Cortex-M0 with its 16 KiB of RAM.
+const SENSORS_CPUS: [&str; 2] = ["cortex-m4f", "cortex-m0"];
 
 /// The RAM of the board a core's image is linked for (harness/boards/): the node's
 /// statics and stack must fit it.
@@ -281,7 +280,7 @@ fn check_core(
     if let Some(elf) = built
         .firmware_sensors
         .as_ref()
-        .filter(|_| core.id == SENSORS_CPU)
+        .filter(|_| SENSORS_CPUS.contains(&core.id))
     {
         match cross::qemu(core.machine, elf) {
             Ok((Some(0), log)) => node_check(core, elf, &log, true, llvm_size, failures, nodes),
@@ -382,8 +381,8 @@ struct Built {
     target: &'static str,
     /// The firmware example (profile `firmware`).
     firmware: PathBuf,
-    /// The same with the simulated sensors (`--features sim-sensors`), on the
-    /// Cortex-M4F's target only.
+    /// The same with the simulated sensors (`--features sim-sensors`), on the targets
+    /// of [`SENSORS_CPUS`].
     firmware_sensors: Option<PathBuf>,
     /// The harness's minimal images (profile `firmware`).
     harness: Artifacts,
@@ -395,7 +394,10 @@ struct Built {
 fn build_target(target: &'static str) -> Result<Built, String> {
     // First the node through the simulated sensors, kept under its own name: the
     // plain build that follows writes the same file.
-    let firmware_sensors = if target == SENSORS_TARGET {
+    let sensors = CPUS
+        .iter()
+        .any(|c| c.target == target && SENSORS_CPUS.contains(&c.id));
+    let firmware_sensors = if sensors {
         let elf = build_firmware(target, "sim-sensors")?;
         let kept = elf.with_file_name("firmware-sensors");
         std::fs::copy(&elf, &kept).map_err(|e| format!("{}: {e}", kept.display()))?;
