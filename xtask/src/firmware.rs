@@ -17,6 +17,7 @@
 //! - instructions per sample (reported): SysTick under QEMU's `-icount`.
 
 use crate::cross::{self, Artifacts, CPUS, Cpu, Sections};
+use crate::node;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -36,6 +37,140 @@ const MINIMAL: [&str; 5] = [
     "minimal_line_prepare",
     "minimal_line",
 ];
+
+/// The monitoring node through the simulated sensors runs on these cores (their
+/// targets are built with them): the FPU core, and the Cortex-M0 with its 16 KiB of RAM.
+const SENSORS_CPUS: [&str; 2] = ["cortex-m4f", "cortex-m0"];
+
+/// The RAM of the board a core's image is linked for (harness/boards/): the node's
+/// statics and stack must fit it.
+fn board_ram(core: &Cpu) -> u64 {
+    if core.machine == "microbit" {
+        16 * 1024
+    } else {
+        4 * 1024 * 1024
+    }
+}
+
+/// One row of the node table.
+struct NodeRow {
+    core: &'static str,
+    number: &'static str,
+    sensors: bool,
+    flash: u64,
+    ram: u64,
+    measured: node::Measured,
+    board_ram: u64,
+    worst: f64,
+}
+
+/// Checks the node's log on `core` against the host replay (`node.rs`) and measures
+/// its image; a row for the node table, or failures.
+fn node_check(
+    core: &Cpu,
+    elf: &Path,
+    log: &str,
+    sensors: bool,
+    llvm_size: &Path,
+    failures: &mut Vec<String>,
+    nodes: &mut Vec<NodeRow>,
+) {
+    let what = if sensors {
+        "node with simulated sensors"
+    } else {
+        "node"
+    };
+    let fpu = core.has_fpu();
+    let checked = (|| -> Result<NodeRow, String> {
+        let got = node::parse_log(log)?;
+        let measured = node::parse_measured(log)?;
+        let host = node::host_replay(fpu, sensors)?;
+        let tol = node::tolerance(fpu);
+        let c = node::compare(&got, &host, tol);
+        if !c.mismatches.is_empty() {
+            return Err(format!(
+                "events differ from the host replay:\n  {}",
+                c.mismatches.join("\n  ")
+            ));
+        }
+        println!(
+            "  {what}: {} samples, {} events, the host replay's (same states, order and times; \
+             values within {tol:e}, at most {:.2} of it); stack {} B, instructions per sample \
+             {} mean / {} max",
+            measured.samples,
+            got.events.len(),
+            c.worst,
+            measured.stack,
+            measured.instructions_mean,
+            measured.instructions_max
+        );
+        let sections = Sections::of(llvm_size, elf)?;
+        Ok(NodeRow {
+            core: core.name,
+            number: if fpu { "f32" } else { "fixed" },
+            sensors,
+            flash: sections.flash(),
+            ram: sections.ram(),
+            measured,
+            board_ram: board_ram(core),
+            worst: c.worst,
+        })
+    })();
+    match checked {
+        Ok(row) => nodes.push(row),
+        Err(e) => failures.push(format!("{} {what}: {e}", core.name)),
+    }
+}
+
+/// The node table (markdown), and a failure where statics and stack overflow the
+/// board's RAM.
+fn node_table(rows: &[NodeRow]) -> (String, Vec<String>) {
+    let mut t = String::from(
+        "| core | number | input | flash | RAM: statics + stack | events as the host's | instructions per sample mean / max |\n\
+         |---|---|---|--:|--:|--:|--:|\n",
+    );
+    let mut over = Vec::new();
+    for r in rows {
+        let total = r.ram + r.measured.stack;
+        let fits = total <= r.board_ram;
+        writeln!(
+            t,
+            "| {} | {} | {} | {} | {} + {} = {}{} | {}, values {} | {} / {} |",
+            r.core,
+            r.number,
+            if r.sensors {
+                "simulated sensors"
+            } else {
+                "scenario"
+            },
+            r.flash,
+            r.ram,
+            r.measured.stack,
+            total,
+            if fits {
+                ""
+            } else {
+                " **over the board's RAM**"
+            },
+            r.measured.events,
+            if r.worst == 0.0 {
+                "bit for bit".to_string()
+            } else {
+                format!("within {:.2} of the tolerance", r.worst)
+            },
+            r.measured.instructions_mean,
+            r.measured.instructions_max
+        )
+        .unwrap();
+        if !fits {
+            over.push(format!(
+                "{} node: {} B of statics and {} B of stack exceed the board's {} B of RAM",
+                r.core, r.ram, r.measured.stack, r.board_ram
+            ));
+        }
+    }
+    (t, over)
+}
 
 /// One row of the firmware's `result model=... stack_bytes=...` line.
 #[derive(Default, Clone)]
@@ -71,6 +206,7 @@ pub fn run(readme: bool) -> ExitCode {
     let mut failures: Vec<String> = Vec::new();
     let mut rows = Vec::new();
     let mut built: Vec<Built> = Vec::new();
+    let mut nodes = Vec::new();
     // The Cortex-M4F first: the README's table starts with the FPU core.
     for core in CPUS.iter().rev() {
         step(
@@ -88,15 +224,21 @@ pub fn run(readme: bool) -> ExitCode {
             }
         }
         let b = built.iter().find(|b| b.target == core.target).unwrap();
-        rows.extend(check_core(core, b, &llvm_size, &mut failures));
+        rows.extend(check_core(core, b, &llvm_size, &mut failures, &mut nodes));
     }
     check_commands(start, &llvm_size, &mut failures);
     let (table, over) = table(&rows);
+    let (node_table, node_over) = node_table(&nodes);
+    let table = format!(
+        "{table}\nThe monitoring node (`examples/firmware`: the whole image a user flashes, \
+         self-test included; statics and stack must fit the board's RAM):\n\n{node_table}"
+    );
     println!(
         "\nEstimator on Cortex-M (profile `firmware`, bytes; budget per sample on the FPU core: \
          {FLASH_BUDGET} B flash, {STACK_BUDGET} B stack; README \"Size, stack, panics\")\n\n{table}"
     );
     failures.extend(over);
+    failures.extend(node_over);
     if readme && failures.is_empty() {
         match crate::write_readme_section("firmware", &table) {
             Ok(()) => println!("wrote the table into README.md"),
@@ -110,14 +252,45 @@ pub fn run(readme: bool) -> ExitCode {
 /// On one core: the firmware (every answer checked, stack and instructions measured),
 /// the on-target tests, and the minimal images (they run; their sizes) where the core
 /// measures them. Returns the core's rows of the size table.
-fn check_core(core: &Cpu, built: &Built, llvm_size: &Path, failures: &mut Vec<String>) -> Vec<Row> {
+fn check_core(
+    core: &Cpu,
+    built: &Built,
+    llvm_size: &Path,
+    failures: &mut Vec<String>,
+    nodes: &mut Vec<NodeRow>,
+) -> Vec<Row> {
     let runs = match run_firmware(core, &built.firmware) {
-        Ok(runs) => runs,
+        Ok((runs, log)) => {
+            node_check(
+                core,
+                &built.firmware,
+                &log,
+                false,
+                llvm_size,
+                failures,
+                nodes,
+            );
+            runs
+        }
         Err(e) => {
             failures.push(format!("{} firmware: {e}", core.name));
             Vec::new()
         }
     };
+    if let Some(elf) = built
+        .firmware_sensors
+        .as_ref()
+        .filter(|_| SENSORS_CPUS.contains(&core.id))
+    {
+        match cross::qemu(core.machine, elf) {
+            Ok((Some(0), log)) => node_check(core, elf, &log, true, llvm_size, failures, nodes),
+            Ok((status, log)) => failures.push(format!(
+                "{} node with simulated sensors: exit {status:?}:\n{log}",
+                core.name
+            )),
+            Err(e) => failures.push(format!("{} node with simulated sensors: {e}", core.name)),
+        }
+    }
     match cross::qemu(core.machine, &built.test) {
         Ok((Some(0), log)) if log.contains("all tests passed!") => {
             let n = log.lines().filter(|l| l.contains(") running `")).count();
@@ -208,6 +381,9 @@ struct Built {
     target: &'static str,
     /// The firmware example (profile `firmware`).
     firmware: PathBuf,
+    /// The same with the simulated sensors (`--features sim-sensors`), on the targets
+    /// of [`SENSORS_CPUS`].
+    firmware_sensors: Option<PathBuf>,
     /// The harness's minimal images (profile `firmware`).
     harness: Artifacts,
     /// The on-target test (profile `test`).
@@ -216,18 +392,20 @@ struct Built {
 
 /// Builds the firmware example, the minimal images and the on-target test for `target`.
 fn build_target(target: &'static str) -> Result<Built, String> {
-    let firmware = cross::build(cross::cargo().args([
-        "build",
-        "--profile",
-        "firmware",
-        "--target",
-        target,
-        "--features",
-        "firmware",
-        "--example",
-        "firmware",
-        "--message-format=json-render-diagnostics",
-    ]))?;
+    // First the node through the simulated sensors, kept under its own name: the
+    // plain build that follows writes the same file.
+    let sensors = CPUS
+        .iter()
+        .any(|c| c.target == target && SENSORS_CPUS.contains(&c.id));
+    let firmware_sensors = if sensors {
+        let elf = build_firmware(target, "sim-sensors")?;
+        let kept = elf.with_file_name("firmware-sensors");
+        std::fs::copy(&elf, &kept).map_err(|e| format!("{}: {e}", kept.display()))?;
+        Some(kept)
+    } else {
+        None
+    };
+    let firmware = build_firmware(target, "firmware")?;
     let mut minimal = cross::harness_build(target);
     for m in MINIMAL {
         minimal.args(["--bin", m]);
@@ -246,14 +424,33 @@ fn build_target(target: &'static str) -> Result<Built, String> {
     ]))?;
     Ok(Built {
         target,
-        firmware: cross::artifact(&firmware, "firmware")?,
+        firmware,
+        firmware_sensors,
         harness,
         test: cross::artifact(&tests, "on_target")?,
     })
 }
 
-/// Runs the firmware on `core`: exit 0 and one `result` line per contact model.
-fn run_firmware(core: &Cpu, elf: &Path) -> Result<Vec<(String, Run)>, String> {
+/// The firmware example for `target` with `features` (profile `firmware`): its ELF.
+fn build_firmware(target: &str, features: &str) -> Result<PathBuf, String> {
+    let built = cross::build(cross::cargo().args([
+        "build",
+        "--profile",
+        "firmware",
+        "--target",
+        target,
+        "--features",
+        features,
+        "--example",
+        "firmware",
+        "--message-format=json-render-diagnostics",
+    ]))?;
+    cross::artifact(&built, "firmware")
+}
+
+/// Runs the firmware on `core`: exit 0 and one `result` line per contact model; the
+/// results and the whole log.
+fn run_firmware(core: &Cpu, elf: &Path) -> Result<(Vec<(String, Run)>, String), String> {
     let (status, log) = cross::qemu(core.machine, elf)?;
     let results: Vec<(String, Run)> = log.lines().filter_map(parse_result).collect();
     if status != Some(0) || results.len() != MODELS.len() {
@@ -264,12 +461,12 @@ fn run_firmware(core: &Cpu, elf: &Path) -> Result<Vec<(String, Run)>, String> {
     }
     for (model, r) in &results {
         println!(
-            "  firmware {model}: answers match the reference (worst relative error {:.1e}); \
+            "  firmware self-test {model}: answers match the reference (worst relative error {:.1e}); \
              stack {} B, instructions {} mean / {} max",
             r.worst_relative_error, r.stack, r.instructions_mean, r.instructions_max
         );
     }
-    Ok(results)
+    Ok((results, log))
 }
 
 /// `result model=elliptic core=f32 samples=36 failures=0 worst_relative_error=... stack_bytes=...`.

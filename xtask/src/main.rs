@@ -7,6 +7,7 @@ mod firmware;
 mod fit;
 mod fixed_tables;
 mod fuzz;
+mod node;
 mod nopanic;
 mod sweep;
 mod tables;

@@ -1,16 +1,18 @@
-//! The firmware proper (Cortex-M only).
+//! The power-on self-test (Cortex-M only): the estimator of this target against the
+//! f64 reference's answers on the built-in trace (`trace.rs`), before the node starts.
 //!
 //! Every core is reached through the library's estimator contract,
 //! [`misalign::Estimator`]: the f32 core where there is an FPU (Cortex-M4F, M7), the
 //! fixed-point core where there is none (Cortex-M0, M3). The trace, the check against
-//! the reference, the stack and instruction measurements are the same for both.
+//! the reference, the stack and instruction measurements are the same for both; the
+//! `result` lines feed the estimator rows of `cargo xtask firmware`'s size table.
 
 use crate::trace::{self, Answer};
 use misalign::fixed::{FixedEllipticScene, FixedLineScene};
 use misalign::float::{EllipticScene, LineScene};
 use misalign::reference::Regime;
 use misalign::{Error, Estimate, Estimator, Scene};
-use misalign_harness::support::{self, counter::Counter, stack};
+use misalign_harness::support::{counter::Counter, stack};
 
 /// The fixed-point core's LSBs in the firmware: 1 mN and 10 prad per count.
 const LOAD_LSB: f64 = 1e-3;
@@ -84,12 +86,12 @@ fn call<E: Estimator>(core: &E, load: E::Load, phi: E::Angle) -> Result<E::Outpu
     core.estimate(load, phi)
 }
 
-#[cortex_m_rt::entry]
-fn main() -> ! {
-    let peripherals = cortex_m::Peripherals::take().expect("first and only take");
-    let counter = Counter::new(peripherals.SYST);
+/// The self-test: the core of this target over the built-in trace, every answer
+/// against the reference's. Returns the number of mismatches, or the error of a scene
+/// the core refused.
+pub fn run_all(counter: &Counter) -> Result<usize, Error> {
     defmt::println!(
-        "misalign firmware: demo scene, {=usize} elliptic and {=usize} line samples, {=str} core; SysTick ticks per 1000 instructions {=u32}",
+        "self-test: demo scene, {=usize} elliptic and {=usize} line samples, {=str} core; SysTick ticks per 1000 instructions {=u32}",
         trace::ELLIPTIC.len(),
         trace::LINE.len(),
         F32,
@@ -98,53 +100,50 @@ fn main() -> ! {
     let scene = Scene::DEMO;
     let failures = if cfg!(target_abi = "eabihf") {
         // With an FPU: the f32 core.
-        let (elliptic, line) = prepared(EllipticScene::new(&scene), LineScene::new(&scene));
+        let (elliptic, line) = prepared(EllipticScene::new(&scene), LineScene::new(&scene))?;
         run(
             f32_run(&elliptic, "elliptic"),
             &trace::ELLIPTIC,
             &trace::ELLIPTIC_EXPECTED,
-            &counter,
+            counter,
         ) + run(
             f32_run(&line, "line"),
             &trace::LINE,
             &trace::LINE_EXPECTED,
-            &counter,
+            counter,
         )
     } else {
         // Without one: the fixed-point core.
         let (elliptic, line) = prepared(
             FixedEllipticScene::new(&scene, LOAD_LSB, ANGLE_LSB),
             FixedLineScene::new(&scene, LOAD_LSB, ANGLE_LSB),
-        );
+        )?;
         run(
             fixed_run(&elliptic, "elliptic"),
             &trace::ELLIPTIC,
             &trace::ELLIPTIC_EXPECTED,
-            &counter,
+            counter,
         ) + run(
             fixed_run(&line, "line"),
             &trace::LINE,
             &trace::LINE_EXPECTED,
-            &counter,
+            counter,
         )
     };
     if failures == 0 {
-        defmt::println!("all answers within the core's tolerance of the reference");
-        support::exit(0)
+        defmt::println!("self-test: all answers within the core's tolerance of the reference");
+    } else {
+        defmt::error!(
+            "self-test: {=usize} answers differ from the reference",
+            failures
+        );
     }
-    defmt::error!("{=usize} answers differ from the reference", failures);
-    support::exit(1)
+    Ok(failures)
 }
 
-/// Both prepared scenes, or exit 2 with the error.
-fn prepared<A, B>(elliptic: Result<A, Error>, line: Result<B, Error>) -> (A, B) {
-    match (elliptic, line) {
-        (Ok(a), Ok(b)) => (a, b),
-        (Err(e), _) | (_, Err(e)) => {
-            defmt::error!("cannot prepare the demo scene: {}", defmt::Debug2Format(&e));
-            support::exit(2)
-        }
-    }
+/// Both prepared scenes, or the first error.
+fn prepared<A, B>(elliptic: Result<A, Error>, line: Result<B, Error>) -> Result<(A, B), Error> {
+    Ok((elliptic?, line?))
 }
 
 /// Runs the core over `trace`: first every sample once on a painted stack (the deepest
