@@ -124,6 +124,14 @@ fn log_event(e: &Event) {
         EventKind::Approaching { time_to_critical_s } => {
             ("approaching", "-", "-", None, Some(time_to_critical_s))
         }
+        // Not raised here: the node measures no axial force (`Monitor::process`).
+        EventKind::Friction { changed, .. } => (
+            "friction",
+            if changed { "band" } else { "baseline" },
+            "-",
+            None,
+            None,
+        ),
     };
     let r = &e.reading;
     defmt::println!(

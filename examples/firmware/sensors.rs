@@ -20,19 +20,17 @@
 //!   50 mm radius, counted by a free-running u32 counter that the tachometer reads each
 //!   sample.
 //!
-//! A sensor fault becomes the sample's `driver_fault` on the channel of the sensor
-//! (load cell: load; either probe: angle; tachometer: speed), so that the monitor
-//! reports a sensor fault, never slip. (`Sample::from_sensors` with the sensor named in
-//! the event is on its way to the library; until then this is the mapping.)
+//! A sensor fault becomes the sample's sensor fault (`Sample::from_sensors`): the
+//! monitor reports a sensor fault naming the sensor and the reason, never slip.
 
-use misalign::monitor::{Channel, Sample};
+use misalign::monitor::Sample;
 use misalign::sensors::sim::{
     SampleCodes, SimAdc, SimClock, SimDelay, SimDout, SimHx711, SimSck, TraceEncoder,
 };
 use misalign::sensors::{
     CalibrationError, Hx711, Hx711Channel, LoadCalibration, LoadCell, Misalignment,
-    MisalignmentCalibration, ProbeCalibration, ProbeSpec, Rails, RawLimits, SensorFault, SensorId,
-    SensorSample, SpeedCalibration, Tachometer, Timeout,
+    MisalignmentCalibration, ProbeCalibration, ProbeSpec, Rails, RawLimits, SensorSample,
+    SpeedCalibration, Tachometer, Timeout,
 };
 
 /// The HX711's conversion period: 10 samples/s.
@@ -152,17 +150,10 @@ impl<'c> Sensors<'c> {
     }
 }
 
-/// The monitor's sample from the sensors': a fault is the driver fault of its
-/// quantity's channel (its value, 0, is never estimated).
+/// The monitor's sample from the sensors': a fault names its sensor (its value, 0,
+/// is never estimated).
 pub fn to_monitor(time_ms: u32, reading: &SensorSample) -> Sample {
-    let mut sample = Sample::new(time_ms, reading.load_n, reading.phi_rad);
-    sample.speed = reading.speed_m_s;
-    sample.driver_fault = reading.fault.map(|f: SensorFault| match f.sensor {
-        SensorId::Load => Channel::Load,
-        SensorId::Probe1 | SensorId::Probe2 => Channel::Angle,
-        SensorId::Speed => Channel::Speed,
-    });
-    sample
+    Sample::from_sensors(time_ms, reading)
 }
 
 /// A two's-complement ADC's rails (`bits` in 2..=32).

@@ -307,6 +307,14 @@ fn event(e: &misalign::monitor::Event) -> Event {
             "None".into(),
             Some(time_to_critical_s.into()),
         ),
+        // As the node logs it (it measures no axial force, so it raises none).
+        EventKind::Friction { changed, .. } => (
+            "friction",
+            if changed { "band" } else { "baseline" },
+            "-",
+            "None".into(),
+            None,
+        ),
     };
     let r = &e.reading;
     Event {
