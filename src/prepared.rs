@@ -117,7 +117,10 @@ impl<'a> Writer<'a> {
     fn bytes(&mut self, b: &[u8]) {
         let end = self.at.saturating_add(b.len());
         if let Some(out) = self.buf.get_mut(self.at..end) {
-            out.copy_from_slice(b);
+            // (zip, not copy_from_slice: no length check to panic on.)
+            for (o, &x) in out.iter_mut().zip(b) {
+                *o = x;
+            }
         }
         self.at = end;
     }
@@ -155,8 +158,8 @@ impl<'a> Writer<'a> {
         let n = self.buf.len().saturating_sub(4);
         let (body, tail) = self.buf.split_at_mut(n);
         let crc = crc32(body).to_le_bytes();
-        if tail.len() == crc.len() {
-            tail.copy_from_slice(&crc);
+        for (o, &x) in tail.iter_mut().zip(&crc) {
+            *o = x;
         }
     }
 }
