@@ -12,17 +12,35 @@
 //!   own `memory.x` includes the same file; a layout cannot simply be a `memory.x`
 //!   on the search path, since the linker looks in its current directory first.)
 //!
-//! On the host it does nothing. The library `misalign` has no build script.
+//! - `prepared.rs` (every target, `harness/src/prepared.rs` includes it): the demo
+//!   scene [`Scene::DEMO`] prepared here, on the host, as the bytes of
+//!   `misalign::prepared` for every scene type, and the fixed-point LSBs of the images:
+//!   the build-time scenes of the `_const` and node images, which link no f64
+//!   preparation.
+//!
+//! Besides that, on the host it does nothing. The library `misalign` has no build
+//! script.
 
+use misalign::Scene;
+use misalign::fixed::{FixedEllipticScene, FixedLineScene};
+use misalign::float::{EllipticScene, LineScene};
+use misalign::monitor::{model_for_range, scenario};
+use misalign::reference::ModelChoice;
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+/// The fixed-point core's LSBs in every image (N and rad per count).
+const LOAD_LSB: f64 = 1e-3;
+const ANGLE_LSB: f64 = 1e-11;
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-env-changed=MISALIGN_MEMORY_X");
+    let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
+    write(&out, "prepared.rs", &prepared());
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }
-    let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
     let here = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("manifest dir"));
     let layout = chosen_layout(&here);
     println!("cargo:rerun-if-changed={}", layout.display());
@@ -56,4 +74,74 @@ fn chosen_layout(here: &Path) -> PathBuf {
 
 fn write(dir: &Path, name: &str, text: &str) {
     std::fs::write(dir.join(name), text).unwrap_or_else(|e| panic!("write {name}: {e}"));
+}
+
+/// The demo scene prepared on the host, as Rust source: the LSBs and one byte array per
+/// scene type (`misalign::prepared`'s format).
+fn prepared() -> String {
+    let scene = Scene::DEMO;
+    // The node image runs the model the monitor's rule picks for the scenario's
+    // operating range: the ellipse, for which it loads the elliptic scene.
+    let choice = model_for_range(&scene, scenario::LOAD_MAX, scenario::ANGLE_MIN)
+        .expect("the demo scene has a model for its range");
+    assert_eq!(
+        choice,
+        ModelChoice::Elliptic,
+        "the node image expects the ellipse"
+    );
+    let arrays: [(&str, &str, Vec<u8>); 4] = [
+        (
+            "FIXED_ELLIPTIC",
+            "`fixed::FixedEllipticScene` at the LSBs",
+            FixedEllipticScene::new(&scene, LOAD_LSB, ANGLE_LSB)
+                .unwrap_or_else(refused)
+                .to_bytes()
+                .to_vec(),
+        ),
+        (
+            "FIXED_LINE",
+            "`fixed::FixedLineScene` at the LSBs",
+            FixedLineScene::new(&scene, LOAD_LSB, ANGLE_LSB)
+                .unwrap_or_else(refused)
+                .to_bytes()
+                .to_vec(),
+        ),
+        (
+            "ELLIPTIC",
+            "`float::EllipticScene` (its constants; the image names the tables)",
+            EllipticScene::new(&scene)
+                .unwrap_or_else(refused)
+                .to_bytes()
+                .to_vec(),
+        ),
+        (
+            "LINE",
+            "`float::LineScene`",
+            LineScene::new(&scene)
+                .unwrap_or_else(refused)
+                .to_bytes()
+                .to_vec(),
+        ),
+    ];
+    let mut rs = format!(
+        "// Written by harness/build.rs: Scene::DEMO prepared on the host.\n\
+         /// The fixed-point core's load LSB in the images (N per count).\n\
+         pub const LOAD_LSB: f64 = {LOAD_LSB:?};\n\
+         /// The fixed-point core's angle LSB in the images (rad per count).\n\
+         pub const ANGLE_LSB: f64 = {ANGLE_LSB:?};\n"
+    );
+    for (name, what, bytes) in arrays {
+        writeln!(
+            rs,
+            "/// Scene::DEMO as {what}, prepared at build time.\n\
+             pub static {name}: [u8; {}] = {bytes:?};",
+            bytes.len()
+        )
+        .unwrap();
+    }
+    rs
+}
+
+fn refused<T>(e: misalign::Error) -> T {
+    panic!("Scene::DEMO does not prepare: {e}")
 }

@@ -53,6 +53,7 @@ pub mod estimator;
 pub mod fixed;
 pub mod float;
 pub mod monitor;
+pub mod prepared;
 pub mod reference;
 pub mod scene;
 mod sensor_fault;

@@ -20,10 +20,9 @@ static SAMPLE: [f32; 2] = [1000.0, 2e-4];
 /// The same sample for the fixed-point core: counts of [`LOAD_LSB`] and [`ANGLE_LSB`].
 static COUNTS: (u32, i32) = (1_000_000, 20_000_000);
 
-/// The fixed-point core's load LSB in the minimal images (N per count).
-pub const LOAD_LSB: f64 = 1e-3;
-/// The fixed-point core's angle LSB in the minimal images (rad per count).
-pub const ANGLE_LSB: f64 = 1e-11;
+/// The fixed-point core's LSBs in the minimal images (N and rad per count), from the
+/// build script, which prepares the build-time scenes with the same.
+pub use crate::prepared::{ANGLE_LSB, LOAD_LSB};
 
 /// `*x` through a volatile read: the optimiser cannot know the value.
 pub fn read<T: Copy>(x: &T) -> T {

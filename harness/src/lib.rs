@@ -7,7 +7,8 @@
 //! - [`log_panics_and_faults!`] and [`exit_on_panic!`]: the panic (and HardFault)
 //!   handlers, as macros, since an image has exactly one and the no-panic images have
 //!   panic-never's;
-//! - [`io`]: the minimal and no-panic images' inputs (volatile reads) and outputs.
+//! - [`io`]: the minimal and no-panic images' inputs (volatile reads) and outputs;
+//! - [`prepared`]: the demo scene prepared at build time (bytes from the build script).
 //!
 //! Its build script writes the memory layout for every image that depends on it (the
 //! firmware example and the on-target tests too): `MISALIGN_MEMORY_X`, or the QEMU
@@ -16,6 +17,7 @@
 
 pub mod io;
 mod panic;
+pub mod prepared;
 pub mod support;
 
 /// The runtime, for the handler macros.

@@ -5,6 +5,9 @@ use super::{
     FixedDetails, FixedEllipticScene, FixedEstimate, FixedLineDetails, FixedLineScene, InputRange,
     Log2, constant,
 };
+use crate::prepared::{
+    Kind, PreparedError, Reader, choice_byte, models_present, read_choice, seal,
+};
 use crate::reference::{ContactModel, MODEL_SWITCH_BAND, ModelChoice, line_may_answer};
 use crate::{Error, Scene};
 
@@ -219,5 +222,61 @@ impl crate::Estimator for FixedAuto {
     }
     fn with_risk_slip_ratio(self, slip_ratio: f32) -> Result<Self, Error> {
         FixedAuto::with_risk_slip_ratio(self, slip_ratio)
+    }
+}
+
+impl FixedAuto {
+    /// The length of [`FixedAuto::to_bytes`].
+    pub const BYTES: usize = crate::prepared::OVERHEAD + Self::PAYLOAD;
+    const PAYLOAD: usize = 1 + FixedEllipticScene::PAYLOAD + 1 + FixedLineScene::PAYLOAD + 14 + 8;
+
+    /// The prepared scene as bytes (format in [`crate::prepared`]): both models'
+    /// constants (each after a flag byte, zeros when absent), log2(length / 2) after a
+    /// flag byte, log2 of the switch band, the model choice, log2 of the risk threshold
+    /// and the units.
+    pub fn to_bytes(&self) -> [u8; Self::BYTES] {
+        seal(Kind::FixedAuto, |w| {
+            w.option(
+                self.elliptic.as_ref(),
+                FixedEllipticScene::PAYLOAD,
+                |e, w| e.write(w),
+            );
+            w.option(self.line.as_ref(), FixedLineScene::PAYLOAD, |l, w| {
+                l.write(w)
+            });
+            w.option(self.log_half_length.as_ref(), 4, |l, w| w.i32(*l));
+            w.i32(self.log_band);
+            w.u8(choice_byte(self.choice));
+            w.i32(self.log_risk);
+            self.units.write(w);
+        })
+    }
+
+    /// The scene [`FixedAuto::to_bytes`] wrote, checked with integer operations only;
+    /// it answers bit for bit as the scene that wrote it.
+    ///
+    /// # Errors
+    /// A [`PreparedError`] for a wrong length, magic, kind, version or checksum, or a
+    /// constant that [`FixedAuto::new`] does not produce.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, PreparedError> {
+        let r = &mut Reader::open(bytes, Kind::FixedAuto, Self::BYTES)?;
+        let elliptic = r.option(FixedEllipticScene::PAYLOAD, FixedEllipticScene::read)?;
+        let line = r.option(FixedLineScene::PAYLOAD, FixedLineScene::read)?;
+        let log_half_length = r.option(4, super::read_constant)?;
+        let log_band = super::read_constant(r)?;
+        let choice = read_choice(r)?;
+        let log_risk = super::read_constant(r)?;
+        let units = super::Units::read(r)?;
+        // The model a choice forces is there, and some model is.
+        models_present(choice, elliptic.is_some(), line.is_some())?;
+        Ok(FixedAuto {
+            elliptic,
+            line,
+            log_half_length,
+            log_band,
+            choice,
+            log_risk,
+            units,
+        })
     }
 }

@@ -7,9 +7,10 @@ use super::tables::{
 use super::uniform::{ONE, UniformTable};
 use super::{
     FixedEstimate, InputRange, LOG2_HALF_PI, Log2, Units, angle_max, constant, constant_below,
-    log_risk, log2_result, margin_counts, output_range,
+    log_risk, log2_result, margin_counts, output_range_thirds, read_constant,
 };
 use crate::estimator::DEFAULT_RISK_SLIP_RATIO;
+use crate::prepared::{Kind, PreparedError, Reader, Writer, seal, value};
 use crate::reference::{Regime, hertz_scale};
 use crate::{Error, Scene, ThetaRelation};
 use core::f64::consts::PI;
@@ -112,21 +113,26 @@ impl FixedEllipticScene {
     /// table values (|log2| < 42) to constants (|log2| < 100) and counts (< 32) and stay
     /// inside i32 by construction.
     fn check_sums(&self) -> Result<(), Error> {
-        let one = ONE as f64;
-        let lp_min = log2_u32(self.range.load_min) as f64; // load_min >= 1
-        let lp_max = 32.0 * one;
+        // In i64 and times 3 (the thirds of log2 P exact): integers only, so that
+        // scenes loaded from bytes are checked without floating point.
+        let one = ONE as i64;
+        let lp_min = log2_u32(self.range.load_min) as i64; // load_min >= 1
+        let lp_max = 32 * one;
         // g from one angle count up to g(pi/2) = pi/2; one octave for the tables' error.
-        let g_min = lookup(LOG_G_LOW, LOG_G_HIGH, self.log_theta_lsb)? as f64 - one;
-        let g_max = LOG2_HALF_PI as f64 + one;
-        let slip = self.log_slip as f64;
-        let slip_min = slip + g_min - lp_max / 3.0;
-        let slip_max = slip + g_max - lp_min / 3.0;
-        output_range(slip_min, slip_max)?;
+        let g_min = lookup(LOG_G_LOW, LOG_G_HIGH, self.log_theta_lsb)? as i64 - one;
+        let g_max = LOG2_HALF_PI as i64 + one;
+        let slip = self.log_slip as i64;
+        let slip_min = 3 * (slip + g_min) - lp_max;
+        let slip_max = 3 * (slip + g_max) - lp_min;
+        output_range_thirds(slip_min, slip_max)?;
         // F / (mu P) = s r(s), log2 r in [0, 1.25] (eq 21), one octave for the table:
         // F grows like P^(2/3) in partial slip and like P in gross slip.
-        let force = self.log_force as f64;
-        let partial_min = force + slip + g_min + lp_min - lp_min / 3.0 - one;
-        output_range(f64::min(partial_min, force + lp_min), force + lp_max)
+        let force = self.log_force as i64;
+        let partial_min = 3 * (force + slip + g_min + lp_min - one) - lp_min;
+        output_range_thirds(
+            i64::min(partial_min, 3 * (force + lp_min)),
+            3 * (force + lp_max),
+        )
     }
 
     /// The finest angle LSB (rad) this scene accepts: one count must give theta >= 2^-40,
@@ -356,5 +362,74 @@ pub(super) fn zero_load(a: u32, log_risk: i32) -> FixedEstimate {
         critical_angle: Some(Log2::ZERO),
         margin: Some(0i32.saturating_sub_unsigned(a)),
         microslip_risk: slip.0 >= log_risk,
+    }
+}
+
+impl FixedEllipticScene {
+    /// The length of [`FixedEllipticScene::to_bytes`].
+    pub const BYTES: usize = crate::prepared::OVERHEAD + Self::PAYLOAD;
+    pub(super) const PAYLOAD: usize = 48;
+
+    /// The prepared scene as bytes (format in [`crate::prepared`]): for a scene
+    /// prepared on a host and loaded on the node with [`FixedEllipticScene::from_bytes`].
+    pub fn to_bytes(&self) -> [u8; Self::BYTES] {
+        seal(Kind::FixedElliptic, |w| self.write(w))
+    }
+
+    /// The scene [`FixedEllipticScene::to_bytes`] wrote, checked with integer
+    /// operations only; it answers bit for bit as the scene that wrote it.
+    ///
+    /// # Errors
+    /// A [`PreparedError`] for a wrong length, magic, kind, version or checksum, or a
+    /// constant that [`FixedEllipticScene::new`] does not produce.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, PreparedError> {
+        Self::read(&mut Reader::open(bytes, Kind::FixedElliptic, Self::BYTES)?)
+    }
+
+    pub(super) fn write(&self, w: &mut Writer<'_>) {
+        for x in [
+            self.log_theta_lsb,
+            self.log_slip,
+            self.log_critical,
+            self.log_radius_factor,
+            self.log_force,
+            self.log_risk,
+            self.log_hertz,
+            self.log_pressure,
+        ] {
+            w.i32(x);
+        }
+        w.u32(self.range.load_min);
+        w.u32(self.range.angle_max);
+        self.units.write(w);
+    }
+
+    pub(super) fn read(r: &mut Reader<'_>) -> Result<Self, PreparedError> {
+        let mut c = [0i32; 8];
+        for x in &mut c {
+            *x = read_constant(r)?;
+        }
+        let scene = FixedEllipticScene {
+            log_theta_lsb: c[0],
+            log_slip: c[1],
+            log_critical: c[2],
+            log_radius_factor: c[3],
+            log_force: c[4],
+            log_risk: c[5],
+            log_hertz: c[6],
+            log_pressure: c[7],
+            range: InputRange {
+                load_min: r.u32(),
+                angle_max: r.u32(),
+            },
+            units: Units::read(r)?,
+        };
+        value(
+            scene.log_theta_lsb >= LOG_G_LOW.start
+                && scene.range.load_min >= 1
+                && (1..=1 << 31).contains(&scene.range.angle_max),
+        )?;
+        scene.check_sums().map_err(|_| PreparedError::Value)?;
+        Ok(scene)
     }
 }

@@ -5,9 +5,10 @@ use super::logexp::{exp2_fixed, log2_u32};
 use super::uniform::ONE;
 use super::{
     FixedEstimate, InputRange, Log2, Units, angle_max, constant, constant_below, log_risk,
-    margin_counts, output_range,
+    margin_counts, output_range_thirds, read_constant,
 };
 use crate::estimator::DEFAULT_RISK_SLIP_RATIO;
+use crate::prepared::{Kind, PreparedError, Reader, Writer, seal, value};
 use crate::reference::Regime;
 use crate::{Error, Scene};
 use core::f64::consts::PI;
@@ -90,18 +91,20 @@ impl FixedLineScene {
     /// Bounds every per-sample sum of [`FixedLineScene::estimate`] over the declared
     /// range (loads of 1 to 2^32 counts, angles of 1 to `angle_max` counts), in i64.
     fn check_sums(&self) -> Result<(), Error> {
-        let one = ONE as f64;
-        let half_lp_max = 16.0 * one;
-        let la_max = log2_u32(self.range.angle_max) as f64 + one;
+        // In i64 (exact, integers only: scenes loaded from bytes are checked alike),
+        // times 3 for `output_range_thirds`.
+        let one = ONE as i64;
+        let half_lp_max = 16 * one;
+        let la_max = log2_u32(self.range.angle_max) as i64 + one;
         // phi0 in counts (eq 28), what the margin is formed from.
-        let critical = self.log_critical as f64 - self.log_angle_lsb as f64;
-        output_range(critical, critical + half_lp_max)?;
+        let critical = self.log_critical as i64 - self.log_angle_lsb as i64;
+        output_range_thirds(3 * critical, 3 * (critical + half_lp_max))?;
         // d/b (eq 23): |phi| / sqrt(P).
-        let slip = self.log_slip as f64;
-        output_range(slip - half_lp_max, slip + la_max)?;
+        let slip = self.log_slip as i64;
+        output_range_thirds(3 * (slip - half_lp_max), 3 * (slip + la_max))?;
         // F = mu P s (2 - s) grows like sqrt(P) in partial slip (eq 27), like P beyond.
-        let force = self.log_force as f64;
-        output_range(f64::min(force + slip, force), force + 32.0 * one)
+        let force = self.log_force as i64;
+        output_range_thirds(3 * i64::min(force + slip, force), 3 * (force + 32 * one))
     }
 
     /// The same scene with another d/b threshold for the risk flag.
@@ -203,4 +206,66 @@ pub struct FixedLineDetails {
     pub b: Log2,
     /// Peak pressure p0 (Pa).
     pub p0: Log2,
+}
+
+impl FixedLineScene {
+    /// The length of [`FixedLineScene::to_bytes`].
+    pub const BYTES: usize = crate::prepared::OVERHEAD + Self::PAYLOAD;
+    pub(super) const PAYLOAD: usize = 44;
+
+    /// The prepared scene as bytes (format in [`crate::prepared`]).
+    pub fn to_bytes(&self) -> [u8; Self::BYTES] {
+        seal(Kind::FixedLine, |w| self.write(w))
+    }
+
+    /// The scene [`FixedLineScene::to_bytes`] wrote, checked with integer operations
+    /// only; it answers bit for bit as the scene that wrote it.
+    ///
+    /// # Errors
+    /// A [`PreparedError`] for a wrong length, magic, kind, version or checksum, or a
+    /// constant that [`FixedLineScene::new`] does not produce.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, PreparedError> {
+        Self::read(&mut Reader::open(bytes, Kind::FixedLine, Self::BYTES)?)
+    }
+
+    pub(super) fn write(&self, w: &mut Writer<'_>) {
+        for x in [
+            self.log_slip,
+            self.log_critical,
+            self.log_angle_lsb,
+            self.log_force,
+            self.log_risk,
+            self.log_width,
+            self.log_pressure,
+        ] {
+            w.i32(x);
+        }
+        w.u32(self.range.load_min);
+        w.u32(self.range.angle_max);
+        self.units.write(w);
+    }
+
+    pub(super) fn read(r: &mut Reader<'_>) -> Result<Self, PreparedError> {
+        let mut c = [0i32; 7];
+        for x in &mut c {
+            *x = read_constant(r)?;
+        }
+        let scene = FixedLineScene {
+            log_slip: c[0],
+            log_critical: c[1],
+            log_angle_lsb: c[2],
+            log_force: c[3],
+            log_risk: c[4],
+            log_width: c[5],
+            log_pressure: c[6],
+            range: InputRange {
+                load_min: r.u32(),
+                angle_max: r.u32(),
+            },
+            units: Units::read(r)?,
+        };
+        value(scene.range.load_min == 1 && (1..=1 << 31).contains(&scene.range.angle_max))?;
+        scene.check_sums().map_err(|_| PreparedError::Value)?;
+        Ok(scene)
+    }
 }

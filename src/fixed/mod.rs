@@ -41,6 +41,7 @@ pub use line::{FixedLineDetails, FixedLineScene};
 pub use logexp::EXP2_MAX_REL_ERROR;
 
 use crate::Error;
+use crate::prepared::{PreparedError, Reader, Writer};
 use crate::reference::Regime;
 use logexp::exp2_fixed;
 use uniform::ONE;
@@ -173,6 +174,21 @@ impl Units {
         }
     }
 
+    pub(crate) fn write(&self, w: &mut Writer<'_>) {
+        w.f32(self.load_lsb);
+        w.f32(self.angle_lsb);
+    }
+
+    /// Units from prepared bytes: both positive normal f32, as [`Units::new`] makes them.
+    pub(crate) fn read(r: &mut Reader<'_>) -> Result<Self, PreparedError> {
+        let load_lsb = crate::prepared::positive_normal(r.f32())?;
+        let angle_lsb = crate::prepared::positive_normal(r.f32())?;
+        Ok(Units {
+            load_lsb,
+            angle_lsb,
+        })
+    }
+
     /// A sample in N and rad as counts, rounded to the nearest.
     #[inline]
     pub(crate) fn counts(&self, load: f32, phi: f32) -> Result<(u32, i32), Error> {
@@ -279,7 +295,7 @@ fn margin_counts(log_phi0_counts: i32, a: u32) -> i32 {
 
 /// Q8.24 log2 of a positive f64 scene constant, within +-100. The per-sample sums
 /// that add such constants to logarithms of counts are bounded when the scene is
-/// prepared ([`output_range`]), so that they cannot leave the i32 range.
+/// prepared ([`output_range_thirds`]), so that they cannot leave the i32 range.
 fn constant(x: f64) -> Result<i32, Error> {
     let l = Log2::from_f64(x)?.0;
     if l.unsigned_abs() < 100 << 24 {
@@ -302,18 +318,25 @@ fn constant_below(x: f64) -> Result<i32, Error> {
 /// [`Log2::from_f64`] accepts, and far from the values that stand for 0 and infinity.
 const LOG2_RESULT_LIMIT: i64 = 126 << 24;
 
-/// [`Error::OutOfRange`] unless the bounds `lo..=hi` of a per-sample log2 (Q8.24, worked
-/// out in f64, exact for these integers, when a scene is prepared) lie within
+/// [`Error::OutOfRange`] unless the bounds `lo..=hi` of a per-sample log2 (Q8.24),
+/// both given times 3 (exact integers, when a scene is prepared or loaded), lie within
 /// [`LOG2_RESULT_LIMIT`]. A scene that passes adds its per-sample logarithms with
 /// wrapping (never wrapping) arithmetic, and none of its results stands for 0 or
 /// infinity at a load above 0.
-fn output_range(lo: f64, hi: f64) -> Result<(), Error> {
-    let limit = LOG2_RESULT_LIMIT as f64;
+fn output_range_thirds(lo: i64, hi: i64) -> Result<(), Error> {
+    let limit = 3 * LOG2_RESULT_LIMIT;
     if -limit <= lo && hi <= limit {
         Ok(())
     } else {
         Err(Error::OutOfRange)
     }
+}
+
+/// A Q8.24 scene constant from prepared bytes: within +-100, as [`constant`] makes it.
+fn read_constant(r: &mut Reader<'_>) -> Result<i32, PreparedError> {
+    let l = r.i32();
+    crate::prepared::value(l.unsigned_abs() < 100 << 24)?;
+    Ok(l)
 }
 
 /// A log2 in i64 (the `details` sums of a few i32, which cannot wrap i64) as [`Log2`],

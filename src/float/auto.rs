@@ -2,6 +2,10 @@
 //! P / length when the ellipse is longer than the rollers, as `reference::estimate`.
 
 use super::{Details, EllipticScene, Estimate, LineDetails, LineScene, check};
+use crate::prepared::{
+    Kind, PreparedError, Reader, choice_byte, models_present, positive_finite, positive_normal,
+    read_choice, seal,
+};
 use crate::reference::{ContactModel, MODEL_SWITCH_BAND, ModelChoice, line_may_answer};
 use crate::{Error, Scene};
 use core::f32::consts::FRAC_PI_2;
@@ -203,5 +207,54 @@ impl crate::Estimator for Auto {
     }
     fn with_risk_slip_ratio(self, slip_ratio: f32) -> Result<Self, Error> {
         Auto::with_risk_slip_ratio(self, slip_ratio)
+    }
+}
+
+impl Auto {
+    /// The length of [`Auto::to_bytes`].
+    pub const BYTES: usize =
+        crate::prepared::OVERHEAD + 1 + EllipticScene::PAYLOAD + 1 + LineScene::PAYLOAD + 9;
+
+    /// The prepared scene as bytes (format in [`crate::prepared`]): both models'
+    /// constants (each after a flag byte, zeros when absent), 2 / length, the model
+    /// choice and the risk threshold. The ellipse loads with the full tables.
+    pub fn to_bytes(&self) -> [u8; Self::BYTES] {
+        seal(Kind::Auto, |w| {
+            w.option(self.elliptic.as_ref(), EllipticScene::PAYLOAD, |e, w| {
+                e.write(w)
+            });
+            w.option(self.line.as_ref(), LineScene::PAYLOAD, |l, w| l.write(w));
+            w.f32(self.two_over_length);
+            w.u8(choice_byte(self.choice));
+            w.f32(self.risk_slip_ratio);
+        })
+    }
+
+    /// The scene [`Auto::to_bytes`] wrote, checked on the bits of its constants (no
+    /// floating-point operation); it answers bit for bit as the scene that wrote it.
+    ///
+    /// # Errors
+    /// A [`PreparedError`] for a wrong length, magic, kind, version or checksum, or a
+    /// constant that [`Auto::new`] does not produce.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, PreparedError> {
+        let r = &mut Reader::open(bytes, Kind::Auto, Self::BYTES)?;
+        let elliptic = r.option(EllipticScene::PAYLOAD, |r| {
+            EllipticScene::read(r, super::Tables::FULL)
+        })?;
+        let line = r.option(LineScene::PAYLOAD, LineScene::read)?;
+        let two_over_length = r.f32();
+        if two_over_length.to_bits() != 0 {
+            positive_normal(two_over_length)?;
+        }
+        let choice = read_choice(r)?;
+        let risk_slip_ratio = positive_finite(r.f32())?;
+        models_present(choice, elliptic.is_some(), line.is_some())?;
+        Ok(Auto {
+            elliptic,
+            line,
+            two_over_length,
+            choice,
+            risk_slip_ratio,
+        })
     }
 }

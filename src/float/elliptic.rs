@@ -7,6 +7,9 @@ use super::octave::OctaveTable;
 use super::tables;
 use super::{DEFAULT_RISK_SLIP_RATIO, Estimate, check};
 use crate::estimator::check_risk;
+use crate::prepared::{
+    Kind, PreparedError, Reader, Writer, positive_finite, positive_normal, seal, value,
+};
 use crate::reference::hertz_scale;
 use crate::{Error, Scene, ThetaRelation};
 use core::f32::consts::{FRAC_PI_2, PI};
@@ -22,6 +25,9 @@ const NORMAL_LOAD_SPAN: u32 = 0x7b80_0000 - 0x0380_0000; // up to 2^120
 /// mu at and above which F = mu P could overflow f32 at a load of 2^120 N (the hot
 /// path's heaviest): mu P < 2^127 below it.
 const FRICTION_LIMIT: f64 = 128.0;
+/// The largest slip gain A that preparing accepts, rounded up to f32 (a test holds it
+/// to `f32::MAX / 2 x cbrt(2^-149) / (pi/2)`): d/b at the lightest load fits f32.
+const SLIP_GAIN_LIMIT: f32 = 1.212_09e23;
 
 /// The tables one elliptic scene reads per sample: g(theta) (eqs 5, 6, 16) and its
 /// inverse (eq 18). [`Tables::FULL`] covers theta from 0 to pi/2; a firmware whose
@@ -348,4 +354,99 @@ pub struct Details {
     pub b: f32,
     /// Peak pressure p0 (Pa), eq (7).
     pub p0: f32,
+}
+
+impl EllipticScene<'static> {
+    /// The length of [`EllipticScene::to_bytes`].
+    pub const BYTES: usize = crate::prepared::OVERHEAD + Self::PAYLOAD;
+    pub(super) const PAYLOAD: usize = 28;
+
+    /// The scene [`EllipticScene::to_bytes`] wrote, with the full tables, checked on
+    /// the bits of its constants (no floating-point operation); it answers bit for bit
+    /// as the scene that wrote it (with the same tables).
+    ///
+    /// # Errors
+    /// A [`PreparedError`] for a wrong length, magic, kind, version or checksum, or a
+    /// constant that [`EllipticScene::new`] does not produce.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, PreparedError> {
+        Self::from_bytes_with_tables(bytes, Tables::FULL)
+    }
+}
+
+impl<'t> EllipticScene<'t> {
+    /// The prepared constants as bytes (format in [`crate::prepared`]); the tables are
+    /// not in them: the loading firmware names its own.
+    pub fn to_bytes(&self) -> [u8; EllipticScene::BYTES] {
+        seal(Kind::Elliptic, |w| self.write(w))
+    }
+
+    /// As [`EllipticScene::from_bytes`], with the given tables (see [`Tables`]).
+    ///
+    /// # Errors
+    /// As [`EllipticScene::from_bytes`].
+    pub fn from_bytes_with_tables(bytes: &[u8], tables: Tables<'t>) -> Result<Self, PreparedError> {
+        Self::read(
+            &mut Reader::open(bytes, Kind::Elliptic, EllipticScene::BYTES)?,
+            tables,
+        )
+    }
+
+    pub(super) fn write(&self, w: &mut Writer<'_>) {
+        for x in [
+            self.radius_factor,
+            self.inv_radius_factor,
+            self.slip_gain,
+            self.critical_gain,
+            self.friction,
+            self.hertz_gain,
+            self.risk_slip_ratio,
+        ] {
+            w.f32(x);
+        }
+    }
+
+    pub(super) fn read(r: &mut Reader<'_>, tables: Tables<'t>) -> Result<Self, PreparedError> {
+        let mut c = [0.0f32; 6];
+        for x in &mut c {
+            *x = positive_normal(r.f32())?;
+        }
+        let risk_slip_ratio = positive_finite(r.f32())?;
+        // On the bits (positive f32 order as their bits): 2^-40 <= c <= 1, A within
+        // `SLIP_GAIN_LIMIT`, mu at most 128 (the f32 of a mu below 128).
+        let bits = |x: f32| x.to_bits();
+        value(
+            bits(SMALL_THETA) <= bits(c[0])
+                && bits(c[0]) <= bits(1.0)
+                && bits(c[2]) <= bits(SLIP_GAIN_LIMIT)
+                && bits(c[4]) <= bits(FRICTION_LIMIT as f32),
+        )?;
+        Ok(EllipticScene {
+            radius_factor: c[0],
+            inv_radius_factor: c[1],
+            slip_gain: c[2],
+            critical_gain: c[3],
+            friction: c[4],
+            hertz_gain: c[5],
+            risk_slip_ratio,
+            tables,
+        })
+    }
+}
+
+#[cfg(test)]
+mod prepared_tests {
+    use super::SLIP_GAIN_LIMIT;
+
+    /// The bound that `from_bytes` checks on the bits is the one `with_tables` applies
+    /// in f64, rounded up to f32 (within 1e-5): no prepared scene is refused.
+    #[test]
+    fn slip_gain_limit_is_the_preparation_bound_rounded_up() {
+        let lightest_cbrt = libm::cbrt(f32::from_bits(1) as f64);
+        let bound = f32::MAX as f64 / 2.0 * lightest_cbrt / core::f64::consts::FRAC_PI_2;
+        let limit = SLIP_GAIN_LIMIT as f64;
+        assert!(
+            bound <= limit && limit <= bound * (1.0 + 1e-5),
+            "{bound} {limit}"
+        );
+    }
 }

@@ -6,7 +6,7 @@
 //!
 //! - mu: `K = mu d/b` from the forward path (`g(theta)` table, eq 16), then s from
 //!   `f(s)/s = F/(K P)` by Newton steps on the axial-force kernel's polynomials
-//!   ([`crate::float::kernels::axial_force_inverse`]), `mu = K / s`; line contact in closed
+//!   (the kernel `float::kernels::axial_force_inverse`), `mu = K / s`; line contact in closed
 //!   form (`mu = K / (2 - F/(K P))`, eqs 23, 27).
 //! - phi: s from `f(s) = F/(mu P)` by the same kernel inverse, then eq (16) solved for
 //!   `g = s P^(1/3) / A` and theta from the inverse table `theta(g)` that the critical

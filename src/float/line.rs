@@ -3,6 +3,9 @@
 use super::kernels::sqrt::inv_sqrt;
 use super::{DEFAULT_RISK_SLIP_RATIO, Estimate, check};
 use crate::estimator::check_risk;
+use crate::prepared::{
+    Kind, PreparedError, Reader, Writer, positive_finite, positive_normal, seal, value,
+};
 use crate::{Error, Scene};
 use core::f32::consts::FRAC_PI_2;
 
@@ -235,5 +238,67 @@ fn f32_below(x: f64) -> f32 {
         y.next_down()
     } else {
         y
+    }
+}
+
+impl LineScene {
+    /// The length of [`LineScene::to_bytes`].
+    pub const BYTES: usize = crate::prepared::OVERHEAD + Self::PAYLOAD;
+    pub(super) const PAYLOAD: usize = 32;
+
+    /// The prepared scene as bytes (format in [`crate::prepared`]).
+    pub fn to_bytes(&self) -> [u8; Self::BYTES] {
+        seal(Kind::Line, |w| self.write(w))
+    }
+
+    /// The scene [`LineScene::to_bytes`] wrote, checked on the bits of its constants
+    /// (no floating-point operation); it answers bit for bit as the scene that wrote it.
+    ///
+    /// # Errors
+    /// A [`PreparedError`] for a wrong length, magic, kind, version or checksum, or a
+    /// constant that [`LineScene::new`] does not produce.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, PreparedError> {
+        Self::read(&mut Reader::open(bytes, Kind::Line, Self::BYTES)?)
+    }
+
+    pub(super) fn write(&self, w: &mut Writer<'_>) {
+        for x in [
+            self.slip_gain,
+            self.critical_gain,
+            self.friction,
+            self.width_gain,
+            self.pressure_gain,
+            self.risk_slip_ratio,
+        ] {
+            w.f32(x);
+        }
+        w.u32(self.load_min_bits);
+        w.u32(self.load_span_bits);
+    }
+
+    pub(super) fn read(r: &mut Reader<'_>) -> Result<Self, PreparedError> {
+        let mut c = [0.0f32; 5];
+        for x in &mut c {
+            *x = positive_normal(r.f32())?;
+        }
+        let risk_slip_ratio = positive_finite(r.f32())?;
+        let (load_min_bits, load_span_bits) = (r.u32(), r.u32());
+        // The load range: positive f32 from the lightest up to at most f32::MAX.
+        value(
+            load_min_bits != 0
+                && load_min_bits
+                    .checked_add(load_span_bits)
+                    .is_some_and(|heaviest| heaviest <= f32::MAX.to_bits()),
+        )?;
+        Ok(LineScene {
+            slip_gain: c[0],
+            critical_gain: c[1],
+            friction: c[2],
+            width_gain: c[3],
+            pressure_gain: c[4],
+            risk_slip_ratio,
+            load_min_bits,
+            load_span_bits,
+        })
     }
 }

@@ -11,7 +11,9 @@
 
 /// `R_D(x, y, z) = 3/2 ∫_0^∞ dt / ((t+x)^(1/2) (t+y)^(1/2) (t+z)^(3/2))` for
 /// `x, y >= 0` (at most one zero) and `z > 0`, by the duplication theorem and
-/// Carlson's fifth-order series (DLMF 19.36.2). Relative error a few ulps.
+/// Carlson's fifth-order series (DLMF 19.36.2). Relative error a few ulps. The
+/// reference itself takes the pair (below); this one is the tests' and tooling's.
+#[cfg(any(test, feature = "_internals"))]
 pub fn carlson_rd(x: f64, y: f64, z: f64) -> f64 {
     #[cfg(test)]
     super::cost::count_rd();
