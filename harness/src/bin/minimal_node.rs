@@ -96,5 +96,13 @@ fn log(event: &Event) {
             time_to_critical_s,
             r.slip_ratio
         ),
+        // Not raised: this node measures no axial force (`Monitor::process`).
+        EventKind::Friction { mu, changed } => defmt::info!(
+            "event {=u32} at {=u32} ms: friction {=f32}, outside the band {=bool}",
+            event.seq,
+            event.time_ms,
+            mu,
+            changed
+        ),
     }
 }
