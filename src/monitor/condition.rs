@@ -75,7 +75,15 @@ impl Window {
 
     /// Appends a finite value, dropping the oldest beyond `n` values (n >= 1).
     pub(crate) fn push_back(&mut self, x: f32, n: usize) {
-        while self.len() >= n.clamp(1, CAP) {
+        let n = n.clamp(1, CAP);
+        while self.len() > n {
+            self.pop_oldest(); // only after a restore into a shorter window
+        }
+        let len = self.len();
+        if len == n && self.replace_oldest(x) {
+            return;
+        }
+        while self.len() >= n {
             self.pop_oldest();
         }
         let len = self.len();
@@ -86,11 +94,43 @@ impl Window {
         // After the values <= x, before the first greater one.
         self.sorted[len] = x;
         let mut k = len;
-        while k > 0 && self.sorted[k - 1] > x {
+        while k > 0 && greater(self.sorted[k - 1], x) {
             self.sorted.swap(k - 1, k);
             k -= 1;
         }
         self.len = (len + 1) as u8;
+    }
+
+    /// In a full window: `x` takes the oldest value's place in the ring and in the
+    /// sorted values, moved from there to after the values <= x and before the first
+    /// greater one (the same order as dropping the oldest and inserting x, in one
+    /// pass). `false`, nothing changed, if the oldest is not found (not reached).
+    fn replace_oldest(&mut self, x: f32) -> bool {
+        let n = self.len();
+        let head = usize::from(self.head) % CAP;
+        let Some(&old) = self.ring.get(head) else {
+            return false;
+        };
+        let Some(i) = self.sorted[..n]
+            .iter()
+            .position(|v| v.to_bits() == old.to_bits())
+        else {
+            return false;
+        };
+        // The newest slot: `head + n`, the oldest's own when the window is the ring.
+        self.ring[head.wrapping_add(n) % CAP] = x;
+        self.head = (head.wrapping_add(1) % CAP) as u8;
+        self.sorted[i] = x;
+        let mut k = i;
+        while k > 0 && greater(self.sorted[k - 1], x) {
+            self.sorted.swap(k - 1, k);
+            k -= 1;
+        }
+        while k + 1 < n && !greater(self.sorted[k + 1], x) {
+            self.sorted.swap(k, k + 1);
+            k += 1;
+        }
+        true
     }
 
     /// The Hampel test of a finite value `x`: `Some(median)` when `x` is a spike
@@ -121,6 +161,31 @@ impl Window {
         self.push_back(x, n);
         verdict
     }
+}
+
+/// `a > b` for finite values. Without an FPU (the soft-float targets, the host's tests)
+/// by integers: the bits mapped to an order of signed integers with 0 and -0 equal,
+/// exactly the float order, some ten times cheaper than a soft-float comparison on a
+/// Cortex-M0; with one (`eabihf`), the FPU's comparison.
+#[inline(always)]
+fn greater(a: f32, b: f32) -> bool {
+    #[cfg(target_abi = "eabihf")]
+    {
+        a > b
+    }
+    #[cfg(not(target_abi = "eabihf"))]
+    {
+        order_key(a) > order_key(b)
+    }
+}
+
+/// A finite value's place in the float order as an i32: the non-negative ones are
+/// their bits, a negative one `i32::MIN - bits` (so -0 is 0, like 0).
+#[cfg_attr(target_abi = "eabihf", allow(dead_code))]
+#[inline(always)]
+fn order_key(x: f32) -> i32 {
+    let i = x.to_bits() as i32;
+    if i < 0 { i32::MIN.wrapping_sub(i) } else { i }
 }
 
 /// Scale of the median absolute deviation to a standard deviation for Gaussian noise.
@@ -219,6 +284,32 @@ impl StuckTracker {
 mod tests {
     use super::*;
 
+    #[test]
+    fn integer_order_is_the_float_order() {
+        let xs = [
+            f32::MIN,
+            -1e30,
+            -2.0,
+            -1.0,
+            -1e-30,
+            -1e-45,
+            -0.0,
+            0.0,
+            1e-45,
+            1e-38,
+            0.5,
+            1.0,
+            3.0,
+            f32::MAX,
+        ];
+        for a in xs {
+            for b in xs {
+                assert_eq!(order_key(a) > order_key(b), a > b, "{a} {b}");
+                assert_eq!(greater(a, b), a > b, "{a} {b}");
+            }
+        }
+    }
+
     /// The window against a plain model: the last `n` values in order, and the same
     /// sorted (values with ties and both zeros, windows of 1 to the capacity).
     #[test]
@@ -238,18 +329,27 @@ mod tests {
                 model[pushed] = x;
                 pushed += 1;
                 let last = &model[pushed.saturating_sub(n)..pushed];
-                let held: [u32; CAP] = core::array::from_fn(|i| {
-                    w.iter().nth(i).map_or(u32::MAX, |v| v.to_bits())
-                });
+                let held: [u32; CAP] =
+                    core::array::from_fn(|i| w.iter().nth(i).map_or(u32::MAX, |v| v.to_bits()));
                 let want: [u32; CAP] =
                     core::array::from_fn(|i| last.get(i).map_or(u32::MAX, |v| v.to_bits()));
                 assert_eq!(held, want, "window {n} after {pushed}");
                 let mut sorted = [0.0f32; CAP];
                 sorted[..last.len()].copy_from_slice(last);
                 let m = last.len();
+                // Stable: equal values (0 and -0 too) in arrival order, bit for bit.
                 sorted[..m].sort_by(|a, b| a.partial_cmp(b).unwrap());
-                assert_eq!(w.sorted(), &sorted[..m], "window {n} after {pushed}");
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<std::vec::Vec<_>>();
+                assert_eq!(
+                    bits(w.sorted()),
+                    bits(&sorted[..m]),
+                    "window {n} after {pushed}"
+                );
             }
+            // Into a shorter window (a restore with another configuration).
+            w.push_back(7.0, 1);
+            assert_eq!(w.iter().copied().collect::<std::vec::Vec<_>>(), [7.0]);
+            assert_eq!(w.sorted(), [7.0]);
             w.clear();
             assert_eq!(w.iter().count(), 0);
             assert!(w.sorted().is_empty());
