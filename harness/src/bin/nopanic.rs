@@ -9,8 +9,10 @@
 //! `with_length`, the exact theta relation) and the condition monitor on both cores
 //! (`Monitor` over `float::Auto` and over `fixed::FixedAuto`: the configuration's
 //! validation, construction, `process` per sample with every optional channel, the
-//! event queue, the statistics, `snapshot` and `restore`, `model_for_range`). Its
-//! panic handler is panic-never's, which
+//! event queue, the statistics, `snapshot` and `restore`, `model_for_range`), the
+//! sensors' conversions (load cell, probes, phi, rolling speed) with a calibration
+//! decoded from a stored record, and the checkpoint codec (`storage::codec::decode`
+//! and `encode` of `SensorCalibration`). Its panic handler is panic-never's, which
 //! refers to a symbol that does not exist: the image links only if the optimiser
 //! (profile `nopanic`: release, fat LTO, overflow checks on) removed every path to a
 //! panic, an integer overflow included. It also runs: in QEMU it exits with 0.
@@ -42,6 +44,13 @@ static SAMPLES: [Sample; 6] = [
     },
     Sample::new(2500, 10.0, 0.0).with_speed(0.0),
 ];
+
+/// A checkpoint record of the sensors' calibration as flash would hold it (its bytes are
+/// as unknown to the optimiser as a damaged record's).
+static CALIBRATION_RECORD: [u8; RECORD_LEN] = [0; RECORD_LEN];
+const RECORD_LEN: usize = misalign::storage::codec::record_len(
+    <misalign::storage::SensorCalibration as misalign::storage::Checkpoint>::SIZE,
+);
 
 /// Which paths run.
 mod paths {
@@ -146,6 +155,37 @@ mod paths {
         Ok(())
     }
 
+    /// The sensors' conversions with a calibration decoded from a stored record, and
+    /// the record encoded again: what a node does at start-up and per reading.
+    pub fn sensors_and_storage(record: &[u8], raw: i32, pulses: u32) {
+        use misalign::sensors::rolling_speed;
+        use misalign::storage::{SensorCalibration, codec};
+        io::emit(rolling_speed(pulses, 64, 0.05, 0.1));
+        let Ok(decoded) = codec::decode::<SensorCalibration>(record) else {
+            return;
+        };
+        let cal = decoded.value;
+        io::emit((cal.load.validate(), cal.misalignment.validate()));
+        let newtons = cal.load.newtons(raw);
+        io::emit((newtons, cal.load.counts_for(newtons)));
+        let m = &cal.misalignment;
+        let (d1, d2) = (m.probe1.metres(raw), m.probe2.metres(raw / 2));
+        io::emit((m.phi(d1, d2), m.probe1.counts_for(d1)));
+        if let Some(speed) = cal.speed {
+            io::emit((
+                speed.validate(),
+                rolling_speed(pulses, speed.pulses_per_rev, speed.radius_m, 0.1),
+            ));
+        }
+        let mut out = [0u8; super::RECORD_LEN];
+        io::emit(codec::encode(
+            &cal,
+            decoded.sequence.wrapping_add(1),
+            &mut out,
+        ));
+        io::emit(out);
+    }
+
     /// The f64 reference, with the scene's length and theta relation as configured.
     pub fn reference(
         scene: &Scene,
@@ -191,6 +231,7 @@ fn main() -> ! {
             risk as f32,
         )?;
         paths::monitors(&with_length, &SAMPLES, 5e3)?;
+        paths::sensors_and_storage(&io::read(&CALIBRATION_RECORD), angle_counts, load_counts);
         paths::reference(&scene, length, exact, (load as f64, phi as f64), (x, y))
     });
     semihosting::process::exit(if result.is_ok() { 0 } else { 1 })
