@@ -217,6 +217,18 @@ impl crate::Estimator for FixedAuto {
     fn to_estimate(&self, output: &FixedAutoEstimate) -> crate::Estimate {
         self.units.estimate(&output.estimate)
     }
+    /// The same as the default, without building the [`FixedAutoEstimate`] around the
+    /// estimate (its copies cost more than the conversion, `cargo xtask bench`).
+    #[inline]
+    fn estimate_si(&self, load: f32, phi: f32) -> Result<crate::Estimate, Error> {
+        let (load, angle) = self.units.counts(load, phi)?;
+        let estimate = match (self.choose(load, angle)?.0, &self.elliptic, &self.line) {
+            (ContactModel::Elliptic, Some(e), _) => e.estimate(load, angle)?,
+            (_, _, Some(l)) => l.estimate(load, angle)?,
+            _ => return Err(Error::OutOfRange), // not reached: see `line_may_answer`
+        };
+        Ok(self.units.estimate(&estimate))
+    }
     fn risk_slip_ratio(&self) -> f32 {
         FixedAuto::risk_slip_ratio(self)
     }

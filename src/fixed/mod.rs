@@ -97,7 +97,8 @@ impl Log2 {
         }
         // 2^fraction with 23 fraction bits, in [2^23, 2^24).
         let mantissa = exp2_fixed(l & (ONE - 1), 23);
-        f32::from_bits(((biased as u32) << 23) + (mantissa - (1 << 23)))
+        // mantissa >= 2^23: wrapping only where the proof cannot see it (no overflow).
+        f32::from_bits(((biased as u32) << 23).wrapping_add(mantissa.wrapping_sub(1 << 23)))
     }
 
     /// The value as an unsigned fixed-point number with `frac_bits` fraction bits,
@@ -203,8 +204,15 @@ impl Units {
         if load > U32_COUNTS || angle > I32_COUNTS {
             return Err(Error::OutOfRange);
         }
-        let angle = angle as i32; // in [0, 2^31): fits
-        Ok((load as u32, if phi < 0.0 { -angle } else { angle }))
+        let angle = angle as i32; // in [0, 2^31): fits, and so does its negation
+        Ok((
+            load as u32,
+            if phi < 0.0 {
+                angle.wrapping_neg()
+            } else {
+                angle
+            },
+        ))
     }
 
     /// A fixed-point answer in SI f32 (a margin saturated at the i32 range of counts

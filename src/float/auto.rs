@@ -202,6 +202,18 @@ impl crate::Estimator for Auto {
     fn to_estimate(&self, output: &AutoEstimate) -> Estimate {
         output.estimate
     }
+    /// [`Auto::estimate`]'s `estimate` field, without building the [`AutoEstimate`]
+    /// around it: its copies cost a Cortex-M4F about 400 instructions a sample
+    /// (`cargo xtask bench`, the monitor's pipeline), more than the estimate itself.
+    #[inline]
+    fn estimate_si(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
+        Self::checked(load, phi)?;
+        match (self.choose(load, phi).0, &self.elliptic, &self.line) {
+            (ContactModel::Elliptic, Some(e), _) => e.estimate(load, phi),
+            (_, _, Some(l)) => l.estimate(load, phi),
+            _ => Err(Error::OutOfRange), // not reached: see `line_may_answer`
+        }
+    }
     fn risk_slip_ratio(&self) -> f32 {
         Auto::risk_slip_ratio(self)
     }

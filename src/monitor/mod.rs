@@ -116,6 +116,7 @@ pub struct Monitor<E> {
     status: Status,
     load_window: condition::Window,
     angle_window: condition::Window,
+    weight: condition::WeightCache,
     trend: trend::TrendBuffer,
     events: events::EventQueue,
 }
@@ -159,6 +160,7 @@ impl<E: Estimator> Monitor<E> {
             status: Status::new(),
             load_window: condition::Window::new(),
             angle_window: condition::Window::new(),
+            weight: condition::WeightCache::new(),
             trend: trend::TrendBuffer::new(),
             events: events::EventQueue::new(),
         })
@@ -415,7 +417,7 @@ impl<E: Estimator> Monitor<E> {
         let dt_s = dt_ms as f32 * 1e-3;
         if config.smoothing_tau_s > 0.0 {
             if let Some([l, p]) = st.smoothed {
-                let w = condition::smoothing_weight(dt_s, config.smoothing_tau_s);
+                let w = self.weight.weight(dt_ms, config.smoothing_tau_s);
                 load = l + w * (load - l);
                 phi = p + w * (phi - p);
             }

@@ -107,7 +107,7 @@ impl<T: Copy, const N: usize> Saved<T, N> {
         let mut len = 0u8;
         for (slot, x) in items.iter_mut().zip(it) {
             *slot = x;
-            len += 1;
+            len = len.saturating_add(1); // at most N, below 256
         }
         Saved { items, len }
     }

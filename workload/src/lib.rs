@@ -51,6 +51,26 @@ pub enum Operation {
     KernelExp2,
     /// The Q8.24 table log2 g(log2 theta).
     TableLogG,
+    /// The inverse mu from (P, phi, F), elliptic contact (issue 11).
+    InverseMu,
+    /// The inverse phi from (P, F), elliptic contact.
+    InversePhi,
+    /// The inverse mu, line contact.
+    InverseMuLine,
+    /// The inverse phi, line contact.
+    InversePhiLine,
+    /// The condition monitor's whole per-sample pipeline (`Monitor::process`:
+    /// conditioning, estimate, states, wear, trend) over the built-in scenario.
+    Monitor,
+    /// The same with spike rejection off: what the Hampel test costs is the difference.
+    MonitorNoSpikes,
+    /// The same with smoothing off.
+    MonitorNoSmoothing,
+    /// The same with the trend (time to critical) off.
+    MonitorNoTrend,
+    /// The same with every conditioning stage (spikes, smoothing, stuck and gap
+    /// checks) and the trend off: sensor range checks, estimate, states, wear, statistics.
+    MonitorBare,
 }
 
 impl Model {
@@ -80,7 +100,7 @@ impl Model {
 
 impl Operation {
     /// Every operation, in the order the benchmark image measures them.
-    pub const ALL: [Operation; 12] = [
+    pub const ALL: [Operation; 21] = [
         Operation::Estimate,
         Operation::EstimateLine,
         Operation::TableG,
@@ -93,6 +113,15 @@ impl Operation {
         Operation::KernelLog2,
         Operation::KernelExp2,
         Operation::TableLogG,
+        Operation::InverseMu,
+        Operation::InversePhi,
+        Operation::InverseMuLine,
+        Operation::InversePhiLine,
+        Operation::Monitor,
+        Operation::MonitorNoSpikes,
+        Operation::MonitorNoSmoothing,
+        Operation::MonitorNoTrend,
+        Operation::MonitorBare,
     ];
 
     /// The name in the benchmark's log, CSV and tables.
@@ -110,12 +139,34 @@ impl Operation {
             Operation::KernelLog2 => "kernel:log2",
             Operation::KernelExp2 => "kernel:exp2",
             Operation::TableLogG => "table:log_g",
+            Operation::InverseMu => "inverse:mu",
+            Operation::InversePhi => "inverse:phi",
+            Operation::InverseMuLine => "inverse:mu:line",
+            Operation::InversePhiLine => "inverse:phi:line",
+            Operation::Monitor => "monitor",
+            Operation::MonitorNoSpikes => "monitor:no_spikes",
+            Operation::MonitorNoSmoothing => "monitor:no_smoothing",
+            Operation::MonitorNoTrend => "monitor:no_trend",
+            Operation::MonitorBare => "monitor:bare",
         }
     }
 
     /// The operation of `name` ([`Operation::name`]).
     pub fn from_name(name: &str) -> Option<Operation> {
         Operation::ALL.into_iter().find(|o| o.name() == name)
+    }
+
+    /// The monitor's pipeline with one stage or more switched off (its profile), and
+    /// the configuration it runs with: `Monitor`'s default with that stage off.
+    pub const fn is_monitor(self) -> bool {
+        matches!(
+            self,
+            Operation::Monitor
+                | Operation::MonitorNoSpikes
+                | Operation::MonitorNoSmoothing
+                | Operation::MonitorNoTrend
+                | Operation::MonitorBare
+        )
     }
 
     /// A whole per-sample estimate (not a kernel or a table).

@@ -2,7 +2,8 @@
 //!
 //! Speed: the benchmark image (harness/src/bin/bench.rs) on the Cortex-M0, M3, M4F and
 //! M7 in QEMU with `-icount` (instructions per call, mean and maximum over the
-//! practical samples of `misalign_workload::samples`). Error: the same code on the host against the
+//! practical samples of `misalign_workload::samples`; the monitor's pipeline per sample over
+//! the built-in scenario, and its profile). Error: the same code on the host against the
 //! independent reference data (tests/data/vectors_scene.csv and
 //! vectors_line.csv, or `$MISALIGN_REFERENCE_DIR`). Writes docs/bench.csv, docs/speed-vs-error.svg and the README's
 //! "Accuracy and cost" table; `--csv` prints the CSV, else a readable table.
@@ -131,12 +132,147 @@ pub fn errors() -> Result<Errors, String> {
     let mut e = Errors::new();
     for row in &read("vectors_scene.csv")? {
         elliptic_errors(&mut e, row)?;
+        inverse_errors(&mut e, row, false)?;
         kernel_errors(&mut e, row);
     }
     for row in &read("vectors_line.csv")? {
         line_errors(&mut e, row)?;
+        inverse_errors(&mut e, row, true)?;
     }
+    monitor_errors(&mut e)?;
     Ok(e)
+}
+
+/// Error of an inverse's answer against the true value: relative, divided by
+/// max(1, sensitivity) (issue 11's measure: an input rounded to f32 already moves the
+/// answer by that much), counted where the sensitivity is below 1e3; 0 for a lower
+/// bound (tests/inverse.rs checks where it is said), +inf for a wrong `inconsistent`.
+fn inverse_error(answer: reference::inverse::Inverse<f64>, want: f64) -> f64 {
+    use reference::inverse::Inverse;
+    match answer {
+        Inverse::Exact { value, sensitivity } if sensitivity < 1e3 => {
+            rel(value, want) / sensitivity.max(1.0)
+        }
+        Inverse::Exact { .. } | Inverse::AtLeast { .. } => 0.0,
+        Inverse::Inconsistent(_) => f64::INFINITY,
+    }
+}
+
+/// The round trips of one reference row through the inverses: the forward estimate's
+/// F (the reference's in f64, the f32 core's in f32), then mu from (P, phi, F) and phi
+/// from (P, F), against the row's mu and phi.
+fn inverse_errors(e: &mut Errors, row: &Record, line: bool) -> Result<(), String> {
+    use reference::inverse as inv;
+    let s = scene(row);
+    let (p, phi, mu) = (num(row, "P"), num(row, "phi"), s.friction());
+    let (p32, phi32) = (p as f32, phi as f32);
+    let err = |r: Result<inv::Inverse<f64>, misalign::Error>, want: f64| {
+        r.map_or(f64::NAN, |a| inverse_error(a, want))
+    };
+    let err32 = |r: Result<inv::Inverse<f32>, misalign::Error>, want: f64| {
+        r.map_or(f64::NAN, |a| inverse_error(a.map(f64::from), want))
+    };
+    let (ops, ref_mu, ref_phi, f32_mu, f32_phi) = if line {
+        let force = reference::line(&s, p, phi)
+            .map_err(|e| e.to_string())?
+            .axial_force;
+        let core = LineScene::new(&s).map_err(|e| e.to_string())?;
+        let f = core.estimate(p32, phi32).map_err(|e| e.to_string())?;
+        (
+            (Operation::InverseMuLine, Operation::InversePhiLine),
+            err(inv::friction_line(&s, p, phi, force), mu),
+            err(inv::angle_line(&s, p, force), phi),
+            err32(
+                core.friction_from_axial_force(p32, phi32, f.axial_force),
+                mu,
+            ),
+            err32(core.angle_from_axial_force(p32, f.axial_force), phi),
+        )
+    } else {
+        let force = reference::elliptic(&s, p, phi)
+            .map_err(|e| e.to_string())?
+            .axial_force;
+        let core = EllipticScene::new(&s).map_err(|e| e.to_string())?;
+        let f = core.estimate(p32, phi32).map_err(|e| e.to_string())?;
+        (
+            (Operation::InverseMu, Operation::InversePhi),
+            err(inv::friction_elliptic(&s, p, phi, force), mu),
+            err(inv::angle_elliptic(&s, p, force), phi),
+            err32(
+                core.friction_from_axial_force(p32, phi32, f.axial_force),
+                mu,
+            ),
+            err32(core.angle_from_axial_force(p32, f.axial_force), phi),
+        )
+    };
+    put(e, Model::Reference, ops.0, ref_mu);
+    put(e, Model::Reference, ops.1, ref_phi);
+    put(e, Model::F32, ops.0, f32_mu);
+    put(e, Model::F32, ops.1, f32_phi);
+    Ok(())
+}
+
+/// The monitor's error: over the whole built-in scenario, the worst relative error of
+/// d/b, F and phi0 in its readings against the reference at the same conditioned
+/// sample (the reading's load and phi), with the model it holds; the pipeline's own
+/// steps (spikes, smoothing) are its purpose, not an error.
+fn monitor_errors(e: &mut Errors) -> Result<(), String> {
+    use misalign::monitor::{Config, Monitor, Reading, model_for_range, scenario};
+    use misalign::reference::ModelChoice;
+    let [r1, r2, g, nu, mu] = scenario::SCENE;
+    let s = Scene::new(r1, r2, g, nu, mu).map_err(|e| e.to_string())?;
+    let choice =
+        model_for_range(&s, scenario::LOAD_MAX, scenario::ANGLE_MIN).map_err(|e| e.to_string())?;
+    let worst = |reading: &Reading| -> f64 {
+        let (p, phi) = (f64::from(reading.load), f64::from(reading.phi));
+        let want = match choice {
+            ModelChoice::Line => {
+                reference::line(&s, p, phi).map(|r| (r.slip_ratio, r.axial_force, r.critical_angle))
+            }
+            _ => reference::elliptic(&s, p, phi).map(|r| {
+                let c = r.critical_angle.unwrap_or(f64::NAN);
+                (r.slip_ratio, r.axial_force, c)
+            }),
+        };
+        let Ok((sr, f, c)) = want else {
+            return f64::INFINITY;
+        };
+        let got_c = reading.critical_angle.map_or(f64::NAN, f64::from);
+        rel(f64::from(reading.slip_ratio), sr)
+            .max(rel(f64::from(reading.axial_force), f))
+            .max(rel(got_c, c))
+    };
+    fn run<E: misalign::Estimator>(
+        core: E,
+        worst: &dyn Fn(&misalign::monitor::Reading) -> f64,
+    ) -> Result<f64, String> {
+        let mut m = Monitor::new(core, Config::default()).map_err(|e| e.to_string())?;
+        let mut err = 0.0f64;
+        for sample in scenario::Scenario::new() {
+            m.process(sample);
+            // The last valid running sample's reading (the same again after a fault).
+            if let Some(r) = m.reading() {
+                let x = worst(&r);
+                err = err.max(if x.is_nan() { f64::INFINITY } else { x });
+            }
+        }
+        Ok(err)
+    }
+    let f32_core = misalign::float::Auto::with_choice(&s, choice).map_err(|e| e.to_string())?;
+    put(e, Model::F32, Operation::Monitor, run(f32_core, &worst)?);
+    let angle_lsb = match choice {
+        ModelChoice::Elliptic => FixedEllipticScene::min_angle_lsb(&s).max(1e-10),
+        _ => 1e-10,
+    };
+    let fixed_core = misalign::fixed::FixedAuto::with_choice(&s, 1e-2, angle_lsb, choice)
+        .map_err(|e| e.to_string())?;
+    put(
+        e,
+        Model::Fixed,
+        Operation::Monitor,
+        run(fixed_core, &worst)?,
+    );
+    Ok(())
 }
 
 type Record = HashMap<String, String>;
@@ -358,15 +494,21 @@ fn csv_text(rows: &[Row]) -> String {
     let mut s =
         String::from("cpu,model,operation,instructions_mean,instructions_max,max_rel_error\n");
     for r in rows {
+        // No error measured (the monitor's profile): an empty field, which
+        // `cargo xtask figures` passes over.
+        let error = if r.error.is_nan() {
+            String::new()
+        } else {
+            format!("{:.3e}", r.error)
+        };
         writeln!(
             s,
-            "{},{},{},{},{},{:.3e}",
+            "{},{},{},{},{},{error}",
             r.cpu,
             r.model.name(),
             r.operation.name(),
             r.mean,
             r.max,
-            r.error
         )
         .unwrap();
     }
@@ -437,6 +579,11 @@ fn table_bytes(model: Model, operation: Operation) -> Option<usize> {
         (Model::F32, O::TableThetaOfG) => size(&t::THETA_OF_G_ROWS),
         (Model::F32, O::KernelAxialForce) => force,
         (Model::F32, O::EstimateLine | O::KernelCbrt | O::KernelInvSqrt) => 0,
+        (Model::F32, O::InverseMu) => size(&t::G_OF_THETA_ROWS) + force,
+        (Model::F32, O::InversePhi) => {
+            size(&t::G_OF_THETA_ROWS) + size(&t::THETA_OF_G_ROWS) + force
+        }
+        (Model::F32, O::InverseMuLine | O::InversePhiLine) => 0,
         (Model::Fixed, O::Estimate) => {
             log_exp + log_g + log_theta + size(x::LOG_FORCE_OVER_S.values)
         }
@@ -455,7 +602,9 @@ fn accuracy_and_cost(rows: &[Row]) -> String {
     writeln!(s, "| model | operation | max relative error | instructions on Cortex-M0 (mean / max) | instructions on Cortex-M4F (mean / max) | table bytes |").unwrap();
     writeln!(s, "|---|---|--:|--:|--:|--:|").unwrap();
     let mut seen = Vec::new();
-    for r in rows {
+    // The monitor's profile has its own table (`pipeline`) and no error of its own.
+    let profile = |o: Operation| o.is_monitor() && o != Operation::Monitor;
+    for r in rows.iter().filter(|r| !profile(r.operation)) {
         if seen.contains(&(r.model, r.operation)) {
             continue;
         }
@@ -474,6 +623,54 @@ fn accuracy_and_cost(rows: &[Row]) -> String {
             on("cortex-m0"),
             on("cortex-m4f"),
             bytes
+        )
+        .unwrap();
+    }
+    s
+}
+
+/// Issue 10's targets for the monitor's mean instructions per sample: the core a CPU
+/// would run (f32 with an FPU, fixed-point without).
+const MONITOR_TARGETS: [(&str, Model, u64); 2] = [
+    ("cortex-m4f", Model::F32, 300),
+    ("cortex-m0", Model::Fixed, 1200),
+];
+
+/// The README's pipeline table: per CPU and core, the monitor's whole per-sample
+/// pipeline beside the bare estimate, where the rest goes (a stage's cost is the mean
+/// with it on minus the mean with it off), and issue 10's target where it sets one.
+fn pipeline(rows: &[Row]) -> String {
+    let mut s = String::new();
+    writeln!(s, "| cpu | core | monitor per sample (mean / max) | bare estimate (mean / max) | spike test | smoothing | trend | checks, states, wear, statistics, conversions | target (mean) |").unwrap();
+    writeln!(s, "|---|---|--:|--:|--:|--:|--:|--:|--:|").unwrap();
+    for r in rows.iter().filter(|r| r.operation == Operation::Monitor) {
+        let mean = |op| find(rows, r.cpu, r.model, op).map(|x| x.mean as i64);
+        let minus = |a: Option<i64>, b: Option<i64>| match (a, b) {
+            (Some(a), Some(b)) => (a - b).to_string(),
+            _ => "-".to_string(),
+        };
+        let all = Some(r.mean as i64);
+        let bare = find(rows, r.cpu, r.model, Operation::Estimate);
+        let target = MONITOR_TARGETS
+            .iter()
+            .find(|(cpu, model, _)| *cpu == r.cpu && *model == r.model)
+            .map_or("-".to_string(), |&(_, _, t)| {
+                let met = if r.mean <= t { "met" } else { "missed" };
+                format!("{t}: {met}")
+            });
+        writeln!(
+            s,
+            "| {} | {} | {} / {} | {} | {} | {} | {} | {} | {} |",
+            r.cpu,
+            r.model.name(),
+            r.mean,
+            r.max,
+            bare.map_or("-".to_string(), |b| format!("{} / {}", b.mean, b.max)),
+            minus(all, mean(Operation::MonitorNoSpikes)),
+            minus(all, mean(Operation::MonitorNoSmoothing)),
+            minus(all, mean(Operation::MonitorNoTrend)),
+            minus(mean(Operation::MonitorBare), bare.map(|b| b.mean as i64)),
+            target
         )
         .unwrap();
     }
@@ -504,7 +701,12 @@ fn write_outputs(rows: &[Row]) -> Result<(), String> {
     let plotted: Vec<BenchRow> = rows.iter().map(Row::plotted).collect();
     crate::figures::speed_vs_error(&plotted, &docs.join("speed-vs-error.svg"))
         .map_err(|e| e.to_string())?;
-    let tables = format!("{}\n{}", readable(rows), accuracy_and_cost(rows));
+    let tables = format!(
+        "{}\n{}\n{}",
+        readable(rows),
+        accuracy_and_cost(rows),
+        pipeline(rows)
+    );
     crate::write_readme_section("bench", &tables)
 }
 
@@ -520,7 +722,7 @@ pub fn run(csv: bool, short: bool) -> ExitCode {
     if csv {
         print!("{}", csv_text(&rows));
     } else {
-        print!("{}", readable(&rows));
+        print!("{}\n{}", readable(&rows), pipeline(&rows));
     }
     if !short {
         if let Err(e) = write_outputs(&rows) {

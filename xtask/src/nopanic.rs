@@ -1,7 +1,7 @@
 //! `cargo xtask nopanic`: the compiler's proof that the estimator cannot panic.
 //!
 //! `harness/src/bin/nopanic.rs` holds every per-sample path of the estimator and the scene
-//! preparation, with panic-never as its panic handler: a handler that calls a symbol
+//! preparation, and the condition monitor on both cores, with panic-never as its panic handler: a handler that calls a symbol
 //! which does not exist. The image links only if optimisation (profile `nopanic`: the
 //! firmware profile, release with fat LTO, plus overflow checks) removed every call to
 //! it, i.e. every panic path, an integer overflow included. Built for each

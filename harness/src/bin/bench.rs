@@ -18,10 +18,12 @@ mod run {
     use core::hint::black_box;
     use misalign::fixed::logexp::{exp2_fixed, log2_u32};
     use misalign::fixed::tables::LOG_G_HIGH;
-    use misalign::fixed::{FixedEllipticScene, FixedLineScene};
+    use misalign::fixed::{FixedAuto, FixedEllipticScene, FixedLineScene};
     use misalign::float::kernels::{axial_force::axial_force_ratio, cbrt::cbrt, sqrt::inv_sqrt};
-    use misalign::float::{EllipticScene, G_OF_THETA, LineScene, THETA_OF_G};
-    use misalign::{Scene, reference};
+    use misalign::float::{Auto, EllipticScene, G_OF_THETA, LineScene, THETA_OF_G};
+    use misalign::monitor::{Config, Monitor, model_for_range, scenario};
+    use misalign::reference::ModelChoice;
+    use misalign::{Estimator, Scene, reference};
     use misalign_harness::support::counter::{Counter, SystClkSource};
     use misalign_workload::{Model, Operation, hamrock_brewe::HamrockBrewe, samples};
 
@@ -41,6 +43,11 @@ mod run {
         }
         n
     }
+
+    /// Samples of the built-in scenario that the monitor processes: its first
+    /// `16 * SAMPLES` seconds (4096 s in the full run: the start, the start-up inhibit,
+    /// the load's cycles and two spikes).
+    const MONITOR_SAMPLES: usize = 16 * SAMPLES;
 
     /// The angle LSB of the fixed-point core in the benchmark (rad per count).
     const ANGLE_LSB: f64 = 1e-8;
@@ -89,6 +96,39 @@ mod run {
         s
     }
 
+    /// The monitor's per-sample pipeline (`Monitor::process`) over the scenario's
+    /// first samples, each generated outside the measured call, in order: the monitor
+    /// is the stream's, its state carried from sample to sample.
+    fn monitor<E: Estimator>(c: &Counter, estimator: E, op: Operation) -> Stats {
+        let mut s = Stats::new();
+        let mut config = Config::default();
+        // The profile: the same stream with stages off.
+        if matches!(op, Operation::MonitorNoSpikes | Operation::MonitorBare) {
+            config.spikes = None;
+        }
+        if matches!(op, Operation::MonitorNoSmoothing | Operation::MonitorBare) {
+            config.smoothing_tau_s = 0.0;
+        }
+        if matches!(op, Operation::MonitorNoTrend | Operation::MonitorBare) {
+            config.trend = None;
+        }
+        if op == Operation::MonitorBare {
+            (config.stuck_ms, config.gap_ms) = (0, 0);
+        }
+        let Ok(mut monitor) = Monitor::new(estimator, black_box(config)) else {
+            return s;
+        };
+        for sample in scenario::Scenario::new().take(MONITOR_SAMPLES) {
+            let sample = black_box(sample);
+            let (state, n) = c.measure(|| monitor.process(sample));
+            black_box(state);
+            s.add(n);
+        }
+        // What the consumer would drain, out of the measurement.
+        while black_box(monitor.pop_event()).is_some() {}
+        s
+    }
+
     pub fn main(counter: Counter) -> i32 {
         // Opaque to the optimiser, as a scene read from a configuration block: nothing
         // of it is folded into the per-sample code.
@@ -121,6 +161,53 @@ mod run {
             .print(Model::F32, Operation::EstimateLine);
         each(c, counts(), |(p, a)| fixed_line.estimate(p, a))
             .print(Model::Fixed, Operation::EstimateLine);
+        // The inverses (issue 11): mu from (P, phi, F) and phi from (P, F), with F from
+        // the forward estimate (computed outside the measured call).
+        let with_force =
+            |(p, phi): (f32, f32)| (p, phi, core.estimate(p, phi).map_or(0.0, |e| e.axial_force));
+        each(c, f32s().map(with_force), |(p, phi, f)| {
+            core.friction_from_axial_force(p, phi, f)
+        })
+        .print(Model::F32, Operation::InverseMu);
+        each(c, f32s().map(with_force), |(p, _, f)| {
+            core.angle_from_axial_force(p, f)
+        })
+        .print(Model::F32, Operation::InversePhi);
+        let with_line_force =
+            |(p, phi): (f32, f32)| (p, phi, line.estimate(p, phi).map_or(0.0, |e| e.axial_force));
+        each(c, f32s().map(with_line_force), |(p, phi, f)| {
+            line.friction_from_axial_force(p, phi, f)
+        })
+        .print(Model::F32, Operation::InverseMuLine);
+        each(c, f32s().map(with_line_force), |(p, _, f)| {
+            line.angle_from_axial_force(p, f)
+        })
+        .print(Model::F32, Operation::InversePhiLine);
+        // The monitor's whole per-sample pipeline over the built-in scenario, on both
+        // cores, with the model fixed for the scenario's operating range (section 9)
+        // and the fixed-point LSBs of `cargo run --example monitor -- --model fixed`.
+        let [r1, r2, g, nu, mu] = scenario::SCENE;
+        let Ok(shift) = Scene::new(r1, r2, g, nu, mu) else {
+            return 2;
+        };
+        let shift = black_box(shift);
+        let Ok(choice) = model_for_range(&shift, scenario::LOAD_MAX, scenario::ANGLE_MIN) else {
+            return 2;
+        };
+        let angle_lsb = match choice {
+            ModelChoice::Elliptic => FixedEllipticScene::min_angle_lsb(&shift).max(1e-10),
+            _ => 1e-10,
+        };
+        let (Ok(f32_core), Ok(fixed_core)) = (
+            Auto::with_choice(&shift, choice),
+            FixedAuto::with_choice(&shift, 1e-2, angle_lsb, choice),
+        ) else {
+            return 2;
+        };
+        for op in Operation::ALL.into_iter().filter(|o| o.is_monitor()) {
+            monitor(c, f32_core, op).print(Model::F32, op);
+            monitor(c, fixed_core, op).print(Model::Fixed, op);
+        }
         // The f32 kernels, on what they see in these estimates.
         let thetas = || f32s().map(|(_, phi)| phi.abs());
         each(c, thetas(), |t| G_OF_THETA.eval(t)).print(Model::F32, Operation::TableG);
@@ -168,6 +255,22 @@ mod run {
             reference::line(&scene, p, phi)
         })
         .print(Model::Reference, Operation::EstimateLine);
+        let with_ref_force = |(p, phi): (f64, f64)| {
+            let f = reference::elliptic(&scene, p, phi).map_or(0.0, |e| e.axial_force);
+            (p, phi, f)
+        };
+        each(
+            c,
+            samples::practical(few).map(with_ref_force),
+            |(p, phi, f)| reference::inverse::friction_elliptic(&scene, p, phi, f),
+        )
+        .print(Model::Reference, Operation::InverseMu);
+        each(
+            c,
+            samples::practical(few).map(with_ref_force),
+            |(p, _, f)| reference::inverse::angle_elliptic(&scene, p, f),
+        )
+        .print(Model::Reference, Operation::InversePhi);
         0
     }
 }

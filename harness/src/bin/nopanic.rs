@@ -6,7 +6,13 @@
 //! fixed-point core (`FixedEllipticScene::estimate`, `details`, `FixedLineScene`, their
 //! risk setters), the f64 reference (`reference::elliptic`, `line`, `estimate`,
 //! `critical_angle`, traction, stick zones, pressure) and the scene (`Scene::new`,
-//! `with_length`, the exact theta relation). Its panic handler is panic-never's, which
+//! `with_length`, the exact theta relation) and the condition monitor on both cores
+//! (`Monitor` over `float::Auto` and over `fixed::FixedAuto`: the configuration's
+//! validation, construction, `process` per sample with every optional channel, the
+//! event queue, the statistics, `snapshot` and `restore`, `model_for_range`), the
+//! sensors' conversions (load cell, probes, phi, rolling speed) with a calibration
+//! decoded from a stored record, and the checkpoint codec (`storage::codec::decode`
+//! and `encode` of `SensorCalibration`). Its panic handler is panic-never's, which
 //! refers to a symbol that does not exist: the image links only if the optimiser
 //! (profile `nopanic`: release, fat LTO, overflow checks on) removed every path to a
 //! panic, an integer overflow included. It also runs: in QEMU it exits with 0.
@@ -15,6 +21,7 @@
 
 use panic_never as _;
 
+use misalign::monitor::{Channel, Sample};
 use misalign_harness::io;
 
 /// What the scene and the cores are configured with besides the demo scene: a contact
@@ -24,6 +31,27 @@ static SETTINGS: [f64; 4] = [0.02, 0.8, 1e-4, 2e-5];
 /// Whether the scene uses the exact theta relation (the reference only).
 static EXACT_THETA: bool = false;
 
+/// The monitor's samples: timestamps across the u32 wrap, a repeated and a
+/// backwards one, a measured speed and axial force, a driver's fault, a stop.
+static SAMPLES: [Sample; 6] = [
+    Sample::new(u32::MAX - 500, 1000.0, 2e-4).with_speed(2.0),
+    Sample::new(500, 1010.0, 2.1e-4).with_axial_force(30.0),
+    Sample::new(500, 1010.0, 2.1e-4),
+    Sample::new(1500, 990.0, -2e-4).with_speed(2.0),
+    Sample {
+        driver_fault: Some(Channel::Load),
+        ..Sample::new(100, 1000.0, 2e-4)
+    },
+    Sample::new(2500, 10.0, 0.0).with_speed(0.0),
+];
+
+/// A checkpoint record of the sensors' calibration as flash would hold it (its bytes are
+/// as unknown to the optimiser as a damaged record's).
+static CALIBRATION_RECORD: [u8; RECORD_LEN] = [0; RECORD_LEN];
+const RECORD_LEN: usize = misalign::storage::codec::record_len(
+    <misalign::storage::SensorCalibration as misalign::storage::Checkpoint>::SIZE,
+);
+
 /// Which paths run.
 mod paths {
     use misalign::fixed::FixedAuto;
@@ -31,7 +59,8 @@ mod paths {
     use misalign::float::octave::{OctaveTable, Row, narrow_rows};
     use misalign::float::{Auto, EllipticScene, LineScene, Tables};
     use misalign::float::{G_OF_THETA_ROWS, THETA_OF_G_ROWS};
-    use misalign::{Error, Scene, ThetaRelation, reference};
+    use misalign::monitor::{Config, Monitor, Sample, model_for_range};
+    use misalign::{Error, Estimator, Scene, ThetaRelation, reference};
     use misalign_harness::io;
 
     // Narrowed tables (theta from 2^-20 to 2^-6), as in tests/narrow_tables.rs.
@@ -92,6 +121,71 @@ mod paths {
         Ok(())
     }
 
+    /// The condition monitor over `estimator`: validation and construction, every
+    /// sample, the events, the statistics, the state taken out and put back.
+    fn monitor<E: Estimator + Copy>(estimator: E, config: Config, samples: &[Sample]) {
+        io::emit(config.validate());
+        let Ok(mut m) = Monitor::new(estimator, config) else {
+            return;
+        };
+        for s in samples {
+            io::emit(m.process(io::read(s)));
+        }
+        io::emit(m.pop_event());
+        io::emit((m.pending_events(), m.reading(), m.time_to_critical()));
+        io::emit((m.statistics().total_energy(), m.statistics().faults.total()));
+        let state = io::read(&m.snapshot());
+        if let Ok(mut r) = Monitor::restore(estimator, config, &state) {
+            for s in samples {
+                io::emit(r.process(io::read(s)));
+            }
+            io::emit(r.pop_event());
+        }
+    }
+
+    /// The monitor on both cores, with the model chosen for the operating range.
+    pub fn monitors(scene: &Scene, samples: &[Sample], load_max: f64) -> Result<(), Error> {
+        let choice = model_for_range(scene, load_max, 1e-5)?;
+        let config = io::read(&Config::default());
+        let f32_core = Auto::with_choice(scene, choice)?;
+        monitor(f32_core, config, samples);
+        let (lsb_p, lsb_a) = (io::LOAD_LSB, io::ANGLE_LSB);
+        let fixed = FixedAuto::with_choice(scene, lsb_p, lsb_a, choice)?;
+        monitor(fixed, config, samples);
+        Ok(())
+    }
+
+    /// The sensors' conversions with a calibration decoded from a stored record, and
+    /// the record encoded again: what a node does at start-up and per reading.
+    pub fn sensors_and_storage(record: &[u8], raw: i32, pulses: u32) {
+        use misalign::sensors::rolling_speed;
+        use misalign::storage::{SensorCalibration, codec};
+        io::emit(rolling_speed(pulses, 64, 0.05, 0.1));
+        let Ok(decoded) = codec::decode::<SensorCalibration>(record) else {
+            return;
+        };
+        let cal = decoded.value;
+        io::emit((cal.load.validate(), cal.misalignment.validate()));
+        let newtons = cal.load.newtons(raw);
+        io::emit((newtons, cal.load.counts_for(newtons)));
+        let m = &cal.misalignment;
+        let (d1, d2) = (m.probe1.metres(raw), m.probe2.metres(raw / 2));
+        io::emit((m.phi(d1, d2), m.probe1.counts_for(d1)));
+        if let Some(speed) = cal.speed {
+            io::emit((
+                speed.validate(),
+                rolling_speed(pulses, speed.pulses_per_rev, speed.radius_m, 0.1),
+            ));
+        }
+        let mut out = [0u8; super::RECORD_LEN];
+        io::emit(codec::encode(
+            &cal,
+            decoded.sequence.wrapping_add(1),
+            &mut out,
+        ));
+        io::emit(out);
+    }
+
     /// The f64 reference, with the scene's length and theta relation as configured.
     pub fn reference(
         scene: &Scene,
@@ -136,6 +230,8 @@ fn main() -> ! {
             (load_counts, angle_counts),
             risk as f32,
         )?;
+        paths::monitors(&with_length, &SAMPLES, 5e3)?;
+        paths::sensors_and_storage(&io::read(&CALIBRATION_RECORD), angle_counts, load_counts);
         paths::reference(&scene, length, exact, (load as f64, phi as f64), (x, y))
     });
     semihosting::process::exit(if result.is_ok() { 0 } else { 1 })
