@@ -329,8 +329,15 @@ pub struct FixedDetails {
 /// A log-log table in two pieces, coarse below the high piece's start.
 #[inline(always)]
 fn lookup(low: UniformTable<'static>, high: UniformTable<'static>, x: i32) -> Result<i32, Error> {
-    let table = if x < high.start { low } else { high };
-    table.eval(x).ok_or(Error::OutOfRange)
+    // Each branch evaluates its own table: with the spacing a constant in each, the
+    // shifts and masks are immediates (selecting the table first and evaluating once
+    // made them registers, about 15 instructions more on the Cortex-M0).
+    let value = if x < high.start {
+        low.eval(x)
+    } else {
+        high.eval(x)
+    };
+    value.ok_or(Error::OutOfRange)
 }
 
 /// Zero angle: no slip and no force; the critical angle and margin still stand.
@@ -338,14 +345,14 @@ fn lookup(low: UniformTable<'static>, high: UniformTable<'static>, x: i32) -> Re
 #[inline(always)]
 fn lookup3(tables: [UniformTable<'static>; 3], x: i32) -> Result<i32, Error> {
     let [low, mid, high] = tables;
-    let table = if x < mid.start {
-        low
+    let value = if x < mid.start {
+        low.eval(x)
     } else if x < high.start {
-        mid
+        mid.eval(x)
     } else {
-        high
+        high.eval(x)
     };
-    table.eval(x).ok_or(Error::OutOfRange)
+    value.ok_or(Error::OutOfRange)
 }
 
 pub(super) fn zero_angle(critical: Option<Log2>, margin: Option<i32>) -> FixedEstimate {
