@@ -96,6 +96,13 @@ pub fn exp2_fixed(l: i32, frac_bits: u32) -> u32 {
     if l == i32::MIN {
         return 0;
     }
+    exp2_finite(l, frac_bits)
+}
+
+/// [`exp2_fixed`] for an `l` that is a difference of finite logarithms, never
+/// `i32::MIN` (the stand-in for log2 0): the same value without that test.
+#[inline(always)]
+pub(crate) fn exp2_finite(l: i32, frac_bits: u32) -> u32 {
     let k = l >> 24; // floor
     let mantissa = match EXP2_FRACTION.eval(l & (ONE - 1)) {
         Some(v) => v as u32, // 2^f in Q8.24, in [2^24, 2^25)

@@ -6,7 +6,7 @@
 /// One Q8.24 unit: 1.0.
 pub const ONE: i32 = 1 << 24;
 
-/// `(a * t) >> 16` for `0 <= t < 2^16`, exactly (floor), without a 64-bit product.
+/// `(a * t) >> 16` for `0 <= t <= 2^16`, exactly (floor), without a 64-bit product.
 #[inline(always)]
 pub fn mul_q16(a: i32, t: u32) -> i32 {
     let hi = (a >> 16).wrapping_mul(t as i32);
@@ -23,7 +23,7 @@ pub struct UniformTable<'a> {
     /// The spacing is `2^-spacing_log2`, between 0 and 8.
     pub spacing_log2: u32,
     /// Values in Q8.24. Each segment reads the node after it too, so the table holds
-    /// two nodes past its domain; second differences stay below 2^17 (the generator
+    /// two nodes past its domain; second differences stay below 2^16 (the generator
     /// checks both).
     pub values: &'a [i32],
 }
@@ -47,17 +47,15 @@ impl UniformTable<'_> {
         let t = (position + half) >> (shift - 16);
         let d1 = v[1].wrapping_sub(v[0]);
         let d2 = v[2].wrapping_sub(v[1]).wrapping_sub(d1);
-        // d1 t to 2^-17 of a segment: the bits of x below t move the value by at most
-        // |d1| 2^-17 (2^-16 when truncated; the generator's check measures it).
-        let linear = mul_q16(d1, t);
-        // t (t - 1) / 2 in Q16, from t/2 in Q15 (products stay below 2^30).
+        // Newton's form as v0 + t (d1 + (t - 1) d2 / 2): (t - 1) d2 / 2 from t/2 in
+        // Q15 ((t/2 - 1/2) d2 in Q16; |d2| < 2^16, the generator checks, and
+        // |t/2 - 1/2| <= 2^15: the product fits i32), then one product by t split in
+        // 16-bit halves. Three multiplies.
         let u = (t >> 1) as i32;
-        let tt = u.wrapping_mul(u.wrapping_sub(32768)) >> 15;
-        // |d2| < 2^17 (the generator checks) and |tt| < 2^14: the product fits i32.
-        Some(
-            v[0].wrapping_add(linear)
-                .wrapping_add(d2.wrapping_mul(tt) >> 16),
-        )
+        let inner = d1.wrapping_add(u.wrapping_sub(32768).wrapping_mul(d2) >> 16);
+        // t to 2^-17 of a segment (2^-16 when truncated): the bits of x below it move
+        // the value by at most |d1| 2^-17 (the generator's check measures it).
+        Some(v[0].wrapping_add(mul_q16(inner, t)))
     }
 }
 

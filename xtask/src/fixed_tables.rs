@@ -241,7 +241,7 @@ pub fn source() -> String {
         let v = values(&spec);
         let (worst, d2) = measure(&spec, &v, 16);
         assert!(
-            d2 < 1 << 17,
+            d2 < 1 << 16,
             "{}: second differences too large for the kernel",
             spec.name
         );
