@@ -35,6 +35,7 @@ pub struct FixedEllipticScene {
     log_hertz: i32,
     /// log2(3 x load LSB / (2 pi)): log2 p0 = this + log2(counts) - log2 a - log2 b (eq 7).
     log_pressure: i32,
+    /// `load_min >= 1`: `estimate` tests zero load only below it.
     range: InputRange,
     /// What one count stands for (the estimator contract).
     pub(super) units: Units,
@@ -167,11 +168,13 @@ impl FixedEllipticScene {
         if a > self.range.angle_max {
             return Err(Error::Angle);
         }
-        if load == 0 {
-            return Ok(zero_load(a, self.log_risk));
-        }
+        // load_min >= 1: one compare on the common path, zero load inside it.
         if load < self.range.load_min {
-            return Err(Error::OutOfRange);
+            return if load == 0 {
+                Ok(zero_load(a, self.log_risk))
+            } else {
+                Err(Error::OutOfRange)
+            };
         }
         let lp = log2_u32(load);
         let lp3 = div3(lp);
