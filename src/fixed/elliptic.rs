@@ -1,8 +1,9 @@
 //! The elliptic contact (paper sections 5-7) in fixed point.
 
-use super::logexp::{div3, exp2_fixed, log2_u32};
+use super::logexp::{div3, log2_u32};
 use super::tables::{
-    LOG_FORCE_OVER_S, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW, LOG_THETA_HIGH, LOG_THETA_LOW,
+    LOG_FORCE_HIGH, LOG_FORCE_LOW, LOG_FORCE_MID, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW,
+    LOG_THETA_HIGH, LOG_THETA_LOW,
 };
 use super::uniform::{ONE, UniformTable};
 use super::{
@@ -35,6 +36,7 @@ pub struct FixedEllipticScene {
     log_hertz: i32,
     /// log2(3 x load LSB / (2 pi)): log2 p0 = this + log2(counts) - log2 a - log2 b (eq 7).
     log_pressure: i32,
+    /// `load_min >= 1`: `estimate` tests zero load only below it.
     range: InputRange,
     /// What one count stands for (the estimator contract).
     pub(super) units: Units,
@@ -172,11 +174,13 @@ impl FixedEllipticScene {
         if a > self.range.angle_max {
             return Err(Error::Angle);
         }
-        if load == 0 {
-            return Ok(zero_load(a, self.log_risk));
-        }
+        // load_min >= 1: one compare on the common path, zero load inside it.
         if load < self.range.load_min {
-            return Err(Error::OutOfRange);
+            return if load == 0 {
+                Ok(zero_load(a, self.log_risk))
+            } else {
+                Err(Error::OutOfRange)
+            };
         }
         let lp = log2_u32(load);
         let lp3 = div3(lp);
@@ -207,8 +211,12 @@ impl FixedEllipticScene {
         let ls = self.log_slip.wrapping_add(log_g).wrapping_sub(lp3);
         // F / (mu P) = s r(s) for s < 1 (eq 21), 1 beyond (eq 29); never above 1.
         let (regime, log_ratio) = if ls < 0 {
-            let s = exp2_fixed(ls, 24) as i32; // d/b in Q0.24
-            let log_r = LOG_FORCE_OVER_S.eval(s).ok_or(Error::OutOfRange)?;
+            // Against log2 s itself: no exp2. Below the tables' start (s < 2^-24) the
+            // ratio is its limit 3 pi / 4 to within 2^-24: the first node.
+            let log_r = lookup3(
+                [LOG_FORCE_LOW, LOG_FORCE_MID, LOG_FORCE_HIGH],
+                ls.max(LOG_FORCE_LOW.start),
+            )?;
             (Regime::Partial, ls.wrapping_add(log_r).min(0))
         } else {
             (Regime::Gross, 0)
@@ -330,11 +338,32 @@ pub struct FixedDetails {
 /// A log-log table in two pieces, coarse below the high piece's start.
 #[inline(always)]
 fn lookup(low: UniformTable<'static>, high: UniformTable<'static>, x: i32) -> Result<i32, Error> {
-    let table = if x < high.start { low } else { high };
-    table.eval(x).ok_or(Error::OutOfRange)
+    // Each branch evaluates its own table: with the spacing a constant in each, the
+    // shifts and masks are immediates (selecting the table first and evaluating once
+    // made them registers, about 15 instructions more on the Cortex-M0).
+    let value = if x < high.start {
+        low.eval(x)
+    } else {
+        high.eval(x)
+    };
+    value.ok_or(Error::OutOfRange)
 }
 
 /// Zero angle: no slip and no force; the critical angle and margin still stand.
+/// [`lookup`] over three tables that follow each other.
+#[inline(always)]
+fn lookup3(tables: [UniformTable<'static>; 3], x: i32) -> Result<i32, Error> {
+    let [low, mid, high] = tables;
+    let value = if x < mid.start {
+        low.eval(x)
+    } else if x < high.start {
+        mid.eval(x)
+    } else {
+        high.eval(x)
+    };
+    value.ok_or(Error::OutOfRange)
+}
+
 pub(super) fn zero_angle(critical: Option<Log2>, margin: Option<i32>) -> FixedEstimate {
     FixedEstimate {
         slip_ratio: Log2::ZERO,

@@ -297,8 +297,14 @@ const LOG2_HALF_PI: i32 = 10_930_291;
 /// `counts - a`, saturating to i32, from the critical angle in counts' log2.
 #[inline(always)]
 fn margin_counts(log_phi0_counts: i32, a: u32) -> i32 {
-    let phi0 = exp2_fixed(log_phi0_counts, 0) as i64;
-    (phi0 - a as i64).clamp(i32::MIN as i64, i32::MAX as i64) as i32
+    // A difference of two finite logarithms (the critical angle's and one count's).
+    let phi0 = logexp::exp2_finite(log_phi0_counts, 0);
+    if (phi0 | a) < 1 << 31 {
+        // Both fit i32 and are non-negative: the difference cannot wrap.
+        (phi0 as i32).wrapping_sub(a as i32)
+    } else {
+        (phi0 as i64 - a as i64).clamp(i32::MIN as i64, i32::MAX as i64) as i32
+    }
 }
 
 /// Q8.24 log2 of a positive f64 scene constant, within +-100. The per-sample sums

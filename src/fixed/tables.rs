@@ -5,7 +5,7 @@
 use super::uniform::UniformTable;
 
 /// log2(1 + x), x in [0, 1): the fraction part of an integer's log2.
-/// Q8.24, spacing 2^-7, quadratic interpolation; worst error 1.9e-7 at the generator's check.
+/// Q8.24, spacing 2^-7, quadratic interpolation; worst error 2.5e-7 at the generator's check.
 pub const LOG2_MANTISSA: UniformTable<'static> = UniformTable {
     start: 0,
     spacing_log2: 7,
@@ -31,7 +31,7 @@ pub const LOG2_MANTISSA: UniformTable<'static> = UniformTable {
 };
 
 /// 2^x, x in [0, 1): the mantissa of an exponential.
-/// Q8.24, spacing 2^-6, quadratic interpolation; worst error 2.6e-7 at the generator's check.
+/// Q8.24, spacing 2^-6, quadratic interpolation; worst error 4.9e-7 at the generator's check.
 pub const EXP2_FRACTION: UniformTable<'static> = UniformTable {
     start: 0,
     spacing_log2: 6,
@@ -49,7 +49,7 @@ pub const EXP2_FRACTION: UniformTable<'static> = UniformTable {
 };
 
 /// log2 g(theta) against y = log2 theta, y from -40 to -4 (eqs 5, 6, 16).
-/// Q8.24, spacing 2^-2, quadratic interpolation; worst error 1.6e-6 at the generator's check.
+/// Q8.24, spacing 2^-2, quadratic interpolation; worst error 2.4e-6 at the generator's check.
 pub const LOG_G_LOW: UniformTable<'static> = UniformTable {
     start: -671088640,
     spacing_log2: 2,
@@ -77,7 +77,7 @@ pub const LOG_G_LOW: UniformTable<'static> = UniformTable {
 };
 
 /// log2 g(theta) against y = log2 theta, y from -4 to log2(pi/2) (eqs 5, 6, 16).
-/// Q8.24, spacing 2^-5, quadratic interpolation; worst error 3.1e-6 at the generator's check.
+/// Q8.24, spacing 2^-5, quadratic interpolation; worst error 2.9e-6 at the generator's check.
 pub const LOG_G_HIGH: UniformTable<'static> = UniformTable {
     start: -67108864,
     spacing_log2: 5,
@@ -125,7 +125,7 @@ pub const LOG_THETA_LOW: UniformTable<'static> = UniformTable {
 };
 
 /// log2 theta(g) against log2 g from -6 to log2(pi/2): the critical angle (eq 18).
-/// Q8.24, spacing 2^-5, quadratic interpolation; worst error 1.6e-6 at the generator's check.
+/// Q8.24, spacing 2^-5, quadratic interpolation; worst error 1.9e-6 at the generator's check.
 pub const LOG_THETA_HIGH: UniformTable<'static> = UniformTable {
     start: -100663296,
     spacing_log2: 5,
@@ -161,7 +161,7 @@ pub const LOG_THETA_HIGH: UniformTable<'static> = UniformTable {
 };
 
 /// log2 m(theta) against y = log2 theta, y from -40 to -4 (eqs 5, 6): details only.
-/// Q8.24, spacing 2^-2, quadratic interpolation; worst error 5.2e-6 at the generator's check.
+/// Q8.24, spacing 2^-2, quadratic interpolation; worst error 4.3e-6 at the generator's check.
 pub const LOG_M_LOW: UniformTable<'static> = UniformTable {
     start: -671088640,
     spacing_log2: 2,
@@ -189,7 +189,7 @@ pub const LOG_M_LOW: UniformTable<'static> = UniformTable {
 };
 
 /// log2 m(theta) against y = log2 theta, y from -4 to log2(pi/2) (eqs 5, 6): details only.
-/// Q8.24, spacing 2^-5, quadratic interpolation; worst error 1.6e-6 at the generator's check.
+/// Q8.24, spacing 2^-5, quadratic interpolation; worst error 1.4e-6 at the generator's check.
 pub const LOG_M_HIGH: UniformTable<'static> = UniformTable {
     start: -67108864,
     spacing_log2: 5,
@@ -216,28 +216,77 @@ pub const LOG_M_HIGH: UniformTable<'static> = UniformTable {
     ],
 };
 
-/// log2(F/(mu P) / s) against s = d/b in [0, 1) (eq 21).
-/// Q8.24, spacing 2^-7, quadratic interpolation; worst error 1.8e-6 at the generator's check.
-pub const LOG_FORCE_OVER_S: UniformTable<'static> = UniformTable {
-    start: 0,
-    spacing_log2: 7,
+/// log2(F/(mu P) / s) against log2 s, s = d/b from 2^-24 to 2^-10 (eq 21): below, the constant log2(3 pi / 4) is within 2^-24.
+/// Q8.24, spacing 2^-2, quadratic interpolation; worst error 2.7e-7 at the generator's check.
+pub const LOG_FORCE_LOW: UniformTable<'static> = UniformTable {
+    start: -402653184,
+    spacing_log2: 2,
     values: &[
-        20744334, 20623651, 20502367, 20380480, 20257988, 20134887, 20011176, 19886853,
-        19761914, 19636358, 19510182, 19383384, 19255961, 19127911, 18999231, 18869920,
-        18739974, 18609391, 18478169, 18346305, 18213797, 18080642, 17946838, 17812383,
-        17677273, 17541506, 17405081, 17267994, 17130243, 16991826, 16852740, 16712983,
-        16572552, 16431446, 16289661, 16147195, 16004046, 15860212, 15715690, 15570478,
-        15424574, 15277976, 15130682, 14982689, 14833995, 14684598, 14534497, 14383689,
-        14232173, 14079946, 13927007, 13773354, 13618986, 13463900, 13308096, 13151572,
-        12994327, 12836359, 12677668, 12518252, 12358110, 12197241, 12035646, 11873322,
-        11710271, 11546491, 11381982, 11216745, 11050779, 10884085, 10716663, 10548514,
-        10379640, 10210041, 10039718, 9868673, 9696908, 9524425, 9351227, 9177315,
-        9002694, 8827366, 8651335, 8474605, 8297180, 8119066, 7940267, 7760788,
-        7580637, 7399820, 7218343, 7036214, 6853442, 6670035, 6486003, 6301356,
-        6116105, 5930261, 5743837, 5556846, 5369302, 5181221, 4992618, 4803511,
-        4613918, 4423860, 4233356, 4042429, 3851103, 3659405, 3467360, 3274999,
-        3082353, 2889454, 2696341, 2503050, 2309625, 2116110, 1922555, 1729012,
-        1535540, 1342202, 1149070, 956221, 763746, 571747, 380345, 189692,
-        0, -188362, -375270,
+        20744333, 20744332, 20744332, 20744332, 20744332, 20744331, 20744331, 20744330,
+        20744330, 20744329, 20744328, 20744327, 20744326, 20744325, 20744323, 20744321,
+        20744319, 20744316, 20744313, 20744309, 20744304, 20744299, 20744292, 20744284,
+        20744275, 20744264, 20744250, 20744235, 20744216, 20744194, 20744167, 20744136,
+        20744098, 20744054, 20744001, 20743938, 20743863, 20743774, 20743668, 20743543,
+        20743393, 20743215, 20743003, 20742752, 20742452, 20742097, 20741673, 20741170,
+        20740571, 20739859, 20739013, 20738006, 20736808, 20735384, 20733691, 20731677,
+        20729281, 20726432, 20723043,
+    ],
+};
+
+/// log2(F/(mu P) / s) against log2 s, s = d/b from 2^-10 to 2^-3 (eq 21).
+/// Q8.24, spacing 2^-4, quadratic interpolation; worst error 7.2e-7 at the generator's check.
+pub const LOG_FORCE_MID: UniformTable<'static> = UniformTable {
+    start: -167772160,
+    spacing_log2: 4,
+    values: &[
+        20729281, 20728614, 20727918, 20727191, 20726432, 20725639, 20724811, 20723946,
+        20723043, 20722100, 20721115, 20720087, 20719013, 20717891, 20716720, 20715497,
+        20714219, 20712885, 20711492, 20710037, 20708517, 20706930, 20705273, 20703542,
+        20701734, 20699847, 20697875, 20695816, 20693666, 20691420, 20689075, 20686625,
+        20684067, 20681396, 20678605, 20675691, 20672648, 20669469, 20666149, 20662682,
+        20659060, 20655278, 20651327, 20647201, 20642892, 20638391, 20633690, 20628780,
+        20623651, 20618294, 20612699, 20606854, 20600749, 20594373, 20587712, 20580754,
+        20573487, 20565895, 20557964, 20549680, 20541026, 20531985, 20522541, 20512675,
+        20502367, 20491599, 20480349, 20468595, 20456315, 20443484, 20430078, 20416071,
+        20401436, 20386143, 20370163, 20353464, 20336014, 20317778, 20298721, 20278804,
+        20257988, 20236232, 20213492, 20189723, 20164878, 20138906, 20111755, 20083371,
+        20053696, 20022669, 19990228, 19956306, 19920833, 19883736, 19844938, 19804359,
+        19761914, 19717514, 19671065, 19622470, 19571624, 19518420, 19462742, 19404470,
+        19343477, 19279631, 19212790, 19142807, 19069524, 18992779, 18912395, 18828192,
+        18739974, 18647538, 18550667,
+    ],
+};
+
+/// log2(F/(mu P) / s) against log2 s, s = d/b from 2^-3 to 1 (eq 21).
+/// Q8.24, spacing 2^-6, quadratic interpolation; worst error 3.8e-6 at the generator's check.
+pub const LOG_FORCE_HIGH: UniformTable<'static> = UniformTable {
+    start: -50331648,
+    spacing_log2: 6,
+    values: &[
+        18739974, 18717269, 18694296, 18671054, 18647538, 18623744, 18599670, 18575312,
+        18550667, 18525730, 18500497, 18474966, 18449133, 18422993, 18396542, 18369778,
+        18342694, 18315289, 18287557, 18259494, 18231096, 18202359, 18173278, 18143849,
+        18114067, 18083928, 18053428, 18022560, 17991321, 17959706, 17927710, 17895328,
+        17862555, 17829385, 17795814, 17761836, 17727445, 17692638, 17657406, 17621746,
+        17585652, 17549117, 17512136, 17474703, 17436812, 17398456, 17359630, 17320326,
+        17280540, 17240263, 17199490, 17158214, 17116427, 17074123, 17031295, 16987936,
+        16944038, 16899594, 16854597, 16809038, 16762911, 16716207, 16668918, 16621036,
+        16572552, 16523460, 16473749, 16423411, 16372438, 16320820, 16268549, 16215614,
+        16162008, 16107719, 16052740, 15997058, 15940666, 15883552, 15825705, 15767117,
+        15707775, 15647669, 15586789, 15525121, 15462656, 15399382, 15335286, 15270358,
+        15204583, 15137951, 15070448, 15002062, 14932779, 14862587, 14791471, 14719418,
+        14646414, 14572445, 14497496, 14421553, 14344600, 14266622, 14187604, 14107530,
+        14026384, 13944150, 13860811, 13776350, 13690749, 13603993, 13516062, 13426939,
+        13336604, 13245041, 13152229, 13058148, 12962781, 12866105, 12768101, 12668749,
+        12568026, 12465912, 12362385, 12257422, 12151001, 12043099, 11933692, 11822758,
+        11710271, 11596207, 11480542, 11363249, 11244304, 11123679, 11001349, 10877286,
+        10751464, 10623853, 10494427, 10363156, 10230011, 10094962, 9957981, 9819037,
+        9678098, 9535134, 9390114, 9243006, 9093777, 8942396, 8788829, 8633044,
+        8475007, 8314684, 8152043, 7987049, 7819668, 7649867, 7477610, 7302866,
+        7125598, 6945775, 6763363, 6578329, 6390640, 6200265, 6007174, 5811336,
+        5612722, 5411306, 5207062, 4999965, 4789994, 4577129, 4361355, 4142659,
+        3921031, 3696467, 3468968, 3238539, 3005195, 2768956, 2529853, 2287928,
+        2043235, 1795844, 1545843, 1293344, 1038485, 781445, 522452, 261815,
+        0, -262144, -524288,
     ],
 };

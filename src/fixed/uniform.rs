@@ -6,7 +6,7 @@
 /// One Q8.24 unit: 1.0.
 pub const ONE: i32 = 1 << 24;
 
-/// `(a * t) >> 16` for `0 <= t < 2^16`, exactly (floor), without a 64-bit product.
+/// `(a * t) >> 16` for `0 <= t <= 2^16`, exactly (floor), without a 64-bit product.
 #[inline(always)]
 pub fn mul_q16(a: i32, t: u32) -> i32 {
     let hi = (a >> 16).wrapping_mul(t as i32);
@@ -23,7 +23,7 @@ pub struct UniformTable<'a> {
     /// The spacing is `2^-spacing_log2`, between 0 and 8.
     pub spacing_log2: u32,
     /// Values in Q8.24. Each segment reads the node after it too, so the table holds
-    /// two nodes past its domain; second differences stay below 2^17 (the generator
+    /// two nodes past its domain; second differences stay below 2^16 (the generator
     /// checks both).
     pub values: &'a [i32],
 }
@@ -37,22 +37,25 @@ impl UniformTable<'_> {
         let shift = 24 - self.spacing_log2;
         let i = (dx >> shift) as usize;
         let v = self.values.get(i..i + 3)?;
-        // The position in the segment, `shift` bits: t in Q16 and the bits below it.
+        // The position in the segment, `shift` bits, rounded to t in Q16 (t = 2^16 at
+        // a segment's end is its next node: both terms below stay exact). With at most
+        // two bits below t (spacing 2^-6 and finer: log2's and exp2's tables) it is
+        // truncated instead: log2 keeps its excess below half a unit and exp2 its
+        // mantissa below 2^25 (an f32 mantissa never carries into the exponent).
         let position = dx & ((1 << shift) - 1);
-        let t = position >> (shift - 16);
-        let below = (position & ((1 << (shift - 16)) - 1)) as i32;
+        let half = if shift > 18 { 1 << (shift - 17) } else { 0 };
+        let t = (position + half) >> (shift - 16);
         let d1 = v[1].wrapping_sub(v[0]);
         let d2 = v[2].wrapping_sub(v[1]).wrapping_sub(d1);
-        // d1 t exactly to the last bit of x: the Q16 part plus the bits below it.
-        let linear = mul_q16(d1, t).wrapping_add(d1.wrapping_mul(below) >> shift);
-        // t (t - 1) / 2 in Q16, from t/2 in Q15 (products stay below 2^30).
+        // Newton's form as v0 + t (d1 + (t - 1) d2 / 2): (t - 1) d2 / 2 from t/2 in
+        // Q15 ((t/2 - 1/2) d2 in Q16; |d2| < 2^16, the generator checks, and
+        // |t/2 - 1/2| <= 2^15: the product fits i32), then one product by t split in
+        // 16-bit halves. Three multiplies.
         let u = (t >> 1) as i32;
-        let tt = u.wrapping_mul(u.wrapping_sub(32768)) >> 15;
-        // |d2| < 2^17 (the generator checks) and |tt| < 2^14: the product fits i32.
-        Some(
-            v[0].wrapping_add(linear)
-                .wrapping_add(d2.wrapping_mul(tt) >> 16),
-        )
+        let inner = d1.wrapping_add(u.wrapping_sub(32768).wrapping_mul(d2) >> 16);
+        // t to 2^-17 of a segment (2^-16 when truncated): the bits of x below it move
+        // the value by at most |d1| 2^-17 (the generator's check measures it).
+        Some(v[0].wrapping_add(mul_q16(inner, t)))
     }
 }
 
@@ -94,7 +97,8 @@ mod tests {
         for k in 0..200 {
             let x = -1.0 + k as f64 * 0.0125;
             let got = table.eval((x * ONE as f64) as i32).unwrap() as f64 / ONE as f64;
-            assert!((got - f(x)).abs() < 2e-7, "{x}: {got}");
+            // t rounded to Q16: within |d1| 2^-17 (2 units here) and one rounding.
+            assert!((got - f(x)).abs() < 2.5e-7, "{x}: {got}");
         }
         assert_eq!(table.eval(-ONE - 1), None);
         assert_eq!(table.eval(2 * ONE), None);
