@@ -548,6 +548,17 @@ fn angle_line_below(
     }
 }
 
+/// P / length (N/m), refused with [`Error::Load`] where it overflows, as
+/// [`super::estimate`] refuses it.
+fn per_length(load: f64, length: f64) -> Result<f64, Error> {
+    let p = load / length;
+    if p.is_finite() {
+        Ok(p)
+    } else {
+        Err(Error::Load)
+    }
+}
+
 /// The misalignment through section 9's model choice ([`super::estimate`]): `load` (N)
 /// and `force` (N) are totals. Each model's answer counts only where the model choice
 /// at that phi picks that model; see the module docs for two answers or none.
@@ -561,7 +572,7 @@ pub fn angle_estimate(scene: &Scene, load: f64, force: f64) -> Result<Inverse<f6
     // [`super::estimate`] reads them.
     if scene.is_plane() || scene.radius_factor() == 0.0 {
         let length = scene.length().unwrap_or(1.0);
-        let per_length = load / length;
+        let per_length = per_length(load, length)?;
         let saturated = scene.friction() * (per_length * 1.0);
         if let Some(answer) = angle_trivial(load, force, 1.0) {
             return Ok(answer);
@@ -575,7 +586,7 @@ pub fn angle_estimate(scene: &Scene, load: f64, force: f64) -> Result<Inverse<f6
     let Some(length) = scene.length() else {
         return angle_elliptic(scene, load, force);
     };
-    let per_length = load / length;
+    let per_length = per_length(load, length)?;
     if let Some(answer) = angle_trivial(load, force, 1.5) {
         // F = 0: phi = 0, where the ellipse is infinitely long: line contact, S = 1.
         return Ok(match answer {
