@@ -120,7 +120,7 @@ pub(crate) fn check_risk(slip_ratio: f32) -> Result<f32, Error> {
 }
 
 /// The friction coefficient mu from a measured axial force, per sample: the inverse of
-/// eqs (16, 21) for the ellipse and (23, 27) for line contact (issue 11). Implemented by
+/// eqs (16, 21) for the ellipse and (23, 27) for line contact. Implemented by
 /// the f32 core's scenes ([`EllipticScene`](crate::float::EllipticScene),
 /// [`LineScene`](crate::float::LineScene), [`Auto`](crate::float::Auto)), which answer
 /// it from the forward path's tables; the fixed-point core has no inverse, so a

@@ -47,7 +47,7 @@ fn reproduce_with(model: &str, file: &str, contact: &str, columns: &[&str], boun
     for (i, (g, w)) in got.iter().zip(&want).enumerate() {
         assert_eq!(g["error"], "", "row {i}");
         // Only the reference is exact at d/b = 1; the cores may differ within their
-        // error of it (issue 3: 1e-6 for f32; the same window for fixed).
+        // error of it (the cores' bound: 1e-6 for f32; the same window for fixed).
         if model == "reference" || (num(w, "s") - 1.0).abs() > 1e-6 {
             assert_eq!(g["regime"], w["regime"], "row {i}");
         }
@@ -79,7 +79,7 @@ fn reproduces_vectors_line() {
     );
 }
 
-/// The cores through the same tool: issue 3's targets (f32 2e-6, fixed 1e-4); the
+/// The cores through the same tool: the cores' targets (f32 2e-6, fixed 1e-4); the
 /// regime may differ from the reference only near d/b = 1, which the data avoid.
 #[test]
 fn cores_reproduce_the_reference_files() {
@@ -189,7 +189,7 @@ fn default_example_runs_clean() {
 }
 
 /// Mixed installations with lengths, long and short ellipses and planes: the three
-/// models answer every row with the same model (issue 16), and the same numbers.
+/// models answer every row with the same model, and the same numbers.
 #[test]
 fn every_model_applies_section_9_per_row() {
     let mut input = String::from("R1,R2,G,nu,mu,P,phi,length\n");

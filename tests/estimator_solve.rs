@@ -1,4 +1,4 @@
-//! `estimate --solve mu|phi` (issue 11 item 5): the CSV layer over the inverses. The
+//! `estimate --solve mu|phi`: the CSV layer over the inverses. The
 //! estimator's forward mode, then its inverse, recovers mu and phi over the public
 //! reference scenes within the library's bounds (1e-12 reference, 2e-6 f32, times the
 //! sensitivity where it exceeds 1, wherever it is below 1e3), says `at_least` exactly

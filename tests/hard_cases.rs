@@ -189,8 +189,8 @@ fn theta_at_a_right_angle_and_its_neighbours() {
     let half_pi = core::f64::consts::FRAC_PI_2;
     let below = f64::from_bits(half_pi.to_bits() - 1);
     let above = f64::from_bits(half_pi.to_bits() + 1);
-    // The angle between two axes is below a right angle: pi/2 itself is refused
-    // (issue 16), its lower neighbour is the last angle in.
+    // The angle between two axes is below a right angle: pi/2 itself is refused, its
+    // lower neighbour is the last angle in.
     assert_eq!(
         elliptic_case("theta = pi/2", &s, 1e3, half_pi).err(),
         Some(Error::Angle)

@@ -1,4 +1,4 @@
-//! Inverse estimates (issue 11): forward, then inverse, over the public reference
+//! Inverse estimates: forward, then inverse, over the public reference
 //! scenes recovers mu and phi within 1e-12 relative (reference) times the sensitivity
 //! where it exceeds 1, wherever the sensitivity is below 1e3; says `at_least` exactly
 //! where the forward map saturates; bad input gets typed errors or `inconsistent`.
@@ -523,7 +523,7 @@ fn float_bad_input() {
     );
 }
 
-/// Section 9 on a plane (issue 16's rule): line contact at every phi, P and F per unit
+/// Section 9 on a plane (section 9's rule): line contact at every phi, P and F per unit
 /// length without a length, totals with one; both inverses through the model choice
 /// are the line inverses at the per-length values, and round-trip the forward answer.
 #[test]

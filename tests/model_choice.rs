@@ -1,5 +1,5 @@
 //! Section 9's model choice per sample, the same in the reference, the f32 core and the
-//! fixed-point core (issue 16): which model answers, one meaning of P with a length,
+//! fixed-point core: which model answers, one meaning of P with a length,
 //! the flag and the jump at the switch, |phi| < pi/2, nu = 0.5, line-contact details,
 //! rolling resistance and power.
 
@@ -95,7 +95,7 @@ fn every_model_chooses_the_same_model_on_every_sample() {
             assert_eq!(f32_auto.near_model_switch, flag, "f32 flag, sample {i}");
             assert_eq!(fixed_auto.near_model_switch, flag, "fixed flag, sample {i}");
         }
-        // And the numbers of the chosen model agree (issue 3's bounds).
+        // And the numbers of the chosen model agree (the cores' bounds).
         let s = want.slip_ratio();
         if s.is_finite() && s > 0.0 {
             assert!(

@@ -592,7 +592,7 @@ fn state_taken_out_and_put_back_goes_on_identically() {
     events.extend(replay_scenario(&mut second, &samples[half + 1..]));
     assert_eq!(events, all);
     assert_eq!(second.statistics(), whole.statistics());
-    // The whole state within the 1 KiB budget of issue 10.
+    // The whole state within its 1 KiB budget.
     assert!(core::mem::size_of::<misalign::monitor::MonitorState>() <= 1024);
 }
 

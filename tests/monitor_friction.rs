@@ -1,4 +1,4 @@
-//! Friction tracking in the monitor (issue 11 item 4): with a measured axial force F the
+//! Friction tracking in the monitor: with a measured axial force F the
 //! monitor tracks mu through the f32 inverse (eqs 16, 21), uses only well-posed
 //! answers, captures a baseline at commissioning and raises a friction-change event
 //! when the filtered mu leaves the band around it, without chattering. F is generated

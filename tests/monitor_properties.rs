@@ -1,4 +1,4 @@
-//! Property tests of the condition monitor over random sample streams (issue 10, bad
+//! Property tests of the condition monitor over random sample streams (bad
 //! input): never a panic, never a NaN, no event lost without being counted, no state
 //! change faster than its delay allows, and a bad sample never raises slip.
 

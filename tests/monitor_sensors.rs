@@ -1,4 +1,4 @@
-//! The sensors feeding the condition monitor (issue 12 item 5): a fault the sensors'
+//! The sensors feeding the condition monitor: a fault the sensors'
 //! own detection finds becomes the monitor's `SensorFault` state and an event naming
 //! the sensor and the reason, counted, never a slip alarm. The node is
 //! simulated: an HX711 load cell and two probes on an ADC (`misalign::sensors::sim`)

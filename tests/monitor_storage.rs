@@ -1,4 +1,4 @@
-//! The monitor's state and configuration as stored checkpoints (issue 13): field by
+//! The monitor's state and configuration as stored checkpoints: field by
 //! field through the storage codec, a frozen version-1 record that every later firmware
 //! must read, corrupted payloads refused, and the whole through a store on the mock
 //! flash beside the sensors' calibration.

@@ -1,4 +1,4 @@
-//! Durable state on the node (issue 13, item 4): a checkpoint, a reset, a restore, in
+//! Durable state on the node: a checkpoint, a reset, a restore, in
 //! QEMU, through `misalign::storage` exactly as a firmware uses it (a blocking flash
 //! driver, `BlockingFlash`, `block_on`, no executor).
 //!

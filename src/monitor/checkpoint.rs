@@ -1,5 +1,5 @@
 //! The monitor's state and configuration as stored checkpoints (feature
-//! `sequential-storage`, issue 13): [`MonitorState`] under
+//! `sequential-storage`): [`MonitorState`] under
 //! [`kind::MONITOR_STATE`] and [`Config`] under [`kind::MONITOR_CONFIG`], field by
 //! field, little-endian, in a fixed order and size.
 //!

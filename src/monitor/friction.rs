@@ -1,4 +1,4 @@
-//! Friction tracking (issue 11 item 4): with a measured axial force F, the friction
+//! Friction tracking: with a measured axial force F, the friction
 //! coefficient mu per sample from the inverse of eqs (16, 21) (ellipse) or (23, 27)
 //! (line contact), used only where it is well-posed, filtered over time, compared with
 //! a baseline captured at commissioning. A falling or rising mu is a lubrication or

@@ -30,7 +30,7 @@
 //! state change names the sensor and the reason
 //! ([`FaultCause::Sensor`]).
 //!
-//! **Friction from a measured axial force (issue 11).** With an f32 scene (which
+//! **Friction from a measured axial force.** With an f32 scene (which
 //! implements [`FrictionInverse`]) and samples carrying a measured F,
 //! [`Monitor::process_with_friction`] also tracks mu: the inverse of eqs (16, 21) or
 //! (23, 27) at the conditioned load and angle, only where it is well-posed (exact, its
@@ -526,7 +526,7 @@ impl<E: Estimator> Monitor<E> {
 
 impl<E: Estimator + FrictionInverse> Monitor<E> {
     /// [`process`](Self::process), and with a measured axial force F on a sample that
-    /// was estimated, the friction coefficient mu from it (issue 11 item 4): the
+    /// was estimated, the friction coefficient mu from it: the
     /// inverse of eqs (16, 21) or (23, 27) at the conditioned load and angle
     /// ([`FrictionInverse`], the f32 scenes only). Only a well-posed answer counts (an
     /// exact mu with its sensitivity at most the configured cap; never a lower bound,

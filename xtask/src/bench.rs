@@ -144,7 +144,7 @@ pub fn errors() -> Result<Errors, String> {
 }
 
 /// Error of an inverse's answer against the true value: relative, divided by
-/// max(1, sensitivity) (issue 11's measure: an input rounded to f32 already moves the
+/// max(1, sensitivity) (the round trips' measure: an input rounded to f32 already moves the
 /// answer by that much), counted where the sensitivity is below 1e3; 0 for a lower
 /// bound (tests/inverse.rs checks where it is said), +inf for a wrong `inconsistent`.
 fn inverse_error(answer: reference::inverse::Inverse<f64>, want: f64) -> f64 {
@@ -643,7 +643,7 @@ const MONITOR_TARGETS: [(&str, Model, u64); 2] = [
 
 /// The README's pipeline table: per CPU and core, the monitor's whole per-sample
 /// pipeline beside the bare estimate, where the rest goes (a stage's cost is the mean
-/// with it on minus the mean with it off), and issue 10's target where it sets one.
+/// with it on minus the mean with it off), and the monitor's target where one is set.
 fn pipeline(rows: &[Row]) -> String {
     let mut s = String::new();
     writeln!(s, "| cpu | core | monitor per sample (mean / max) | bare estimate (mean / max) | spike test | smoothing | trend | checks, states, wear, statistics, conversions | target (mean) |").unwrap();

@@ -37,7 +37,7 @@ use std::time::Instant;
 pub const FLASH_BUDGET: u64 = 8 * 1024;
 pub const STACK_BUDGET: u64 = 256;
 
-/// The monitoring node's targets on the Cortex-M0 (issue 15): flash and RAM (statics
+/// The monitoring node's targets on the Cortex-M0: flash and RAM (statics
 /// and stack), in bytes. Reported (marked when over), not yet a failure.
 pub const NODE_FLASH_TARGET: u64 = 16 * 1024;
 pub const NODE_RAM_TARGET: u64 = 4 * 1024;

@@ -1,4 +1,4 @@
-//! `--solve mu|phi` (issue 11): the inverse estimates, one row in, one row out, over
+//! `--solve mu|phi`: the inverse estimates, one row in, one row out, over
 //! `misalign::reference::inverse` and the f32 cores' `*_from_axial_force`. The header,
 //! the columns, the numbers and the scene are read by the forward mode's code in
 //! `cli.rs`; only the unknown's inputs, the answer and its row are here.

@@ -161,7 +161,7 @@ mod run {
             .print(Model::F32, Operation::EstimateLine);
         each(c, counts(), |(p, a)| fixed_line.estimate(p, a))
             .print(Model::Fixed, Operation::EstimateLine);
-        // The inverses (issue 11): mu from (P, phi, F) and phi from (P, F), with F from
+        // The inverses: mu from (P, phi, F) and phi from (P, F), with F from
         // the forward estimate (computed outside the measured call).
         let with_force =
             |(p, phi): (f32, f32)| (p, phi, core.estimate(p, phi).map_or(0.0, |e| e.axial_force));

@@ -91,7 +91,7 @@ mod paths {
         io::emit(narrow.estimate(load, phi));
         io::emit(line.load_range());
         io::emit(line.estimate(load, phi));
-        // The inverses (issue 11), with a force as unknown as the sample.
+        // The inverses, with a force as unknown as the sample.
         let force = load * phi;
         io::emit(elliptic.friction_from_axial_force(load, phi, force));
         io::emit(elliptic.angle_from_axial_force(load, force));
