@@ -168,7 +168,7 @@ impl FixedEllipticScene {
     /// # Errors
     /// [`Error::Angle`] above the scene's angle range, [`Error::OutOfRange`] for a
     /// non-zero load below its load range.
-    #[inline]
+    #[inline(always)]
     pub fn estimate(&self, load: u32, angle: i32) -> Result<FixedEstimate, Error> {
         let a = angle.unsigned_abs();
         if a > self.range.angle_max {

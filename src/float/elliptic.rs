@@ -157,7 +157,7 @@ impl<'t> EllipticScene<'t> {
     /// non-finite angle or |phi| >= pi/2; [`Error::OutOfRange`] for a theta below
     /// narrowed tables, a load above 2^120 N whose mu P overflows f32, or a load so
     /// light that phi0 would underflow f32 (below its smallest normal value).
-    #[inline]
+    #[inline(always)]
     pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
         let abs_phi = phi.abs();
         // On the bits (|phi| >= 0): f32's FRAC_PI_2 lies above pi/2, so at and above
