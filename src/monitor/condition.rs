@@ -5,27 +5,90 @@ use super::config::{SPIKE_WINDOW_CAPACITY, SpikeFilter};
 
 const CAP: usize = SPIKE_WINDOW_CAPACITY;
 
-/// The Hampel window of one channel: the last raw values in arrival order (a ring),
-/// and the same values kept sorted, so that the median is read, not sorted, per
-/// sample. Plain arrays moved by swaps: a few instructions per value, no `memmove`
-/// call (the window costs per sample what the `cargo xtask bench` profile shows).
+/// The Hampel window of one channel: the last `size` values in arrival order (a ring
+/// of `size` slots) and the same values sorted, so that the median is read, not
+/// sorted, per sample. Both hold order keys ([`key`]): every comparison is an integer
+/// one, a few instructions on any core (a soft-float comparison on a Cortex-M0 costs
+/// ten times more), and a new value takes the oldest one's place in the sorted values
+/// by one pass of moves (the window's per-sample cost is in the `cargo xtask bench`
+/// profile).
 #[derive(Debug, Clone)]
 pub(crate) struct Window {
-    ring: [f32; CAP],
-    sorted: [f32; CAP],
-    /// Index of the oldest value in `ring`.
+    /// Keys in arrival order: slots `0..len` while filling, then a ring from `head`.
+    ring: [i32; CAP],
+    /// The same keys ascending.
+    sorted: [i32; CAP],
+    /// Slot of the oldest value once full (0 before).
     head: u8,
-    /// Values held (at most `CAP`).
+    /// Values held, at most `size`.
     len: u8,
+    /// The window's length (1 to `CAP`) the slots are laid out for.
+    size: u8,
+}
+
+/// A finite value's order key: its bits, negative ones with all but the sign bit
+/// flipped, so that keys compare as signed integers exactly as the values do (-0 just
+/// below 0). Its own inverse.
+#[inline(always)]
+fn key(x: f32) -> i32 {
+    let i = x.to_bits() as i32;
+    i ^ (((i >> 31) as u32) >> 1) as i32
+}
+
+/// The value of an order key.
+#[inline(always)]
+fn value(k: i32) -> f32 {
+    f32::from_bits(key(f32::from_bits(k as u32)) as u32)
+}
+
+/// `a >= b` for values that are not NaN: the FPU's comparison where there is one
+/// (`eabihf`), else integers ([`order`]), some ten times cheaper than a soft-float
+/// comparison on a Cortex-M0. The same answer either way, -0 equal to 0 included.
+#[inline(always)]
+pub(crate) fn ge(a: f32, b: f32) -> bool {
+    #[cfg(target_abi = "eabihf")]
+    {
+        a >= b
+    }
+    #[cfg(not(target_abi = "eabihf"))]
+    {
+        order(a) >= order(b)
+    }
+}
+
+/// `lo <= x <= hi` for `lo`, `hi` not NaN; false for a NaN `x`. As [`ge`]: the FPU's
+/// comparisons or integers, the same answer.
+#[inline(always)]
+pub(crate) fn within(x: f32, lo: f32, hi: f32) -> bool {
+    #[cfg(target_abi = "eabihf")]
+    {
+        x >= lo && x <= hi
+    }
+    #[cfg(not(target_abi = "eabihf"))]
+    {
+        let k = order(x);
+        k >= order(lo) && k <= order(hi)
+    }
+}
+
+/// A value's place in the float order as an i32, -0 equal to 0: the non-negative
+/// ones are their bits, a negative one `i32::MIN - bits`. A NaN lands above +inf or
+/// below -inf, by its sign.
+#[cfg_attr(target_abi = "eabihf", allow(dead_code))]
+#[inline(always)]
+pub(crate) fn order(x: f32) -> i32 {
+    let i = x.to_bits() as i32;
+    if i < 0 { i32::MIN.wrapping_sub(i) } else { i }
 }
 
 impl Window {
     pub(crate) const fn new() -> Self {
         Window {
-            ring: [0.0; CAP],
-            sorted: [0.0; CAP],
+            ring: [0; CAP],
+            sorted: [0; CAP],
             head: 0,
             len: 0,
+            size: CAP as u8,
         }
     }
 
@@ -39,123 +102,146 @@ impl Window {
     }
 
     /// The values, oldest first.
-    pub(crate) fn iter(&self) -> impl Iterator<Item = &f32> {
-        let head = usize::from(self.head);
-        (0..self.len()).filter_map(move |k| self.ring.get(head.wrapping_add(k) % CAP))
+    pub(crate) fn iter(&self) -> impl Iterator<Item = f32> + '_ {
+        let (head, size) = (usize::from(self.head), usize::from(self.size));
+        (0..self.len()).filter_map(move |k| {
+            // head < size: slots from the oldest, wrapping once.
+            let i = head.wrapping_add(k);
+            let i = if i >= size { i.wrapping_sub(size) } else { i };
+            self.ring.get(i).map(|&k| value(k))
+        })
     }
 
-    /// The values in order.
-    fn sorted(&self) -> &[f32] {
+    /// The sorted keys.
+    fn sorted(&self) -> &[i32] {
         self.sorted.get(..self.len()).unwrap_or(&[])
-    }
-
-    /// Drops the oldest value from the ring and its copy (the first one equal bit for
-    /// bit) from the sorted values.
-    fn pop_oldest(&mut self) {
-        let n = self.len();
-        let Some(&old) = self.ring.get(usize::from(self.head) % CAP) else {
-            return;
-        };
-        if n == 0 {
-            return;
-        }
-        self.head = (usize::from(self.head).wrapping_add(1) % CAP) as u8;
-        self.len = (n - 1) as u8;
-        // The same value (bit for bit) was inserted into `sorted` with it: move it to
-        // the end, past the values that remain.
-        if let Some(i) = self.sorted[..n]
-            .iter()
-            .position(|v| v.to_bits() == old.to_bits())
-        {
-            for k in i + 1..n {
-                self.sorted.swap(k - 1, k);
-            }
-        }
     }
 
     /// Appends a finite value, dropping the oldest beyond `n` values (n >= 1).
     pub(crate) fn push_back(&mut self, x: f32, n: usize) {
-        let n = n.clamp(1, CAP);
-        while self.len() > n {
-            self.pop_oldest(); // only after a restore into a shorter window
+        if n != usize::from(self.size) {
+            self.resize(n.clamp(1, CAP));
         }
-        let len = self.len();
-        if len == n && self.replace_oldest(x) {
+        let n = usize::from(self.size).min(CAP);
+        let k = key(x);
+        let len = usize::from(self.len);
+        if len >= n {
+            self.replace_oldest(k, n);
             return;
         }
-        while self.len() >= n {
-            self.pop_oldest();
-        }
-        let len = self.len();
-        if len >= CAP {
-            return; // not reached: the pops above leave room
-        }
-        self.ring[usize::from(self.head).wrapping_add(len) % CAP] = x;
-        // After the values <= x, before the first greater one.
-        self.sorted[len] = x;
-        let mut k = len;
-        while k > 0 && greater(self.sorted[k - 1], x) {
-            self.sorted.swap(k - 1, k);
-            k -= 1;
-        }
+        // Filling: slot `len`, then into the sorted keys after the ones <= k.
+        let (Some(slot), Some(sorted)) = (self.ring.get_mut(len), self.sorted.get_mut(..=len))
+        else {
+            return; // not reached: len < n <= CAP
+        };
+        *slot = k;
+        insert(sorted, len, k);
         self.len = (len + 1) as u8;
     }
 
-    /// In a full window: `x` takes the oldest value's place in the ring and in the
-    /// sorted values, moved from there to after the values <= x and before the first
-    /// greater one (the same order as dropping the oldest and inserting x, in one
-    /// pass). `false`, nothing changed, if the oldest is not found (not reached).
-    fn replace_oldest(&mut self, x: f32) -> bool {
-        let n = self.len();
-        let head = usize::from(self.head) % CAP;
-        let Some(&old) = self.ring.get(head) else {
-            return false;
+    /// A full window of `n` (at most `CAP`): `k` takes the oldest key's slot in the
+    /// ring, and its place among the sorted keys, moved from there to where it belongs.
+    #[inline(always)]
+    fn replace_oldest(&mut self, k: i32, n: usize) {
+        // `head < n`: it only ever counts up to `n` and wraps to 0.
+        let head = usize::from(self.head);
+        let (Some(slot), Some(sorted)) = (self.ring.get_mut(head), self.sorted.get_mut(..n)) else {
+            return;
         };
-        let Some(i) = self.sorted[..n]
+        let old = core::mem::replace(slot, k);
+        self.head = if head + 1 >= n { 0 } else { head + 1 } as u8;
+        // The oldest key is held (keys are the values, bit for bit).
+        let i = sorted.iter().position(|&v| v == old).unwrap_or(0);
+        insert(sorted, i, k);
+    }
+
+    /// Lays the window out for `n` values, keeping the newest (a restore into another
+    /// configuration).
+    #[cold]
+    fn resize(&mut self, n: usize) {
+        let mut keep = [0.0f32; CAP];
+        let m = self.len().min(n);
+        for (slot, x) in keep.iter_mut().zip(self.iter().skip(self.len() - m)) {
+            *slot = x;
+        }
+        self.clear();
+        self.size = n as u8;
+        for &x in keep.iter().take(m) {
+            self.push_back(x, n);
+        }
+    }
+
+    /// The median of a non-empty window.
+    #[inline(always)]
+    fn median(&self) -> f32 {
+        // n / 2 < n <= CAP.
+        let n = usize::from(self.len).min(CAP);
+        let upper = value(self.sorted.get(n / 2).copied().unwrap_or(0));
+        if n % 2 == 1 {
+            upper
+        } else {
+            let lower = value(
+                self.sorted
+                    .get((n / 2).saturating_sub(1))
+                    .copied()
+                    .unwrap_or(0),
+            );
+            0.5 * (lower + upper)
+        }
+    }
+
+    /// The median absolute deviation from `med`, the window's median. The deviations
+    /// of the sorted values grow outwards from the middle on both sides: the two
+    /// sequences are merged up to the middle, `n/2 + 1` steps, no sort.
+    #[cold]
+    fn mad(&self, med: f32) -> f32 {
+        let values = self.sorted();
+        let n = values.len();
+        let (left, right) = values.split_at(n / 2);
+        let mut l = left
             .iter()
-            .position(|v| v.to_bits() == old.to_bits())
-        else {
-            return false;
+            .rev()
+            .map(|&k| (med - value(k)).abs())
+            .peekable();
+        let mut r = right.iter().map(|&k| (value(k) - med).abs()).peekable();
+        // Absolute values (-0 is 0): their bits order them.
+        let mut next = || match (l.peek(), r.peek()) {
+            (Some(a), Some(b)) if a.to_bits() <= b.to_bits() => l.next(),
+            (Some(_), None) => l.next(),
+            _ => r.next(),
         };
-        // The newest slot: `head + n`, the oldest's own when the window is the ring.
-        self.ring[head.wrapping_add(n) % CAP] = x;
-        self.head = (head.wrapping_add(1) % CAP) as u8;
-        self.sorted[i] = x;
-        let mut k = i;
-        while k > 0 && greater(self.sorted[k - 1], x) {
-            self.sorted.swap(k - 1, k);
-            k -= 1;
+        let mut lower = 0.0;
+        for _ in 0..n.saturating_sub(1) / 2 {
+            next();
         }
-        while k + 1 < n && !greater(self.sorted[k + 1], x) {
-            self.sorted.swap(k, k + 1);
-            k += 1;
+        if n.is_multiple_of(2) {
+            lower = next().unwrap_or(0.0);
         }
-        true
+        let upper = next().unwrap_or(0.0);
+        if n.is_multiple_of(2) {
+            0.5 * (lower + upper)
+        } else {
+            upper
+        }
     }
 
     /// The Hampel test of a finite value `x`: `Some(median)` when `x` is a spike
     /// (further than `k` scaled MADs plus `floor` from the window's median), to be used
     /// in its place. The raw value enters the window either way, so that a real step
     /// passes once it fills half the window. No test until `window` values are in.
+    #[inline(always)]
     pub(crate) fn hampel(&mut self, x: f32, filter: &SpikeFilter, floor: f32) -> Option<f32> {
-        let n = usize::from(filter.window).clamp(1, SPIKE_WINDOW_CAPACITY);
+        let n = usize::from(filter.window);
         let mut verdict = None;
-        let sorted = self.sorted();
-        if sorted.len() >= n {
-            let med = median_of_sorted(sorted);
+        if usize::from(self.len) >= n && n > 0 {
+            let med = self.median();
             let deviation = (x - med).abs();
             // Within the floor a value is never a spike: the MAD (a second median) is
             // needed only beyond it, which keeps the usual sample cheap.
-            if deviation > floor {
-                let mut values = [0.0f32; SPIKE_WINDOW_CAPACITY];
-                let m = sorted.len().min(SPIKE_WINDOW_CAPACITY);
-                for (v, w) in values.iter_mut().zip(sorted.iter()) {
-                    *v = (*w - med).abs();
-                }
-                let mad = median(&mut values[..m]);
-                if deviation > filter.k * MAD_SCALE * mad + floor {
-                    verdict = Some(med);
-                }
+            if deviation.to_bits() > floor.to_bits()
+                && deviation > filter.k * MAD_SCALE * self.mad(med) + floor
+            {
+                verdict = Some(med);
             }
         }
         self.push_back(x, n);
@@ -163,60 +249,36 @@ impl Window {
     }
 }
 
-/// `a > b` for finite values. Without an FPU (the soft-float targets, the host's tests)
-/// by integers: the bits mapped to an order of signed integers with 0 and -0 equal,
-/// exactly the float order, some ten times cheaper than a soft-float comparison on a
-/// Cortex-M0; with one (`eabihf`), the FPU's comparison.
+/// Puts `k` into the sorted keys in place of the one at `i`: the keys between are
+/// moved one place towards `i`, so that all stay sorted.
 #[inline(always)]
-fn greater(a: f32, b: f32) -> bool {
-    #[cfg(target_abi = "eabihf")]
-    {
-        a > b
+fn insert(sorted: &mut [i32], mut i: usize, k: i32) {
+    // Every index is checked (`get`): no panic path, and as cheap as indexing.
+    while let Some(&next) = sorted.get(i.wrapping_add(1)) {
+        if next >= k {
+            break;
+        }
+        if let Some(slot) = sorted.get_mut(i) {
+            *slot = next;
+        }
+        i = i.wrapping_add(1);
     }
-    #[cfg(not(target_abi = "eabihf"))]
-    {
-        order_key(a) > order_key(b)
+    while let Some(&prev) = sorted.get(i.wrapping_sub(1)) {
+        if prev <= k {
+            break;
+        }
+        if let Some(slot) = sorted.get_mut(i) {
+            *slot = prev;
+        }
+        i = i.wrapping_sub(1);
     }
-}
-
-/// A finite value's place in the float order as an i32: the non-negative ones are
-/// their bits, a negative one `i32::MIN - bits` (so -0 is 0, like 0).
-#[cfg_attr(target_abi = "eabihf", allow(dead_code))]
-#[inline(always)]
-fn order_key(x: f32) -> i32 {
-    let i = x.to_bits() as i32;
-    if i < 0 { i32::MIN.wrapping_sub(i) } else { i }
+    if let Some(slot) = sorted.get_mut(i) {
+        *slot = k;
+    }
 }
 
 /// Scale of the median absolute deviation to a standard deviation for Gaussian noise.
 const MAD_SCALE: f32 = 1.4826;
-
-/// Median of sorted values (0 for none).
-fn median_of_sorted(values: &[f32]) -> f32 {
-    let n = values.len();
-    match n {
-        0 => 0.0,
-        _ if n % 2 == 1 => values.get(n / 2).copied().unwrap_or(0.0),
-        // n even and >= 2: the two middle values, (n - 1) / 2 = n / 2 - 1 and n / 2.
-        _ => match (values.get((n - 1) / 2), values.get(n / 2)) {
-            (Some(a), Some(b)) => 0.5 * (a + b),
-            _ => 0.0,
-        },
-    }
-}
-
-/// Median of finite values, sorting them in place.
-fn median(values: &mut [f32]) -> f32 {
-    // Insertion sort: at most 7 values, and only for the MAD, beyond the floor.
-    for i in 1..values.len() {
-        let mut j = i;
-        while j > 0 && values[j - 1] > values[j] {
-            values.swap(j - 1, j);
-            j -= 1;
-        }
-    }
-    median_of_sorted(values)
-}
 
 /// The weight of a new sample in the exponential smoothing after a time step `dt_s`
 /// (s): `1 - exp(-dt / tau)`, the exact discrete form of a first-order lag with time
@@ -285,7 +347,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn integer_order_is_the_float_order() {
+    fn keys_order_as_the_values_and_invert() {
         let xs = [
             f32::MIN,
             -1e30,
@@ -304,8 +366,18 @@ mod tests {
         ];
         for a in xs {
             for b in xs {
-                assert_eq!(order_key(a) > order_key(b), a > b, "{a} {b}");
-                assert_eq!(greater(a, b), a > b, "{a} {b}");
+                // The float order, with -0 just below 0.
+                let below_zero = a == b && a.is_sign_negative() && b.is_sign_positive();
+                assert_eq!(key(a) < key(b), a < b || below_zero, "{a} {b}");
+                assert_eq!(value(key(a)).to_bits(), a.to_bits(), "{a}");
+                assert_eq!(ge(a, b), a >= b, "{a} {b}");
+                assert_eq!(order(a) >= order(b), a >= b, "{a} {b}");
+                assert_eq!(within(a, b, 1.0), b <= a && a <= 1.0, "{a} {b}");
+            }
+            // A NaN of either sign is outside every finite range.
+            for nan in [f32::NAN, -f32::NAN] {
+                assert!(order(nan) > order(f32::INFINITY) || order(nan) < order(f32::NEG_INFINITY));
+                assert!(!within(nan, f32::NEG_INFINITY, f32::INFINITY));
             }
         }
     }
@@ -334,22 +406,29 @@ mod tests {
                 let want: [u32; CAP] =
                     core::array::from_fn(|i| last.get(i).map_or(u32::MAX, |v| v.to_bits()));
                 assert_eq!(held, want, "window {n} after {pushed}");
-                let mut sorted = [0.0f32; CAP];
-                sorted[..last.len()].copy_from_slice(last);
-                let m = last.len();
-                // Stable: equal values (0 and -0 too) in arrival order, bit for bit.
-                sorted[..m].sort_by(|a, b| a.partial_cmp(b).unwrap());
-                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<std::vec::Vec<_>>();
-                assert_eq!(
-                    bits(w.sorted()),
-                    bits(&sorted[..m]),
-                    "window {n} after {pushed}"
-                );
+                let mut sorted: std::vec::Vec<i32> = last.iter().map(|&x| key(x)).collect();
+                sorted.sort();
+                assert_eq!(w.sorted(), &sorted[..], "window {n} after {pushed}");
+                // The median and the MAD as a plain sort gives them.
+                let med = |v: &[f32]| {
+                    let mut v = v.to_vec();
+                    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+                    let m = v.len();
+                    if m % 2 == 1 {
+                        v[m / 2]
+                    } else {
+                        0.5 * (v[m / 2 - 1] + v[m / 2])
+                    }
+                };
+                let m = med(last);
+                assert_eq!(w.median(), m, "window {n} after {pushed}");
+                let deviations: std::vec::Vec<f32> = last.iter().map(|x| (x - m).abs()).collect();
+                assert_eq!(w.mad(m), med(&deviations), "window {n} after {pushed}");
             }
             // Into a shorter window (a restore with another configuration).
             w.push_back(7.0, 1);
-            assert_eq!(w.iter().copied().collect::<std::vec::Vec<_>>(), [7.0]);
-            assert_eq!(w.sorted(), [7.0]);
+            assert_eq!(w.iter().collect::<std::vec::Vec<_>>(), [7.0]);
+            assert_eq!(w.sorted(), [key(7.0)]);
             w.clear();
             assert_eq!(w.iter().count(), 0);
             assert!(w.sorted().is_empty());

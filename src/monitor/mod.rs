@@ -97,6 +97,7 @@ pub use wear::{EnergySum, dissipated_power};
 pub use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 
 use crate::{Estimator, FrictionInverse};
+use condition::ge;
 use sample::Step;
 
 /// A sample that was estimated: its conditioned load (N) and angle (rad) and its time
@@ -113,6 +114,7 @@ struct Estimated {
 pub struct Monitor<E> {
     estimator: E,
     config: Config,
+    levels: risk::Levels,
     status: Status,
     load_window: condition::Window,
     angle_window: condition::Window,
@@ -137,13 +139,22 @@ impl<E> defmt::Format for Monitor<E> {
 }
 
 /// Checks one channel's value: non-finite, then out of `[lo, hi]`.
+#[inline(always)]
 fn check(x: f32, lo: f32, hi: f32, channel: Channel) -> Option<FaultCause> {
-    if !x.is_finite() {
-        Some(FaultCause::NonFinite(channel))
-    } else if x < lo || x > hi {
-        Some(FaultCause::OutOfRange(channel))
-    } else {
+    // One pair of comparisons on the usual path: a NaN lies outside.
+    if condition::within(x, lo, hi) {
         None
+    } else {
+        Some(out_of_range(x, channel))
+    }
+}
+
+#[cold]
+fn out_of_range(x: f32, channel: Channel) -> FaultCause {
+    if x.is_finite() {
+        FaultCause::OutOfRange(channel)
+    } else {
+        FaultCause::NonFinite(channel)
     }
 }
 
@@ -156,6 +167,7 @@ impl<E: Estimator> Monitor<E> {
         config.validate()?;
         Ok(Monitor {
             estimator,
+            levels: risk::Levels::new(&config.thresholds),
             config,
             status: Status::new(),
             load_window: condition::Window::new(),
@@ -424,7 +436,7 @@ impl<E: Estimator> Monitor<E> {
             st.smoothed = Some([load, phi]);
         }
         // A load cell reads a little below zero at rest; the contact has none.
-        let load = load.max(0.0);
+        let load = if ge(load, 0.0) { load } else { 0.0 };
         let e = self
             .estimator
             .estimate_si(load, phi)
@@ -445,10 +457,18 @@ impl<E: Estimator> Monitor<E> {
             margin,
         });
         let s = &mut st.stats;
-        s.max_slip_ratio = s.max_slip_ratio.max(e.slip_ratio);
-        s.max_axial_force = s.max_axial_force.max(force.abs());
-        if let Some(m) = margin {
-            s.min_margin = Some(s.min_margin.map_or(m, |x| x.min(m)));
+        // Comparisons, not `max`/`min` (a libm call each on some targets); d/b is
+        // not NaN here.
+        if !ge(s.max_slip_ratio, e.slip_ratio) {
+            s.max_slip_ratio = e.slip_ratio;
+        }
+        if !ge(s.max_axial_force, force.abs()) {
+            s.max_axial_force = force.abs();
+        }
+        if let Some(m) = margin
+            && s.min_margin.is_none_or(|x| !ge(m, x))
+        {
+            s.min_margin = Some(m);
         }
         // Wear (section 7): the power F phi V over the step ending here, for the
         // state reported after this sample (never `Stopped`: a running sample leaves it).
@@ -457,7 +477,7 @@ impl<E: Estimator> Monitor<E> {
         let level = if st.alarm.inhibited(config, now) {
             RiskState::Normal
         } else {
-            risk::slip_level(&config.thresholds, e.slip_ratio, margin, held)
+            risk::slip_level(&self.levels, e.slip_ratio, margin, held)
         };
         if let (Some(tc), Some(m)) = (config.trend, margin) {
             let iv = &mut st.trend_interval;

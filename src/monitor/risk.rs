@@ -2,6 +2,7 @@
 //! clearing deadband, on-delay, off-delay (minimum dwell), start-up inhibit; a sensor
 //! fault is a state of its own and never reported as slip.
 
+use super::condition::ge;
 use super::config::{Config, Thresholds};
 
 /// The roller pair's state as the monitor reports it.
@@ -57,40 +58,66 @@ impl RiskState {
     }
 }
 
-/// The slip level of a valid running sample, with the deadband relative to the
-/// current state: a raised level stays until the value is past its threshold by the
-/// deadband.
+/// The thresholds on one scale growing with risk (d/b, or minus the margin), with
+/// their clearing levels less the deadband, formed once for a monitor: the per-sample
+/// test only compares.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Levels {
+    on_margin: bool,
+    warning: f32,
+    alarm: f32,
+    warning_clear: f32,
+    alarm_clear: f32,
+}
+
+impl Levels {
+    pub(crate) fn new(thresholds: &Thresholds) -> Self {
+        let (on_margin, warning, alarm, deadband) = match *thresholds {
+            Thresholds::SlipRatio {
+                warning,
+                alarm,
+                deadband,
+            } => (false, warning, alarm, deadband),
+            Thresholds::Margin {
+                warning,
+                alarm,
+                deadband,
+            } => (true, -warning, -alarm, deadband),
+        };
+        Levels {
+            on_margin,
+            warning,
+            alarm,
+            warning_clear: warning - deadband,
+            alarm_clear: alarm - deadband,
+        }
+    }
+}
+
+/// The slip level a valid sample asks for, from its d/b or margin, with the deadband
+/// on clearing: a level already reached (or passed) holds until the value falls below
+/// its threshold less the deadband.
+#[inline(always)]
 pub(crate) fn slip_level(
-    thresholds: &Thresholds,
+    levels: &Levels,
     slip_ratio: f32,
     margin: Option<f32>,
     current: RiskState,
 ) -> RiskState {
-    // One scale growing with risk: d/b, or minus the margin. No critical angle at
-    // this load (elliptic contact at very high load) means no gross slip: -inf.
-    let (x, warning, alarm, deadband) = match *thresholds {
-        Thresholds::SlipRatio {
-            warning,
-            alarm,
-            deadband,
-        } => (slip_ratio, warning, alarm, deadband),
-        Thresholds::Margin {
-            warning,
-            alarm,
-            deadband,
-        } => (
-            margin.map_or(f32::NEG_INFINITY, |m| -m),
-            -warning,
-            -alarm,
-            deadband,
-        ),
+    // No critical angle at this load (elliptic contact at very high load) means no
+    // gross slip: -inf.
+    let x = if levels.on_margin {
+        margin.map_or(f32::NEG_INFINITY, |m| -m)
+    } else {
+        slip_ratio
     };
     let held = |state: RiskState| current == state || current.rank() > state.rank();
-    let gross = x >= alarm || (current == RiskState::GrossSlip && x >= alarm - deadband);
-    let micro = x >= warning
+    let gross =
+        ge(x, levels.alarm) || (current == RiskState::GrossSlip && ge(x, levels.alarm_clear));
+    let micro = ge(x, levels.warning)
         || (held(RiskState::Microslip)
             && current != RiskState::SensorFault
-            && x >= warning - deadband);
+            && ge(x, levels.warning_clear));
     if gross {
         RiskState::GrossSlip
     } else if micro {

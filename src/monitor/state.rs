@@ -162,8 +162,8 @@ impl<E: Estimator> Monitor<E> {
     pub fn snapshot(&self) -> MonitorState {
         MonitorState {
             status: self.status,
-            load_window: Saved::from_iter(0.0, self.load_window.iter().copied()),
-            angle_window: Saved::from_iter(0.0, self.angle_window.iter().copied()),
+            load_window: Saved::from_iter(0.0, self.load_window.iter()),
+            angle_window: Saved::from_iter(0.0, self.angle_window.iter()),
             trend: Saved::from_iter(TrendPoint::default(), self.trend.iter().copied()),
             events: Saved::from_iter(NO_EVENT, self.events.iter().copied()),
         }
