@@ -202,21 +202,26 @@ impl Units {
     /// A sample in N and rad as counts, rounded to the nearest.
     #[inline]
     pub(crate) fn counts(&self, load: f32, phi: f32) -> Result<(u32, i32), Error> {
-        if load.is_nan() || load < 0.0 || load == f32::INFINITY {
+        // The checks on the bits: integer comparisons, where soft float would call a
+        // comparison routine for each (a Cortex-M0).
+        let load_bits = load.to_bits();
+        // Finite and not below 0 (-0 is 0): not NaN, negative or infinite.
+        if load_bits > f32::MAX.to_bits() && load_bits != (-0.0f32).to_bits() {
             return Err(Error::Load);
         }
-        if !phi.is_finite() {
+        if phi.to_bits() & 0x7fff_ffff > f32::MAX.to_bits() {
             return Err(Error::Angle);
         }
         let load = load * self.per_load + 0.5;
         let angle = phi.abs() * self.per_angle + 0.5;
-        if load > U32_COUNTS || angle > I32_COUNTS {
+        // Both positive (or +inf): their bits order them as their values.
+        if load.to_bits() > U32_COUNTS.to_bits() || angle.to_bits() > I32_COUNTS.to_bits() {
             return Err(Error::OutOfRange);
         }
         let angle = angle as i32; // in [0, 2^31): fits, and so does its negation
         Ok((
             load as u32,
-            if phi < 0.0 {
+            if phi.is_sign_negative() {
                 angle.wrapping_neg()
             } else {
                 angle

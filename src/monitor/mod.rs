@@ -97,7 +97,7 @@ pub use wear::{EnergySum, dissipated_power};
 pub use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 
 use crate::{Estimator, FrictionInverse};
-use condition::ge;
+use condition::{finite, ge};
 use sample::Step;
 
 /// A sample that was estimated: its conditioned load (N) and angle (rad) and its time
@@ -294,9 +294,13 @@ impl<E: Estimator> Monitor<E> {
 
     /// [`process`](Self::process), and the sample that was estimated, if it was.
     fn step(&mut self, sample: Sample) -> (RiskState, Option<Estimated>) {
-        let config = self.config;
+        // Borrowed, not copied: a copy of the whole configuration costs more per
+        // sample than the fields read.
+        let config = &self.config;
         let st = &mut self.status;
-        st.stats.samples = st.stats.samples.saturating_add(1);
+        // The u64 counters and times add without saturating: at one sample a
+        // microsecond, or in milliseconds, they cannot wrap in 500 000 years.
+        st.stats.samples = st.stats.samples.wrapping_add(1);
         let held = st.alarm.state;
         let mut fault = None;
         let dt_ms = match st.clock.step(sample.time_ms) {
@@ -315,7 +319,7 @@ impl<E: Estimator> Monitor<E> {
         let now = st.clock.elapsed_ms;
         // Each step counts for the state held during it.
         let t = &mut st.stats.time_in_state_ms[held.index()];
-        *t = t.saturating_add(u64::from(dt_ms));
+        *t = t.wrapping_add(u64::from(dt_ms));
         if config.gap_ms > 0 && dt_ms > config.gap_ms {
             fault = Some(FaultCause::Gap);
         }
@@ -339,7 +343,7 @@ impl<E: Estimator> Monitor<E> {
                 let f = sample.axial_force?;
                 check(f, -config.force_max, config.force_max, Channel::AxialForce)
             });
-        let running = sample.load >= config.stop_load && speed >= config.stop_speed;
+        let running = ge(sample.load, config.stop_load) && ge(speed, config.stop_speed);
         if fault.is_none() && config.stuck_ms > 0 {
             let load_stuck = st.stuck[0].stuck(sample.load, now, config.stuck_ms, !running);
             let angle_stuck = st.stuck[1].stuck(sample.phi, now, config.stuck_ms, !running);
@@ -378,9 +382,10 @@ impl<E: Estimator> Monitor<E> {
             // Not estimated: what the windows and the filter hold is stale now.
             self.restart_conditioning();
         }
-        let changed = self.status.alarm.offer(&config, candidate, now);
+        let changed = self.status.alarm.offer(&self.config, candidate, now);
         let st = &mut self.status;
-        if st.energy_step > 0.0 {
+        // Above zero (by its bits: a soft-float comparison costs more).
+        if st.energy_step.to_bits() as i32 > 0 {
             st.stats.energy[st.alarm.state.index()].add(st.energy_step);
             st.energy_step = 0.0;
         }
@@ -443,17 +448,18 @@ impl<E: Estimator> Monitor<E> {
             .map_err(|_| FaultCause::Estimator)?;
         // The cores answer finite d/b for a running load; anything else is refused,
         // never carried on as NaN.
-        if e.slip_ratio.is_nan() || !e.axial_force.is_finite() {
+        let nan = e.slip_ratio.to_bits() & 0x7fff_ffff > f32::INFINITY.to_bits();
+        if nan || !finite(e.axial_force) {
             return Err(FaultCause::Estimator);
         }
-        let margin = e.margin.filter(|m| m.is_finite());
+        let margin = e.margin.filter(|&m| finite(m));
         let force = sample.axial_force.unwrap_or(e.axial_force);
         st.reading = Some(Reading {
             load,
             phi,
             slip_ratio: e.slip_ratio,
             axial_force: force,
-            critical_angle: e.critical_angle.filter(|c| c.is_finite()),
+            critical_angle: e.critical_angle.filter(|&c| finite(c)),
             margin,
         });
         let s = &mut st.stats;
@@ -526,7 +532,7 @@ impl<E: Estimator> Monitor<E> {
         let st = &mut self.status;
         let ttc = st.time_to_critical_s;
         match ttc {
-            Some(t) if t < tc.horizon_s => {
+            Some(t) if !ge(t, tc.horizon_s) => {
                 let live = matches!(st.alarm.state, RiskState::Normal | RiskState::Microslip);
                 if st.approaching_armed && live {
                     st.approaching_armed = false;
@@ -538,7 +544,7 @@ impl<E: Estimator> Monitor<E> {
                     );
                 }
             }
-            Some(t) if t < 1.5 * tc.horizon_s => {}
+            Some(t) if !ge(t, 1.5 * tc.horizon_s) => {}
             _ => st.approaching_armed = true,
         }
     }

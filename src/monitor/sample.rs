@@ -128,7 +128,8 @@ impl Clock {
             },
         };
         if let Step::Forward(d) = step {
-            self.elapsed_ms = self.elapsed_ms.saturating_add(u64::from(d));
+            // Forward steps below 2^31 ms: u64 cannot wrap in 500 000 years.
+            self.elapsed_ms = self.elapsed_ms.wrapping_add(u64::from(d));
         }
         if step != Step::Repeated {
             self.last_time_ms = Some(time_ms);

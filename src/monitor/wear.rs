@@ -23,11 +23,14 @@ impl EnergySum {
     pub fn add(&mut self, term: f32) {
         let y = term + self.compensation;
         let t = self.sum + y;
-        if !t.is_finite() {
+        // Not finite, by the bits (no soft-float comparison).
+        if t.to_bits() & 0x7fff_ffff > f32::MAX.to_bits() {
             return;
         }
         // Fast2Sum: t + (lost) == sum + y exactly.
-        self.compensation = if self.sum.abs() >= y.abs() {
+        // |sum| >= |y| by the bits of the absolute values (finite here): the same
+        // order, and an integer comparison where floats are soft.
+        self.compensation = if self.sum.abs().to_bits() >= y.abs().to_bits() {
             (self.sum - t) + y
         } else {
             (y - t) + self.sum
