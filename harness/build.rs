@@ -17,6 +17,10 @@
 //!   `misalign::prepared` for every scene type, and the fixed-point LSBs of the images:
 //!   the build-time scenes of the `_const` and node images, which link no f64
 //!   preparation.
+//! - `shapes.rs` (every target, the `shapes` image includes it): the file named by
+//!   `MISALIGN_SHAPES_TABLES` (the table shapes that `cargo xtask shapes` generated and
+//!   weighs), or else a stub without shapes, with which the image measures the
+//!   library's kernels only.
 //!
 //! Besides that, on the host it does nothing. The library `misalign` has no build
 //! script.
@@ -38,6 +42,7 @@ fn main() {
     println!("cargo:rerun-if-env-changed=MISALIGN_MEMORY_X");
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
     write(&out, "prepared.rs", &prepared());
+    write(&out, "shapes.rs", &shapes());
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }
@@ -140,6 +145,29 @@ fn prepared() -> String {
         .unwrap();
     }
     rs
+}
+
+/// The generated table shapes (`MISALIGN_SHAPES_TABLES`), or the stub.
+fn shapes() -> String {
+    println!("cargo:rerun-if-env-changed=MISALIGN_SHAPES_TABLES");
+    match std::env::var_os("MISALIGN_SHAPES_TABLES") {
+        Some(path) if !path.is_empty() => {
+            let path = PathBuf::from(path);
+            println!("cargo:rerun-if-changed={}", path.display());
+            std::fs::read_to_string(&path).unwrap_or_else(|e| {
+                panic!(
+                    "MISALIGN_SHAPES_TABLES: cannot read {}: {e}",
+                    path.display()
+                )
+            })
+        }
+        _ => "// Written by harness/build.rs: no MISALIGN_SHAPES_TABLES, no shapes.\n\
+              #[cfg(target_abi = \"eabihf\")]\n\
+              pub fn f32_shapes(_: &Counter, _: &[f32], _: &[f32]) {}\n\
+              #[cfg(not(target_abi = \"eabihf\"))]\n\
+              pub fn fixed_shapes(_: &Counter, _: &[i32], _: &[i32]) {}\n"
+            .to_string(),
+    }
 }
 
 fn refused<T>(e: misalign::Error) -> T {

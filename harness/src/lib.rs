@@ -8,7 +8,9 @@
 //!   handlers, as macros, since an image has exactly one and the no-panic images have
 //!   panic-never's;
 //! - [`io`]: the minimal and no-panic images' inputs (volatile reads) and outputs;
-//! - [`prepared`]: the demo scene prepared at build time (bytes from the build script).
+//! - [`prepared`]: the demo scene prepared at build time (bytes from the build script);
+//! - [`shapes`]: evaluators of every table shape that `cargo xtask shapes` weighs (the
+//!   `shapes` image; xtask compiles the same file for the host's error).
 //!
 //! Its build script writes the memory layout for every image that depends on it (the
 //! firmware example and the on-target tests too): `MISALIGN_MEMORY_X`, or the QEMU
@@ -18,6 +20,7 @@
 pub mod io;
 mod panic;
 pub mod prepared;
+pub mod shapes;
 pub mod support;
 
 /// The runtime, for the handler macros.

@@ -38,7 +38,7 @@ fn shape_at_theta(theta: f64) -> normal::EllipseShape {
     normal::shape_from_kprime(0.5 * (lo + hi))
 }
 
-fn g_of_log_theta(y: f64) -> f64 {
+pub fn g_of_log_theta(y: f64) -> f64 {
     shape_at_theta(y.exp2()).g().log2()
 }
 
@@ -46,7 +46,7 @@ fn m_of_log_theta(y: f64) -> f64 {
     shape_at_theta(y.exp2()).m.log2()
 }
 
-fn log_theta_of_log_g(z: f64) -> f64 {
+pub fn log_theta_of_log_g(z: f64) -> f64 {
     let g = z.exp2();
     if g <= FRAC_PI_2 {
         return normal::theta_for_g(g).expect("g in range").theta.log2();

@@ -9,6 +9,7 @@ mod fixed_tables;
 mod fuzz;
 mod node;
 mod nopanic;
+mod shapes;
 mod sweep;
 mod tables;
 mod trace;
@@ -30,13 +31,21 @@ tasks:
     tables --explore | --explore-force | --explore-fixed | --derivatives
                                    error and size of the table shapes considered
     figures [--check]              write the paper's Figs 1-4 (and the speed against
-                                   error from docs/bench.csv, if any) as SVG to docs/
+                                   error from docs/bench.csv, the table shapes from
+                                   docs/shapes.csv, if any) as SVG to docs/
                                    (--check: fail if a committed SVG differs)
     bench [--csv] [--short]        speed against error: the benchmark image on Cortex-M0, M3,
                                    M4F, M7 in QEMU (instructions) and the same code on the
                                    host against the reference data (error); writes
                                    docs/bench.csv, docs/speed-vs-error.svg and the README
                                    table (--short: fewer samples, writes nothing)
+    shapes [--short] [--csv]       the table shapes weighed (f32: variable, segments, degree;
+                                   fixed point: spacing, interpolation, one table or two):
+                                   instructions in QEMU (f32 on the Cortex-M4F, fixed point
+                                   on the M0 and M3) beside the library's kernels, bytes,
+                                   and error against the reference on the host; writes
+                                   docs/shapes.csv and docs/table-shapes.svg (--short:
+                                   fewer inputs, writes nothing)
     firmware [--readme]            build every firmware image and on-target test, run them
                                    in QEMU (Cortex-M4F, M7, M3, M0), print the size and
                                    stack table (--readme: write it into README.md); fail
@@ -106,6 +115,7 @@ fn main() -> ExitCode {
         Some("tables") => tables_task(flag("--check")),
         Some("figures") => figures::run(&root().join("docs"), flag("--check")),
         Some("bench") => bench::run(flag("--csv"), flag("--short")),
+        Some("shapes") => shapes::run(flag("--short"), flag("--csv")),
         Some("firmware") => firmware::run(flag("--readme")),
         Some("nopanic") => nopanic::run(),
         _ => {

@@ -1,10 +1,11 @@
-//! The benchmark's figure: speed against error of every model, per CPU
-//! (`docs/speed-vs-error.svg`), from the benchmark's rows.
+//! The benchmark's figure: speed against error of every model, a panel per CPU
+//! (`docs/speed-vs-error.svg`), from the benchmark's rows. The estimates are labelled
+//! by model; the tables and kernels by a number, which the key names.
 
-use super::labels::{Labels, text_width};
+use super::labels::{LabelReport, Labels};
 use super::{
-    BLUE_, DESC, FONT, GREEN_, GREY, LABEL, LIGHT, NOTE, ORANGE, PURPLE, Res, SKY, VERMILION,
-    log_axis, power_of_ten, render, ten_to, text,
+    Area, BLUE_, FONT, GREEN_, GREY, LIGHT, NOTE, ORANGE, PURPLE, Res, SKY, VERMILION, log_axis,
+    power_of_ten, render_sized, ten_to, text,
 };
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
@@ -80,21 +81,22 @@ pub fn parse_bench_csv(text: &str) -> Res<Vec<BenchRow>> {
 }
 
 /// Whether the figure plots `row`: every elliptic estimate, and the `table:` and
-/// `kernel:` variants where they run (f32 on the Cortex-M4F, fixed point on the
-/// Cortex-M0), so that the labels stay legible.
+/// `kernel:` variants where their core runs: f32 where there is an FPU (Cortex-M4F,
+/// M7), fixed point where there is none (Cortex-M0, M3).
 pub fn plotted(row: &BenchRow) -> bool {
     let variant = row.operation.starts_with("table:") || row.operation.starts_with("kernel:");
-    let where_it_runs = (row.model == "f32" && row.cpu == "cortex-m4f")
-        || (row.model == "fixed" && row.cpu == "cortex-m0");
+    let fpu = matches!(row.cpu.as_str(), "cortex-m4f" | "cortex-m7");
+    let where_it_runs = (row.model == "f32" && fpu) || (row.model == "fixed" && !fpu);
     row.operation == "estimate" || (variant && where_it_runs)
 }
 
-/// `cortex-m4f` -> `m4f`.
-fn short_cpu(cpu: &str) -> &str {
-    cpu.strip_prefix("cortex-").unwrap_or(cpu)
+/// `Cortex-M4F` for `cortex-m4f`.
+fn cpu_name(cpu: &str) -> String {
+    cpu.strip_prefix("cortex-")
+        .map_or(cpu.to_string(), |c| format!("Cortex-{}", c.to_uppercase()))
 }
 
-/// The figure's log axes, in whole decades.
+/// The figure's log axes, in whole decades, shared by every panel.
 struct Axes {
     /// Where an error of exactly 0 (the reference against itself) is drawn: on a
     /// dashed line one decade below the smallest non-zero error, which says so.
@@ -145,8 +147,8 @@ fn decades(values: impl Iterator<Item = f64>) -> (i32, i32) {
 }
 
 /// The models of the estimate rows: the four known ones in a fixed order, then any
-/// other in sorted order.
-fn models_in_order(rows: &[BenchRow]) -> Vec<&str> {
+/// other in sorted order; with their colours.
+fn models_in_order(rows: &[BenchRow]) -> Vec<(&str, RGBColor)> {
     let mut models: Vec<&str> = vec!["reference", "f32", "fixed", "hamrock-brewe"];
     let mut others: Vec<&str> = rows
         .iter()
@@ -156,7 +158,79 @@ fn models_in_order(rows: &[BenchRow]) -> Vec<&str> {
     others.sort_unstable();
     others.dedup();
     models.extend(others);
+    let palette = [BLUE_, GREEN_, VERMILION, ORANGE, PURPLE, SKY, BLACK];
     models
+        .into_iter()
+        .filter(|m| {
+            rows.iter()
+                .any(|r| r.operation == "estimate" && r.model == *m)
+        })
+        .enumerate()
+        .map(|(i, m)| (m, palette[i % palette.len()]))
+        .collect()
+}
+
+/// The figure's size (px): two panels a row, the key in the cell after the last.
+pub const SPEED_SIZE: (u32, u32) = (1200, 1060);
+/// Font sizes (plotters' sizes) of the panels' titles, axes and point labels.
+const PANEL_TITLE: u32 = 21;
+const AXIS: u32 = 18;
+const TICKS: u32 = 16;
+const POINT: u32 = 16;
+
+/// One panel: a CPU's rows (and the title that says which CPUs it stands for).
+struct Panel {
+    title: String,
+    rows: Vec<BenchRow>,
+}
+
+/// The panels: one per CPU, in the rows' order; the Cortex-M7's merged into the M4F's
+/// when every one of its rows is the M4F's (QEMU counts instructions, and the M7 runs
+/// the M4F's image: the same counts).
+fn panels(rows: &[BenchRow]) -> Vec<Panel> {
+    let mut cpus: Vec<&str> = Vec::new();
+    for r in rows {
+        if !cpus.contains(&r.cpu.as_str()) {
+            cpus.push(&r.cpu);
+        }
+    }
+    let of =
+        |cpu: &str| -> Vec<BenchRow> { rows.iter().filter(|r| r.cpu == cpu).cloned().collect() };
+    let key = |r: &BenchRow| {
+        (
+            r.model.clone(),
+            r.operation.clone(),
+            r.instructions,
+            r.error,
+        )
+    };
+    let m4f: Vec<_> = of("cortex-m4f").iter().map(key).collect();
+    let m7 = of("cortex-m7");
+    let merged = !m4f.is_empty() && !m7.is_empty() && m7.iter().all(|r| m4f.contains(&key(r)));
+    cpus.into_iter()
+        .filter(|cpu| !(merged && *cpu == "cortex-m7"))
+        .map(|cpu| Panel {
+            title: if merged && cpu == "cortex-m4f" {
+                "Cortex-M4F and M7 (the same image: the same counts)".to_string()
+            } else {
+                cpu_name(cpu)
+            },
+            rows: of(cpu),
+        })
+        .collect()
+}
+
+/// The tables and kernels drawn, numbered for the key: `(model, operation)` in the
+/// rows' order.
+fn variants(rows: &[BenchRow]) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = Vec::new();
+    for r in rows.iter().filter(|r| r.operation != "estimate") {
+        let k = (r.model.clone(), r.operation.clone());
+        if !out.contains(&k) {
+            out.push(k);
+        }
+    }
+    out
 }
 
 /// The speed-against-error figure of the benchmark's `rows` (those it [`plotted`]) as
@@ -165,6 +239,11 @@ fn models_in_order(rows: &[BenchRow]) -> Vec<&str> {
 /// # Errors
 /// When no plotted row has instructions > 0.
 pub fn speed_vs_error_svg(rows: &[BenchRow]) -> Res<String> {
+    Ok(speed_vs_error_layout(rows)?.0)
+}
+
+/// The figure and where its point labels went (for the tests).
+pub(super) fn speed_vs_error_layout(rows: &[BenchRow]) -> Res<(String, LabelReport)> {
     let rows: Vec<BenchRow> = rows
         .iter()
         .filter(|r| plotted(r) && r.instructions > 0.0)
@@ -173,149 +252,168 @@ pub fn speed_vs_error_svg(rows: &[BenchRow]) -> Res<String> {
     if rows.is_empty() {
         return Err("bench CSV has no estimate, table: or kernel: row to plot".into());
     }
-    // The Cortex-M7 runs the M4F's code: its rows are drawn only where they differ.
-    let as_m4f = |r: &BenchRow| {
-        r.cpu == "cortex-m7"
-            && rows.iter().any(|o| {
-                o.cpu == "cortex-m4f"
-                    && (&o.model, &o.operation, o.instructions, o.error)
-                        == (&r.model, &r.operation, r.instructions, r.error)
-            })
-    };
-    let m7_as_m4f = rows.iter().any(as_m4f);
-    let rows: Vec<BenchRow> = rows.iter().filter(|r| !as_m4f(r)).cloned().collect();
-    let caption = if m7_as_m4f {
-        "Speed against error per CPU and model (M7: only where it differs from the M4F)"
-    } else {
-        "Speed against error: one estimate (d/b, regime, F, φ₀) per CPU and model"
-    };
-    let Axes {
-        floor,
-        x_lo,
-        x_hi,
-        y_lo,
-        y_hi,
-        has_zero,
-    } = Axes::of(&rows);
-    let y_of = |r: &BenchRow| r.error.max(floor);
+    let axes = Axes::of(&rows);
     let models = models_in_order(&rows);
-    let palette = [BLUE_, GREEN_, VERMILION, ORANGE, PURPLE, SKY, BLACK];
-
-    render(|root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(caption, (FONT, 23))
-            .margin(18)
-            .x_label_area_size(62)
-            .y_label_area_size(90)
-            .build_cartesian_2d(log_axis(x_lo, x_hi), log_axis(y_lo, y_hi))?;
-        chart
-            .configure_mesh()
-            .x_desc("instructions per estimate (mean; QEMU -icount)")
-            .y_desc("max. relative error vs f64 reference")
-            .x_label_formatter(&power_of_ten)
-            .y_label_formatter(&power_of_ten)
-            .axis_desc_style((FONT, DESC))
-            .label_style((FONT, LABEL))
-            .light_line_style(WHITE)
-            .bold_line_style(LIGHT)
-            .draw()?;
-        if has_zero {
-            chart.draw_series(DashedLineSeries::new(
-                [(ten_to(x_lo), floor), (ten_to(x_hi), floor)],
-                4,
-                4,
-                GREY.stroke_width(1),
-            ))?;
+    let numbered = variants(&rows);
+    let panels = panels(&rows);
+    let mut report = LabelReport::default();
+    let svg = render_sized(SPEED_SIZE, |root| {
+        let inner = root.titled(
+            "Speed against error: every model's estimate and the kernels weighed, per core",
+            (FONT, 25),
+        )?;
+        let cells = inner.split_evenly(((panels.len() + 1).div_ceil(2), 2));
+        for (panel, cell) in panels.iter().zip(&cells) {
+            report.add(draw_panel(root, cell, panel, &axes, &models, &numbered)?);
         }
-        // Markers first; their boxes keep the labels off them.
-        let (xs, ys) = chart.plotting_area().get_pixel_range();
-        let mut labels = Labels::new([xs.start, ys.start, xs.end, ys.end]);
-        let mut pending: Vec<(String, (i32, i32), RGBColor, u32)> = Vec::new();
-        for (i, model) in models.iter().enumerate() {
-            let color = palette[i % palette.len()];
-            let points: Vec<&BenchRow> = rows
-                .iter()
-                .filter(|r| r.operation == "estimate" && r.model == *model)
-                .collect();
-            if points.is_empty() {
-                continue;
-            }
-            chart
-                .draw_series(
-                    points
-                        .iter()
-                        .map(|r| Circle::new((r.instructions, y_of(r)), 6, color.filled())),
-                )?
-                .label(format!("{model} (estimate)"))
-                .legend(move |(x, y)| Circle::new((x + 10, y), 6, color.filled()));
-            for r in points {
-                let at = chart.backend_coord(&(r.instructions, y_of(r)));
-                labels.mark(at, 7);
-                pending.push((short_cpu(&r.cpu).to_string(), at, color, NOTE));
-            }
-        }
-        let variants: Vec<&BenchRow> = rows.iter().filter(|r| r.operation != "estimate").collect();
-        if !variants.is_empty() {
-            chart
-                .draw_series(
-                    variants
-                        .iter()
-                        .map(|r| TriangleMarker::new((r.instructions, y_of(r)), 7, GREY.filled())),
-                )?
-                .label("tables and kernels weighed")
-                .legend(|(x, y)| TriangleMarker::new((x + 10, y), 7, GREY.filled()));
-            for r in variants {
-                let at = chart.backend_coord(&(r.instructions, y_of(r)));
-                labels.mark(at, 8);
-                let name = format!("{} ({} {})", r.operation, short_cpu(&r.cpu), r.model);
-                pending.push((name, at, GREY, 15));
-            }
-        }
-        if has_zero {
-            // Just above the dashed line, at its left end.
-            let (x, y) = chart.backend_coord(&(ten_to(x_lo), floor));
-            let name = "error = 0 (exact): drawn on this line";
-            let (w, h) = (text_width(name, 15), 15 * 100 / 124);
-            labels.taken.push([x + 6, y - 4 - h, x + 6 + w, y - 4]);
-            root.draw_text(
-                name,
-                &text(15, GREY, HPos::Left, VPos::Bottom),
-                (x + 6, y - 4),
-            )?;
-        }
-        for (name, at, color, size) in pending {
-            let (h, v, pos) = labels.place(at, &name, size);
-            root.draw_text(&name, &text(size, color, h, v), pos)?;
-        }
-        let corner = labels.emptiest_corner(legend_box(&models, &rows));
-        chart
-            .configure_series_labels()
-            .position(corner)
-            .margin(12)
-            .legend_area_size(30)
-            .background_style(WHITE)
-            .border_style(GREY)
-            .label_font((FONT, NOTE))
-            .draw()?;
+        draw_key(root, &cells[panels.len()], &axes, &models, &numbered)?;
         Ok(())
-    })
+    })?;
+    Ok((svg, report))
 }
 
-/// Estimated size (px) of the legend of the speed-against-error figure.
-fn legend_box(models: &[&str], rows: &[BenchRow]) -> (i32, i32) {
-    let mut names: Vec<String> = models
-        .iter()
-        .filter(|m| {
-            rows.iter()
-                .any(|r| r.operation == "estimate" && r.model == **m)
+/// One CPU's panel: the estimates (colour by model, labelled by name) and the tables
+/// and kernels (grey triangles, labelled by their number in the key).
+fn draw_panel(
+    root: &Area,
+    cell: &Area,
+    panel: &Panel,
+    axes: &Axes,
+    models: &[(&str, RGBColor)],
+    numbered: &[(String, String)],
+) -> Res<Labels> {
+    let y_of = |r: &BenchRow| r.error.max(axes.floor);
+    let mut chart = ChartBuilder::on(cell)
+        .caption(&panel.title, (FONT, PANEL_TITLE))
+        .margin(12)
+        .margin_right(20)
+        .x_label_area_size(52)
+        .y_label_area_size(82)
+        .build_cartesian_2d(
+            log_axis(axes.x_lo, axes.x_hi),
+            log_axis(axes.y_lo, axes.y_hi),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("instructions per call (mean; QEMU -icount)")
+        .y_desc("max. relative error")
+        .x_label_formatter(&power_of_ten)
+        .y_label_formatter(&|v| {
+            // Every other decade: the axis is long.
+            let e = v.log10().round() as i32;
+            if e % 2 == 0 {
+                power_of_ten(v)
+            } else {
+                String::new()
+            }
         })
-        .map(|m| format!("{m} (estimate)"))
-        .collect();
-    if rows.iter().any(|r| r.operation != "estimate") {
-        names.push("tables and kernels weighed".to_string());
+        .axis_desc_style((FONT, AXIS))
+        .label_style((FONT, TICKS))
+        .light_line_style(WHITE)
+        .bold_line_style(LIGHT)
+        .draw()?;
+    if axes.has_zero {
+        chart.draw_series(DashedLineSeries::new(
+            [
+                (ten_to(axes.x_lo), axes.floor),
+                (ten_to(axes.x_hi), axes.floor),
+            ],
+            4,
+            4,
+            GREY.stroke_width(1),
+        ))?;
     }
-    let widest = names.iter().map(|n| text_width(n, NOTE)).max().unwrap_or(0);
-    (widest + 60, 22 * names.len() as i32 + 16)
+    let (xs, ys) = chart.plotting_area().get_pixel_range();
+    let mut labels = Labels::new([xs.start, ys.start, xs.end, ys.end]);
+    // Markers first; their boxes keep the labels off them.
+    let mut pending: Vec<(String, (i32, i32), RGBColor)> = Vec::new();
+    for r in panel.rows.iter().filter(|r| r.operation != "estimate") {
+        let at = chart.backend_coord(&(r.instructions, y_of(r)));
+        root.draw(&TriangleMarker::new(at, 6, GREY.filled()))?;
+        labels.mark(at, 6);
+        let k = (r.model.clone(), r.operation.clone());
+        let n = numbered.iter().position(|v| *v == k).map_or(0, |i| i + 1);
+        pending.push((n.to_string(), at, GREY));
+    }
+    for &(model, color) in models {
+        for r in panel
+            .rows
+            .iter()
+            .filter(|r| r.operation == "estimate" && r.model == model)
+        {
+            let at = chart.backend_coord(&(r.instructions, y_of(r)));
+            root.draw(&Circle::new(at, 7, color.filled()))?;
+            labels.mark(at, 7);
+            // The estimates' names first: the fewer labels, the larger.
+            pending.insert(0, (model.to_string(), at, color));
+        }
+    }
+    for (name, at, color) in pending {
+        let (h, v, pos) = labels.place(at, &name, POINT);
+        root.draw_text(&name, &text(POINT, color, h, v), pos)?;
+    }
+    Ok(labels)
+}
+
+/// The key, in the cell after the last panel: the models' colours, the numbered
+/// tables and kernels, and what the axes measure.
+fn draw_key(
+    root: &Area,
+    cell: &Area,
+    axes: &Axes,
+    models: &[(&str, RGBColor)],
+    numbered: &[(String, String)],
+) -> Res<()> {
+    let (x0, y0) = cell.get_base_pixel();
+    let (x, mut y) = (x0 + 110, y0 + 40);
+    let line = 25;
+    let style = |c| text(NOTE, c, HPos::Left, VPos::Center);
+    root.draw_text(
+        "Key",
+        &text(PANEL_TITLE, BLACK, HPos::Left, VPos::Center),
+        (x, y),
+    )?;
+    y += line + 6;
+    for &(model, color) in models {
+        root.draw(&Circle::new((x + 8, y), 7, color.filled()))?;
+        root.draw_text(
+            &format!("{model}: one estimate (d/b, regime, F, φ₀)"),
+            &style(BLACK),
+            (x + 26, y),
+        )?;
+        y += line;
+    }
+    y += 6;
+    root.draw(&TriangleMarker::new((x + 8, y), 6, GREY.filled()))?;
+    root.draw_text(
+        "n: a table or kernel, where its core runs",
+        &style(BLACK),
+        (x + 26, y),
+    )?;
+    y += line;
+    for (i, (model, op)) in numbered.iter().enumerate() {
+        root.draw_text(&format!("{}", i + 1), &style(GREY), (x + 4, y))?;
+        root.draw_text(&format!("{op} ({model})"), &style(BLACK), (x + 26, y))?;
+        y += line;
+    }
+    y += 6;
+    let notes = [
+        "f32 with an FPU (M4F, M7), fixed point without (M0, M3)".to_string(),
+        "error: worst relative error against the f64 reference".to_string(),
+        if axes.has_zero {
+            format!(
+                "error = 0 (exact): on the dashed line at {}",
+                power_of_ten(&axes.floor)
+            )
+        } else {
+            String::new()
+        },
+    ];
+    for note in notes.iter().filter(|n| !n.is_empty()) {
+        root.draw_text(note, &style(GREY), (x, y))?;
+        y += line;
+    }
+    Ok(())
 }
 
 /// Writes the speed-against-error figure of `rows` to `svg_path`.
@@ -375,24 +473,60 @@ cortex-m4f,f32,cbrt,18,18,1.0e-7
         speed_vs_error(&rows, &svg).unwrap();
         let out = std::fs::read_to_string(&svg).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
-        assert!(out.starts_with("<svg width=\"800\" height=\"600\""));
+        assert!(out.starts_with("<svg width=\"1200\" height=\"1060\""));
         for label in [
-            "reference (estimate)",
-            "hamrock-brewe (estimate)",
-            "error = 0",
-            "m0",
-            "kernel:cbrt (m4f f32)",
-            "table:degree4 (m4f f32)",
-            "tables and kernels weighed",
-            "instructions per estimate",
+            "reference: one estimate",
+            "hamrock-brewe: one estimate",
+            "error = 0 (exact)",
+            "Cortex-M0",
+            "Cortex-M4F",
+            "kernel:cbrt (f32)",
+            "table:degree4 (f32)",
+            "n: a table or kernel",
+            "instructions per call",
         ] {
             assert!(out.contains(label), "missing label {label}");
         }
         assert!(
-            !out.contains(">\ncbrt"),
+            !out.contains(">cbrt ("),
             "plain kernel rows are not plotted"
         );
         assert_eq!(out, speed_vs_error_svg(&rows).unwrap(), "deterministic");
         assert!(speed_vs_error(&[], &svg).is_err(), "no rows, no figure");
+    }
+
+    #[test]
+    fn a_panel_per_cpu_and_the_m7_with_the_m4f_when_it_counts_the_same() {
+        let mut rows = parse_bench_csv(SAMPLE).unwrap();
+        let titles = |rows: &[BenchRow]| -> Vec<String> {
+            panels(rows).into_iter().map(|p| p.title).collect()
+        };
+        assert_eq!(titles(&rows), ["Cortex-M4F", "Cortex-M0"]);
+        let m7: Vec<BenchRow> = rows
+            .iter()
+            .filter(|r| r.cpu == "cortex-m4f")
+            .map(|r| BenchRow {
+                cpu: "cortex-m7".into(),
+                ..r.clone()
+            })
+            .collect();
+        rows.extend(m7.clone());
+        assert_eq!(
+            titles(&rows),
+            [
+                "Cortex-M4F and M7 (the same image: the same counts)",
+                "Cortex-M0"
+            ]
+        );
+        // One count differs: the M7 has a panel of its own.
+        rows.retain(|r| r.cpu != "cortex-m7");
+        rows.extend(m7.into_iter().map(|r| BenchRow {
+            instructions: r.instructions + 1.0,
+            ..r
+        }));
+        assert_eq!(titles(&rows), ["Cortex-M4F", "Cortex-M0", "Cortex-M7"]);
+        let (_, report) = speed_vs_error_layout(&rows).unwrap();
+        assert!(report.crowded.is_empty(), "{:?}", report.crowded);
+        assert!(report.overlaps().is_empty());
     }
 }

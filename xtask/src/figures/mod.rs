@@ -1,7 +1,8 @@
 //! `cargo xtask figures`: the paper's Figs 1-4 redrawn from the f64 reference
-//! ([`paper`]), and the benchmark's speed against error ([`bench_plot`], label
-//! placement in [`labels`]), as SVG files under `docs/`. This module holds what they
-//! share: size, fonts, colours, axes.
+//! ([`paper`]), the benchmark's speed against error ([`bench_plot`], from
+//! docs/bench.csv) and the table shapes weighed ([`shapes_plot`], from
+//! docs/shapes.csv), label placement in [`labels`], as SVG files under `docs/`. This
+//! module holds what they share: size, fonts, colours, axes.
 //!
 //! The output is deterministic (no dates, no randomness, fixed orders), so
 //! `cargo xtask figures --check` can hold the committed files to what the reference
@@ -10,9 +11,10 @@
 mod bench_plot;
 mod labels;
 mod paper;
+mod shapes_plot;
 
-use bench_plot::speed_vs_error_svg;
 pub use bench_plot::{BenchRow, speed_vs_error};
+pub use shapes_plot::{ShapeRow, fronts, shapes_csv};
 
 use std::error::Error;
 use std::fmt::Write as _;
@@ -113,9 +115,14 @@ fn text(size: u32, color: RGBColor, h: HPos, v: VPos) -> TextStyle<'static> {
 
 /// Draws into an 800x600 SVG held in memory and returns it.
 fn render(draw: impl FnOnce(&Area) -> Res<()>) -> Res<String> {
+    render_sized(SIZE, draw)
+}
+
+/// Draws into an SVG of `size` px held in memory and returns it.
+fn render_sized(size: (u32, u32), draw: impl FnOnce(&Area) -> Res<()>) -> Res<String> {
     let mut buf = String::new();
     {
-        let root = SVGBackend::with_string(&mut buf, SIZE).into_drawing_area();
+        let root = SVGBackend::with_string(&mut buf, size).into_drawing_area();
         root.fill(&WHITE)?;
         draw(&root)?;
         root.present()?;
@@ -138,6 +145,19 @@ fn legend_dashed(
 /// Name of the benchmark's CSV and of its figure under `docs/`.
 const BENCH_CSV: &str = "bench.csv";
 const SPEED_SVG: &str = "speed-vs-error.svg";
+/// Name of the table shapes' CSV and of its figure under `docs/`.
+pub const SHAPES_CSV: &str = "shapes.csv";
+pub const SHAPES_SVG: &str = "table-shapes.svg";
+
+/// Writes the table shapes' figure of `rows` to `svg_path`.
+///
+/// # Errors
+/// No row to plot, or an unwritable SVG.
+pub fn table_shapes(rows: &[ShapeRow], svg_path: &Path) -> Res<()> {
+    let svg = shapes_plot::table_shapes_svg(rows)?;
+    std::fs::write(svg_path, svg).map_err(|e| format!("write {}: {e}", svg_path.display()))?;
+    Ok(())
+}
 
 /// `cargo xtask figures [--check]` with `docs` the output folder.
 pub fn run(docs: &Path, check: bool) -> ExitCode {
@@ -151,6 +171,48 @@ pub fn run(docs: &Path, check: bool) -> ExitCode {
     }
 }
 
+/// Says which labels of `name` found no free place or overlap (the tests forbid both
+/// for the committed CSVs).
+fn warn_labels(name: &str, report: &labels::LabelReport) {
+    if !report.crowded.is_empty() {
+        eprintln!("{name}: labels with no free place: {:?}", report.crowded);
+    }
+    let overlaps = report.overlaps();
+    if !overlaps.is_empty() {
+        eprintln!("{name}: {} pairs of labels overlap", overlaps.len());
+    }
+}
+
+/// The figures drawn from measurements, each from its CSV under `docs` when that
+/// exists: the speed against error (docs/bench.csv) and the table shapes
+/// (docs/shapes.csv), with where their labels went.
+fn measured_figures(docs: &Path) -> Res<Vec<(&'static str, String, labels::LabelReport)>> {
+    let mut out = Vec::new();
+    let csv = docs.join(BENCH_CSV);
+    if csv.exists() {
+        let rows = bench_plot::parse_bench_csv(&std::fs::read_to_string(&csv)?)?;
+        let (svg, report) = bench_plot::speed_vs_error_layout(&rows)?;
+        out.push((SPEED_SVG, svg, report));
+    } else {
+        println!(
+            "skipped {SPEED_SVG}: no {} (run cargo xtask bench)",
+            csv.display()
+        );
+    }
+    let csv = docs.join(SHAPES_CSV);
+    if csv.exists() {
+        let rows = shapes_plot::parse_shapes_csv(&std::fs::read_to_string(&csv)?)?;
+        let (svg, report) = shapes_plot::table_shapes_layout(&rows)?;
+        out.push((SHAPES_SVG, svg, report));
+    } else {
+        println!(
+            "skipped {SHAPES_SVG}: no {} (run cargo xtask shapes)",
+            csv.display()
+        );
+    }
+    Ok(out)
+}
+
 fn run_inner(docs: &Path, check: bool) -> Res<bool> {
     // `xtask/../docs` reads better as the absolute folder.
     let docs = &docs
@@ -159,16 +221,9 @@ fn run_inner(docs: &Path, check: bool) -> Res<bool> {
         .zip(docs.file_name())
         .map_or_else(|| docs.to_path_buf(), |(p, name)| p.join(name));
     let mut figures = paper::paper_figures()?;
-    let csv = docs.join(BENCH_CSV);
-    if csv.exists() {
-        let text = std::fs::read_to_string(&csv)?;
-        let rows = bench_plot::parse_bench_csv(&text)?;
-        figures.push((SPEED_SVG, speed_vs_error_svg(&rows)?));
-    } else {
-        println!(
-            "skipped {SPEED_SVG}: no {} (run the benchmark)",
-            csv.display()
-        );
+    for (name, svg, report) in measured_figures(docs)? {
+        warn_labels(name, &report);
+        figures.push((name, svg));
     }
     if check {
         let mut stale = String::new();
@@ -197,6 +252,34 @@ fn run_inner(docs: &Path, check: bool) -> Res<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The committed speed-against-error and table-shapes figures are what their
+    /// committed CSVs draw, and every label in them found a place of its own: none
+    /// overlaps another, none was forced onto a marker.
+    #[test]
+    fn measured_figures_match_their_csvs_and_no_label_overlaps() {
+        let docs = crate::root().join("docs");
+        let figures = measured_figures(&docs).unwrap();
+        assert_eq!(
+            figures.len(),
+            2,
+            "docs/bench.csv and docs/shapes.csv are committed"
+        );
+        for (name, svg, report) in figures {
+            let committed = std::fs::read_to_string(docs.join(name)).unwrap_or_default();
+            assert!(
+                committed == svg,
+                "docs/{name} differs from its CSV's figure: run `cargo xtask figures`"
+            );
+            assert!(!report.boxes.is_empty(), "{name}: no label placed");
+            assert_eq!(
+                report.crowded,
+                Vec::<String>::new(),
+                "{name}: crowded labels"
+            );
+            assert_eq!(report.overlaps(), vec![], "{name}: overlapping labels");
+        }
+    }
 
     #[test]
     fn power_of_ten_labels() {
