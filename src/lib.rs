@@ -54,6 +54,7 @@ pub mod fixed;
 pub mod float;
 pub mod monitor;
 pub mod prepared;
+mod recip;
 pub mod reference;
 pub mod scene;
 mod sensor_fault;

@@ -1,9 +1,8 @@
 //! The elliptic contact (paper sections 5-7) in fixed point.
 
-use super::logexp::{div3, log2_u32};
+use super::logexp::{div3, exp2_finite, log2_u32};
 use super::tables::{
-    LOG_FORCE_HIGH, LOG_FORCE_LOW, LOG_FORCE_MID, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW,
-    LOG_THETA_HIGH, LOG_THETA_LOW,
+    LOG_FORCE_OVER_S, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW, LOG_THETA_HIGH, LOG_THETA_LOW,
 };
 use super::uniform::{ONE, UniformTable};
 use super::{
@@ -211,12 +210,9 @@ impl FixedEllipticScene {
         let ls = self.log_slip.wrapping_add(log_g).wrapping_sub(lp3);
         // F / (mu P) = s r(s) for s < 1 (eq 21), 1 beyond (eq 29); never above 1.
         let (regime, log_ratio) = if ls < 0 {
-            // Against log2 s itself: no exp2. Below the tables' start (s < 2^-24) the
-            // ratio is its limit 3 pi / 4 to within 2^-24: the first node.
-            let log_r = lookup3(
-                [LOG_FORCE_LOW, LOG_FORCE_MID, LOG_FORCE_HIGH],
-                ls.max(LOG_FORCE_LOW.start),
-            )?;
+            // Against s in Q0.24 (s < 1 here): one table of 524 bytes.
+            let s = exp2_finite(ls, 24) as i32; // ls: a sum of finite logarithms
+            let log_r = LOG_FORCE_OVER_S.eval(s).ok_or(Error::OutOfRange)?;
             (Regime::Partial, ls.wrapping_add(log_r).min(0))
         } else {
             (Regime::Gross, 0)
@@ -350,20 +346,6 @@ fn lookup(low: UniformTable<'static>, high: UniformTable<'static>, x: i32) -> Re
 }
 
 /// Zero angle: no slip and no force; the critical angle and margin still stand.
-/// [`lookup`] over three tables that follow each other.
-#[inline(always)]
-fn lookup3(tables: [UniformTable<'static>; 3], x: i32) -> Result<i32, Error> {
-    let [low, mid, high] = tables;
-    let value = if x < mid.start {
-        low.eval(x)
-    } else if x < high.start {
-        mid.eval(x)
-    } else {
-        high.eval(x)
-    };
-    value.ok_or(Error::OutOfRange)
-}
-
 pub(super) fn zero_angle(critical: Option<Log2>, margin: Option<i32>) -> FixedEstimate {
     FixedEstimate {
         slip_ratio: Log2::ZERO,

@@ -161,6 +161,22 @@ pub(crate) struct Units {
     per_angle: f32,
 }
 
+/// `x` truncated to an integer, for `0 <= x < 2^32`: `x as u32` from the bits (the
+/// cast, which saturates, calls soft-float comparisons on a core without an FPU).
+#[inline(always)]
+fn truncate(x: f32) -> u32 {
+    let bits = x.to_bits();
+    let exponent = (bits >> 23) as i32 - 127; // at most 31 below 2^32
+    let mantissa = bits & 0x007f_ffff | 0x0080_0000;
+    if exponent < 0 {
+        0
+    } else if exponent >= 23 {
+        mantissa.wrapping_shl((exponent - 23) as u32)
+    } else {
+        mantissa >> (23 - exponent)
+    }
+}
+
 /// Largest f32 below 2^32 and 2^31: counts that fit u32 and i32.
 const U32_COUNTS: f32 = 4_294_967_040.0;
 const I32_COUNTS: f32 = 2_147_483_520.0;
@@ -182,8 +198,10 @@ impl Units {
         Units {
             load_lsb,
             angle_lsb,
-            per_load: 1.0 / load_lsb,
-            per_angle: 1.0 / angle_lsb,
+            // Reciprocals without a division (crate::recip, within 1 ulp): no
+            // division routine in a node's flash.
+            per_load: crate::recip::recip(load_lsb),
+            per_angle: crate::recip::recip(angle_lsb),
         }
     }
 
@@ -218,9 +236,9 @@ impl Units {
         if load.to_bits() > U32_COUNTS.to_bits() || angle.to_bits() > I32_COUNTS.to_bits() {
             return Err(Error::OutOfRange);
         }
-        let angle = angle as i32; // in [0, 2^31): fits, and so does its negation
+        let angle = truncate(angle) as i32; // in [0, 2^31): fits, and so does its negation
         Ok((
-            load as u32,
+            truncate(load),
             if phi.is_sign_negative() {
                 angle.wrapping_neg()
             } else {
@@ -374,5 +392,19 @@ fn log2_result(x: i64) -> Result<Log2, Error> {
         Ok(Log2(x as i32))
     } else {
         Err(Error::OutOfRange)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn truncate_is_the_cast() {
+        // Every exponent from below 1 to 2^32, a spread of mantissas each.
+        for bits in (0..0x4f80_0000u32).step_by(997) {
+            let x = f32::from_bits(bits);
+            assert_eq!(super::truncate(x), x as u32, "{x:e}");
+        }
+        let top = super::U32_COUNTS;
+        assert_eq!(super::truncate(top), top as u32);
     }
 }

@@ -165,21 +165,12 @@ impl Window {
         insert(sorted, i, k);
     }
 
-    /// Lays the window out for `n` values, keeping the newest (a restore into another
-    /// configuration).
+    /// Lays the window out for `n` values, empty: a monitor's window length never
+    /// changes (a restore fills a fresh window, which keeps the newest `n`).
     #[cold]
     fn resize(&mut self, n: usize) {
-        let mut keep = [0.0f32; CAP];
-        let m = self.len().min(n);
-        let skip = self.len() - m;
-        for (k, slot) in keep.iter_mut().enumerate().take(m) {
-            *slot = self.nth_oldest(skip.wrapping_add(k));
-        }
         self.clear();
         self.size = n as u8;
-        for &x in keep.iter().take(m) {
-            self.push_back(x, n);
-        }
     }
 
     /// The median of a non-empty window.
@@ -250,9 +241,10 @@ impl Window {
             let med = self.median();
             let deviation = (x - med).abs();
             // Within the floor a value is never a spike: the MAD (a second median) is
-            // needed only beyond it, which keeps the usual sample cheap.
+            // needed only beyond it, which keeps the usual sample cheap. Both sides
+            // are >= 0: their bits order them.
             if deviation.to_bits() > floor.to_bits()
-                && deviation > filter.k * MAD_SCALE * self.mad(med) + floor
+                && deviation.to_bits() > (filter.k * MAD_SCALE * self.mad(med) + floor).to_bits()
             {
                 verdict = Some(med);
             }
@@ -298,7 +290,7 @@ const MAD_SCALE: f32 = 1.4826;
 /// constant `tau_s`, so that irregular sampling weighs each sample by the time it
 /// stands for. `y += weight (x - y)`.
 pub(crate) fn smoothing_weight(dt_s: f32, tau_s: f32) -> f32 {
-    one_minus_exp_neg(dt_s / tau_s)
+    one_minus_exp_neg(dt_s * crate::recip::recip(tau_s))
 }
 
 /// `1 - exp(-x)` for `x >= 0` (1 for NaN), within 2.5e-7 of it relative (a test
@@ -308,11 +300,12 @@ pub(crate) fn smoothing_weight(dt_s: f32, tau_s: f32) -> f32 {
 /// y^6, and doubled back `m` times by `expm1(2z) = expm1(z) (expm1(z) + 2)`, which
 /// has no cancellation.
 fn one_minus_exp_neg(x: f32) -> f32 {
-    if x.is_nan() || x >= 88.0 {
+    // On the bits, x >= 0: no soft-float comparison (NaN lands above 88 too).
+    if x.to_bits() >= 88f32.to_bits() {
         return 1.0; // exp(-x) is below the smallest f32, or x is NaN
     }
     let (mut y, mut m) = (x, 0u32);
-    while y >= 0.125 {
+    while y.to_bits() >= 0.125f32.to_bits() {
         y *= 0.5;
         m = m.wrapping_add(1); // at most 10: x < 88
     }
@@ -484,7 +477,7 @@ mod tests {
                 let deviations: std::vec::Vec<f32> = last.iter().map(|x| (x - m).abs()).collect();
                 assert_eq!(w.mad(m), med(&deviations), "window {n} after {pushed}");
             }
-            // Into a shorter window (a restore with another configuration).
+            // Another length starts the window afresh.
             w.push_back(7.0, 1);
             assert_eq!(w.iter().collect::<std::vec::Vec<_>>(), [7.0]);
             assert_eq!(w.sorted(), [key(7.0)]);

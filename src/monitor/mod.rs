@@ -96,6 +96,7 @@ pub use wear::{EnergySum, dissipated_power};
 // the monitor's events name it (always).
 pub use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 
+use crate::recip::recip;
 use crate::{Estimator, FrictionInverse};
 use condition::{finite, ge};
 use sample::Step;
@@ -432,7 +433,8 @@ impl<E: Estimator> Monitor<E> {
             }
         }
         let dt_s = dt_ms as f32 * 1e-3;
-        if config.smoothing_tau_s > 0.0 {
+        // Above zero, by the bits (validated finite and not negative).
+        if config.smoothing_tau_s.to_bits() as i32 > 0 {
             if let Some([l, p]) = st.smoothed {
                 let w = self.weight.weight(dt_ms, config.smoothing_tau_s);
                 load = l + w * (load - l);
@@ -495,7 +497,7 @@ impl<E: Estimator> Monitor<E> {
             if now.saturating_sub(iv.start_ms) >= u64::from(tc.interval_ms) {
                 let point = TrendPoint {
                     time_ms: now as u32,
-                    margin: iv.sum / iv.count as f32,
+                    margin: iv.sum * recip(iv.count as f32),
                 };
                 *iv = TrendInterval::default();
                 // Points older than the window leave (after a stop, say).

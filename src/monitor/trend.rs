@@ -1,7 +1,9 @@
 //! Time to critical: the least-squares trend of the margin phi0 - |phi| over a
 //! fixed window gives the time until gross slip at the current drift.
 
+use super::condition::{finite, ge};
 use super::config::TREND_CAPACITY;
+use crate::recip::recip;
 use heapless::Deque;
 
 /// One trend point: the mean margin over one interval.
@@ -53,26 +55,30 @@ pub fn time_to_critical(points: &[TrendPoint]) -> Option<f32> {
     if n < 3 {
         return None;
     }
-    let (mx, my) = (sx / n as f32, sy / n as f32);
+    // Divisions as products with a reciprocal (crate::recip: no division routine
+    // on a core without an FPU), within 2 ulp.
+    let per_n = recip(n as f32);
+    let (mx, my) = (sx * per_n, sy * per_n);
     let (mut sxx, mut sxy) = (0.0f32, 0.0f32);
     for p in points {
         let dx = -(newest.wrapping_sub(p.time_ms) as f32 * 1e-3) - mx;
         sxx += dx * dx;
         sxy += dx * (p.margin - my);
     }
-    if sxx.is_nan() || sxx <= 0.0 {
+    // Comparisons as integers where floats are soft (condition::ge).
+    if !finite(sxx) || ge(0.0, sxx) {
         return None;
     }
-    let slope = sxy / sxx; // rad/s
+    let slope = sxy * recip(sxx); // rad/s
     let now = my - slope * mx; // the fit at the newest point (x = 0)
-    if !now.is_finite() || !slope.is_finite() {
+    if !finite(now) || !finite(slope) {
         return None;
     }
-    if now <= 0.0 {
+    if ge(0.0, now) {
         Some(0.0)
-    } else if slope < 0.0 {
-        let t = now / -slope;
-        t.is_finite().then_some(t)
+    } else if !ge(slope, 0.0) {
+        let t = now * recip(-slope);
+        finite(t).then_some(t)
     } else {
         None
     }

@@ -585,12 +585,7 @@ fn table_bytes(model: Model, operation: Operation) -> Option<usize> {
         }
         (Model::F32, O::InverseMuLine | O::InversePhiLine) => 0,
         (Model::Fixed, O::Estimate) => {
-            log_exp
-                + log_g
-                + log_theta
-                + size(x::LOG_FORCE_LOW.values)
-                + size(x::LOG_FORCE_MID.values)
-                + size(x::LOG_FORCE_HIGH.values)
+            log_exp + log_g + log_theta + size(x::LOG_FORCE_OVER_S.values)
         }
         (Model::Fixed, O::EstimateLine) => log_exp,
         (Model::Fixed, O::KernelLog2) => size(x::LOG2_MANTISSA.values),

@@ -73,17 +73,6 @@ fn log_force_over_s(s: f64) -> f64 {
     }
 }
 
-fn log_force_over_log_s(x: f64) -> f64 {
-    log_force_over_s(x.exp2())
-}
-
-/// Where the force's table starts: below log2 s = -24 log2(F/(mu P)/s) moves from
-/// its limit log2(3 pi / 4) by less than 2^-24 (its slope is about -0.92 s).
-pub const FORCE_START: f64 = -24.0;
-/// Where the force's log-log tables switch to finer spacing: its third derivative
-/// grows like s, and near s = 1 the (1 - s)^(5/2) of eq (21) needs the finest.
-pub const FORCE_SPLITS: [f64; 2] = [-10.0, -3.0];
-
 /// Where the log-log table of g switches from coarse to fine spacing: below
 /// log2 theta = -4 its third derivative stays under 2e-3, above it reaches 1.1.
 pub const SPLIT_G: f64 = -4.0;
@@ -91,7 +80,7 @@ pub const SPLIT_G: f64 = -4.0;
 pub const SPLIT_THETA: f64 = -6.0;
 
 /// Spacing exponents, chosen by `cargo xtask tables --explore-fixed`.
-pub fn specs() -> [UniformSpec; 11] {
+pub fn specs() -> [UniformSpec; 9] {
     let top = FRAC_PI_2.log2();
     [
         UniformSpec {
@@ -158,29 +147,16 @@ pub fn specs() -> [UniformSpec; 11] {
             spacing_log2: 5,
             f: m_of_log_theta,
         },
+        // Against s, one exp2 per partial-slip sample: 524 bytes, where tables against
+        // log2 s (some 6 instructions fewer on a Cortex-M0) took 1476, more than a
+        // monitoring node in 16 KiB of flash can spare.
         UniformSpec {
-            name: "LOG_FORCE_LOW",
-            doc: "log2(F/(mu P) / s) against log2 s, s = d/b from 2^-24 to 2^-10 (eq 21): below, the constant log2(3 pi / 4) is within 2^-24.",
-            start: FORCE_START,
-            end: FORCE_SPLITS[0],
-            spacing_log2: 2,
-            f: log_force_over_log_s,
-        },
-        UniformSpec {
-            name: "LOG_FORCE_MID",
-            doc: "log2(F/(mu P) / s) against log2 s, s = d/b from 2^-10 to 2^-3 (eq 21).",
-            start: FORCE_SPLITS[0],
-            end: FORCE_SPLITS[1],
-            spacing_log2: 4,
-            f: log_force_over_log_s,
-        },
-        UniformSpec {
-            name: "LOG_FORCE_HIGH",
-            doc: "log2(F/(mu P) / s) against log2 s, s = d/b from 2^-3 to 1 (eq 21).",
-            start: FORCE_SPLITS[1],
-            end: 0.0,
-            spacing_log2: 6,
-            f: log_force_over_log_s,
+            name: "LOG_FORCE_OVER_S",
+            doc: "log2(F/(mu P) / s) against s = d/b in [0, 1) (eq 21), s in Q0.24.",
+            start: 0.0,
+            end: 1.0,
+            spacing_log2: 7,
+            f: log_force_over_s,
         },
     ]
 }
