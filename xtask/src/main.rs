@@ -32,11 +32,13 @@ tasks:
     figures [--check]              write the paper's Figs 1-4 (and the speed against
                                    error from docs/bench.csv, if any) as SVG to docs/
                                    (--check: fail if a committed SVG differs)
-    bench [--csv] [--short]        speed against error: the benchmark image on Cortex-M0, M3,
+    bench [--csv] [--short] [--cpu ID]
+                                   speed against error: the benchmark image on Cortex-M0, M3,
                                    M4F, M7 in QEMU (instructions) and the same code on the
                                    host against the reference data (error); writes
                                    docs/bench.csv, docs/speed-vs-error.svg and the README
-                                   table (--short: fewer samples, writes nothing)
+                                   table (--short: fewer samples, writes nothing; --cpu
+                                   cortex-m4f etc.: that core only, writes nothing)
     firmware [--readme]            build every firmware image and on-target test, run them
                                    in QEMU (Cortex-M4F, M7, M3, M0), print the size and
                                    stack table (--readme: write it into README.md); fail
@@ -105,7 +107,13 @@ fn main() -> ExitCode {
         }
         Some("tables") => tables_task(flag("--check")),
         Some("figures") => figures::run(&root().join("docs"), flag("--check")),
-        Some("bench") => bench::run(flag("--csv"), flag("--short")),
+        Some("bench") => {
+            let cpu = args
+                .iter()
+                .position(|a| a == "--cpu")
+                .map(|i| args.get(i + 1).map(String::as_str).unwrap_or(""));
+            bench::run(flag("--csv"), flag("--short"), cpu)
+        }
         Some("firmware") => firmware::run(flag("--readme")),
         Some("nopanic") => nopanic::run(),
         _ => {
