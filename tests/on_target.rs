@@ -77,7 +77,7 @@ mod check {
 #[cfg(target_os = "none")]
 #[defmt_test::tests]
 mod tests {
-    use misalign::float::octave::{OctaveTable, Row, narrow_rows};
+    use misalign::float::octave::{OctaveTable, Row, WIDE, narrow_rows};
     use misalign::float::{EllipticScene, LineScene, Tables};
     use misalign::float::{G_OF_THETA, G_OF_THETA_ROWS, THETA_OF_G, THETA_OF_G_ROWS};
     use misalign::reference::{self, Regime};
@@ -278,11 +278,11 @@ mod tests {
     #[test]
     fn narrowed_tables_and_risk_threshold() {
         // Rows from theta = 2^-20 up: below that the scene refuses the sample.
-        const SKIP: usize = 20;
+        const SKIP: usize = 12; // the table starts at 2^-32
         const G_ROWS: usize = G_OF_THETA_ROWS.len();
         const T_ROWS: usize = THETA_OF_G_ROWS.len();
-        static G: [Row; G_ROWS - SKIP] = narrow_rows(&G_OF_THETA_ROWS, SKIP);
-        static T: [Row; T_ROWS] = narrow_rows(&THETA_OF_G_ROWS, 0);
+        static G: [Row<WIDE>; G_ROWS - SKIP] = narrow_rows(&G_OF_THETA_ROWS, SKIP);
+        static T: [Row<WIDE>; T_ROWS] = narrow_rows(&THETA_OF_G_ROWS, 0);
         let narrow = Tables {
             g: OctaveTable::new(G_OF_THETA.first_exponent() + SKIP as i32, &G),
             theta_of_g: OctaveTable::new(THETA_OF_G.first_exponent(), &T),

@@ -1,27 +1,57 @@
 //! The elliptic contact (paper sections 5-7) in f32.
 
-use super::kernels::axial_force::axial_force_ratio_nonnegative;
-use super::kernels::cbrt::{cbrt, cbrt_normal};
+use super::kernels::axial_force::axial_force_partial;
+use super::kernels::cbrt::{cbrt, cbrt_cold, cbrt_hot, cbrt_normal};
 use super::kernels::small_theta;
-use super::octave::OctaveTable;
+use super::kernels::theta_top::theta_of_g_top;
+use super::octave::{OctaveTable, WIDE};
 use super::tables;
 use super::{DEFAULT_RISK_SLIP_RATIO, Estimate, check};
 use crate::estimator::check_risk;
 use crate::prepared::{
     Kind, PreparedError, Reader, Writer, positive_finite, positive_normal, seal, value,
 };
-use crate::reference::hertz_scale;
+use crate::reference::{Regime, hertz_scale};
 use crate::{Error, Scene, ThetaRelation};
 use core::f32::consts::{FRAC_PI_2, PI};
 
-/// Below this theta (and g below `SMALL_G`) the small-theta asymptotics are exact in
-/// f32 and take over from the tables.
-const SMALL_THETA: f32 = 9.094_947e-13; // 2^-40
+/// Below these (theta for g, 1/m; g for theta(g)) the small-theta asymptotics take over
+/// from the tables: exact to the float's last few bits there (their own error falls
+/// like theta^2).
+const SMALL_THETA: f32 = 2.328_306_4e-10; // 2^-32, the g table's first octave
+const SMALL_THETA_INV_M: f32 = 9.094_947e-13; // 2^-40, the 1/m table's
 const SMALL_G: f32 = 7.450_581e-9; // 2^-27
-/// Loads outside [2^-120, 2^120] N take the cold path: zero, or a cube root that must
-/// scale. As bits: the lower end and the width of the range.
+/// c below this: the radii differ by more than 1e24, theta never leaves the asymptotic
+/// range and theta0 would underflow f32 while phi0 does not.
+const MIN_RADIUS_FACTOR: f32 = 9.094_947e-13; // 2^-40
+/// Loads outside [2^-120, 2^120) N take the cold path: zero, or a cube root that must
+/// scale. As bits: the lower end and the width of the range (both immediates of one
+/// Thumb-2 instruction).
 const LIGHT_LOAD_BITS: u32 = 0x0380_0000; // 2^-120
 const NORMAL_LOAD_SPAN: u32 = 0x7b80_0000 - 0x0380_0000; // up to 2^120
+/// The hot path takes g0^3 = B^3 P in [2^-81, 1/2): g0 in [2^-27, 0.8), on the
+/// inverse table below its top octave. As bits: the lower end and the width (both, and
+/// the upper end, immediates of one Thumb-2 instruction).
+const HOT_CUBE_LOW_BITS: u32 = 0x1700_0000; // 2^-81
+const HOT_CUBE_SPAN: u32 = 0x3f00_0000 - 0x1700_0000; // up to 1/2
+/// B^3 of the hot path: from 2^-120 (B^3 P < 1/2 means P < 2^119) to 2^39 (B^3 P >= 2^-81
+/// means P >= 2^-120).
+const HOT_GAIN_MIN: f32 = 7.523_164e-37; // 2^-120
+const HOT_GAIN_MAX: f32 = 549_755_813_888.0; // 2^39
+
+/// `2^31 - bits(threshold)` for a positive finite threshold.
+fn risk_offset(threshold: f32) -> u32 {
+    0x8000_0000u32.wrapping_sub(threshold.to_bits())
+}
+
+/// `B^3` if the hot path takes it, else 0.
+fn hot_gain(cubed: f32) -> f32 {
+    if (HOT_GAIN_MIN..=HOT_GAIN_MAX).contains(&cubed) {
+        cubed
+    } else {
+        0.0
+    }
+}
 /// mu at and above which F = mu P could overflow f32 at a load of 2^120 N (the hot
 /// path's heaviest): mu P < 2^127 below it.
 const FRICTION_LIMIT: f64 = 128.0;
@@ -37,9 +67,9 @@ const SLIP_GAIN_LIMIT: f32 = 1.212_09e23;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Tables<'a> {
     /// g(theta) = m n theta.
-    pub g: OctaveTable<'a>,
-    /// theta(g), the inverse of g.
-    pub theta_of_g: OctaveTable<'a>,
+    pub g: OctaveTable<'a, WIDE>,
+    /// theta(g), the inverse of g, in wide segments.
+    pub theta_of_g: OctaveTable<'a, WIDE>,
 }
 
 impl Tables<'static> {
@@ -48,6 +78,15 @@ impl Tables<'static> {
         g: tables::G_OF_THETA,
         theta_of_g: tables::THETA_OF_G,
     };
+}
+
+/// What an estimate is finished from: d/b, `+-mu P` with the sign of phi (the axial
+/// force in gross slip), phi0.
+#[derive(Clone, Copy)]
+struct Parts {
+    slip_ratio: f32,
+    signed_limit: f32,
+    critical_angle: Option<f32>,
 }
 
 /// A prepared elliptic-contact scene: the per-sample constants of eqs (4), (16), (18).
@@ -68,6 +107,13 @@ pub struct EllipticScene<'t> {
     hertz_gain: f32,
     /// d/b at and above which the risk flag is raised.
     risk_slip_ratio: f32,
+    /// `2^31 - bits(risk_slip_ratio)`: d/b at or above the threshold sets bit 31 of
+    /// `bits(d/b) + risk_offset` (both below 2^31 as bits).
+    risk_offset: u32,
+    /// `B^3 = 1/A^3` for the hot path, where g0 = (B^3 P)^(1/3) (eq 18); 0 (no hot
+    /// path) when B^3 lies outside [2^-120, 2^39], so that B^3 P in the hot path's range
+    /// [2^-81, 1/2) means a load in [2^-120, 2^119).
+    cubed_critical_gain: f32,
     tables: Tables<'t>,
 }
 
@@ -98,9 +144,7 @@ impl<'t> EllipticScene<'t> {
             return Err(Error::Unsupported);
         }
         let c = scene.radius_factor();
-        // Below this the radii differ by more than 1e24: theta never leaves the
-        // asymptotic range and theta0 would underflow f32 while phi0 does not.
-        if c < SMALL_THETA as f64 {
+        if c < MIN_RADIUS_FACTOR as f64 {
             return Err(Error::OutOfRange);
         }
         let v = hertz_scale(scene);
@@ -131,6 +175,8 @@ impl<'t> EllipticScene<'t> {
             friction: f[4],
             hertz_gain: f[5],
             risk_slip_ratio: DEFAULT_RISK_SLIP_RATIO,
+            risk_offset: risk_offset(DEFAULT_RISK_SLIP_RATIO),
+            cubed_critical_gain: hot_gain((1.0 / (slip_gain * slip_gain * slip_gain)) as f32),
             tables,
         })
     }
@@ -141,6 +187,7 @@ impl<'t> EllipticScene<'t> {
     /// [`Error::OutOfRange`] for a threshold that is not positive and finite.
     pub fn with_risk_slip_ratio(mut self, slip_ratio: f32) -> Result<Self, Error> {
         self.risk_slip_ratio = check_risk(slip_ratio)?;
+        self.risk_offset = risk_offset(self.risk_slip_ratio);
         Ok(self)
     }
 
@@ -160,17 +207,80 @@ impl<'t> EllipticScene<'t> {
     #[inline(always)]
     pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
         let abs_phi = phi.abs();
-        // On the bits (|phi| >= 0): f32's FRAC_PI_2 lies above pi/2, so at and above
-        // it, and also inf and NaN, whose patterns lie above; so a non-finite phi is
-        // refused here too. theta = c |phi| <= |phi| (c <= 1) stays on the tables.
+        let parts = match self.hot_parts(load, phi, abs_phi) {
+            Some(parts) => parts,
+            None => self.general_parts(load, phi)?,
+        };
+        Ok(self.finish(parts, abs_phi))
+    }
+
+    /// The hot path: |phi| <= 1, B^3 P in [2^-81, 1/2) (so g0 in [2^-27, 0.8) and the
+    /// load in [2^-120, 2^119) N), theta on the tables; `None` for everything else (bad
+    /// input, zero, the asymptotics, no critical angle, the edges), which
+    /// `general_parts` answers the same. The checks are on the bits, each one unsigned
+    /// compare with immediates: |phi| > 1 includes inf and NaN, whose patterns lie
+    /// above; B^3 P outside the range includes a load that is 0, negative, NaN or inf.
+    #[inline(always)]
+    fn hot_parts(&self, load: f32, phi: f32, abs_phi: f32) -> Option<Parts> {
+        let w = self.cubed_critical_gain * load; // g0^3 (eq 18 at d/b = 1)
+        if abs_phi.to_bits() > 1.0f32.to_bits()
+            || w.to_bits().wrapping_sub(HOT_CUBE_LOW_BITS) >= HOT_CUBE_SPAN
+        {
+            return None;
+        }
+        let theta = self.radius_factor * abs_phi;
+        let g = self.tables.g.eval(theta)?;
+        let g0 = cbrt_hot(w);
+        let theta0 = self.tables.theta_of_g.eval(g0)?;
+        Some(Parts {
+            // eq (16) as d/b = g / g0 (A = 1/B).
+            slip_ratio: g / g0,
+            // theta >= 2^-32 here, so phi is not 0: phi / |phi| is its sign, exactly.
+            signed_limit: self.friction * load * (phi / abs_phi),
+            critical_angle: Some(theta0 * self.inv_radius_factor),
+        })
+    }
+
+    /// The estimate from its parts: the axial force of eq (21) (F <= mu P), the regime
+    /// and the risk flag, on the bits (d/b is positive or zero and not NaN, the
+    /// threshold positive and finite: their order is that of their bits).
+    #[inline(always)]
+    fn finish(&self, parts: Parts, abs_phi: f32) -> Estimate {
+        let Parts {
+            slip_ratio: s,
+            signed_limit,
+            critical_angle,
+        } = parts;
+        let bits = s.to_bits();
+        // d/b >= 1: bit 31 of bits + 2^31 - bits(1) (d/b <= +inf: no wrap-around).
+        let gross = bits.wrapping_add(0x8000_0000 - 1.0f32.to_bits()) >> 31;
+        let (force, regime) = if gross == 0 {
+            (axial_force_partial(signed_limit, s), Regime::Partial)
+        } else {
+            (signed_limit, Regime::Gross)
+        };
+        Estimate {
+            slip_ratio: s,
+            regime,
+            axial_force: force,
+            critical_angle,
+            margin: critical_angle.map(|c| c - abs_phi),
+            microslip_risk: bits.wrapping_add(self.risk_offset) >> 31 != 0,
+        }
+    }
+
+    /// The parts of [`EllipticScene::estimate`] for every sample: the checks, zero load
+    /// and angle, the asymptotics below the tables, phi0 where there is none.
+    #[cold]
+    #[inline(never)]
+    fn general_parts(&self, load: f32, phi: f32) -> Result<Parts, Error> {
+        let abs_phi = phi.abs();
         if abs_phi.to_bits() >= FRAC_PI_2.to_bits() {
             return Err(Error::Angle);
         }
         let theta = self.radius_factor * abs_phi;
-        // One unsigned compare on the bits: load outside [2^-120, 2^120] (0, negative,
-        // NaN and inf included) goes to the cold path, which sorts them out.
-        let cbrt_load = if load.to_bits().wrapping_sub(LIGHT_LOAD_BITS) > NORMAL_LOAD_SPAN {
-            match self.extreme_load(load, phi, abs_phi, theta)? {
+        let cbrt_load = if load.to_bits().wrapping_sub(LIGHT_LOAD_BITS) >= NORMAL_LOAD_SPAN {
+            match self.extreme_load(load, phi, theta)? {
                 Ok(cbrt_load) => cbrt_load,
                 Err(zero_load) => return Ok(zero_load),
             }
@@ -178,49 +288,55 @@ impl<'t> EllipticScene<'t> {
             cbrt_normal(load)
         };
         let g = self.g_of_theta(theta)?;
-        let s = self.slip_gain * g / cbrt_load; // eq (16)
-        // eq (21); F <= mu P, formed so that mu P cannot overflow before the ratio.
-        let force = (self.friction * (load * axial_force_ratio_nonnegative(s))).copysign(phi);
-        let g0 = self.critical_gain * cbrt_load; // eq (18) at d/b = 1
-        let critical = self.theta_of_g(g0)?.map(|t| t * self.inv_radius_factor);
-        Ok(Estimate::new(
-            s,
-            force,
-            critical,
-            abs_phi,
-            self.risk_slip_ratio,
-        ))
+        let g0 = self.critical_g(load);
+        // eq (16): d/b = g / g0 as the hot path has it, or A g / P^(1/3) where g0 is
+        // not normal (a light load on a scene of large A: d/b still fits f32).
+        let slip_ratio = if g0.is_normal() {
+            g / g0
+        } else {
+            self.slip_gain * g / cbrt_load
+        };
+        Ok(Parts {
+            slip_ratio,
+            // mu P is finite: `extreme_load` refused the loads where it is not.
+            signed_limit: (self.friction * load).copysign(phi),
+            critical_angle: self.theta_of_g(g0)?.map(|t| t * self.inv_radius_factor),
+        })
     }
 
-    /// Loads outside [2^-120, 2^120] N: bad input (a typed error), zero load (an
+    /// g0 = g(theta0) at load `load` (eq 18 at d/b = 1) for a load 0 or above:
+    /// (B^3 P)^(1/3) as the hot path has it where B^3 P is in its range, else
+    /// B P^(1/3).
+    #[inline]
+    pub(super) fn critical_g(&self, load: f32) -> f32 {
+        let w = self.cubed_critical_gain * load;
+        if w.to_bits().wrapping_sub(HOT_CUBE_LOW_BITS) < HOT_CUBE_SPAN {
+            cbrt_hot(w)
+        } else {
+            self.critical_gain * cbrt_cold(load)
+        }
+    }
+
+    /// Loads outside [2^-120, 2^120) N: bad input (a typed error), zero load (an
     /// unloaded contact slips wherever it is misaligned: d/b = inf, F = 0, phi0 = 0, the
-    /// finished estimate in `Ok(Err(..))`), a load whose mu P overflows f32 (a typed
-    /// error: F would be infinite), or a cube root that must scale (`Ok(Ok(..))`).
+    /// parts in `Ok(Err(..))`), a load whose mu P overflows f32 (a typed error: F would
+    /// be infinite), or a cube root that must scale (`Ok(Ok(..))`).
     #[cold]
     #[inline(never)]
-    fn extreme_load(
-        &self,
-        load: f32,
-        phi: f32,
-        abs_phi: f32,
-        theta: f32,
-    ) -> Result<Result<f32, Estimate>, Error> {
+    fn extreme_load(&self, load: f32, phi: f32, theta: f32) -> Result<Result<f32, Parts>, Error> {
         check(load, phi)?;
         if load == 0.0 {
-            let s = if theta == 0.0 { 0.0 } else { f32::INFINITY };
-            return Ok(Err(Estimate::new(
-                s,
-                0.0,
-                Some(0.0),
-                abs_phi,
-                self.risk_slip_ratio,
-            )));
+            return Ok(Err(Parts {
+                slip_ratio: if theta == 0.0 { 0.0 } else { f32::INFINITY },
+                signed_limit: 0.0,
+                critical_angle: Some(0.0),
+            }));
         }
         // F <= mu P (eq 21) fits f32 when mu P does.
         if (self.friction * load).to_bits() >= f32::INFINITY.to_bits() {
             return Err(Error::OutOfRange);
         }
-        Ok(Ok(cbrt(load)))
+        Ok(Ok(cbrt_cold(load)))
     }
 
     #[inline(always)]
@@ -250,6 +366,8 @@ impl<'t> EllipticScene<'t> {
             return Ok(None);
         }
         match self.tables.theta_of_g.eval(g) {
+            // The top octave from its own, finer table.
+            Some(_) if g.to_bits() >= 1.0f32.to_bits() => Ok(Some(theta_of_g_top(g))),
             Some(t) => Ok(Some(t)),
             None => self.theta_outside(g).map(Some),
         }
@@ -284,7 +402,7 @@ impl<'t> EllipticScene<'t> {
         let inv_m = match tables::INV_M_OF_THETA.eval(theta) {
             Some(x) => x,
             None if theta == 0.0 => return f32::INFINITY, // the strip limit: a = inf
-            None if theta < SMALL_THETA => small_theta::inv_m_small(theta),
+            None if theta < SMALL_THETA_INV_M => small_theta::inv_m_small(theta),
             None => 1.0, // not reached: the table covers theta up to pi/2
         };
         // 2 m V^(1/3) P^(1/3) / length; inf / 0 cannot occur (P > 0).
@@ -315,7 +433,7 @@ impl<'t> EllipticScene<'t> {
         let g = self.g_of_theta(theta)?;
         let inv_m = match tables::INV_M_OF_THETA.eval(theta) {
             Some(x) => x,
-            None if theta < SMALL_THETA => small_theta::inv_m_small(theta),
+            None if theta < SMALL_THETA_INV_M => small_theta::inv_m_small(theta),
             None => return Err(Error::OutOfRange),
         };
         let m = 1.0 / inv_m;
@@ -359,7 +477,7 @@ pub struct Details {
 impl EllipticScene<'static> {
     /// The length of [`EllipticScene::to_bytes`].
     pub const BYTES: usize = crate::prepared::OVERHEAD + Self::PAYLOAD;
-    pub(super) const PAYLOAD: usize = 28;
+    pub(super) const PAYLOAD: usize = 32;
 
     /// The scene [`EllipticScene::to_bytes`] wrote, with the full tables, checked on
     /// the bits of its constants (no floating-point operation); it answers bit for bit
@@ -400,6 +518,7 @@ impl<'t> EllipticScene<'t> {
             self.friction,
             self.hertz_gain,
             self.risk_slip_ratio,
+            self.cubed_critical_gain,
         ] {
             w.f32(x);
         }
@@ -411,14 +530,20 @@ impl<'t> EllipticScene<'t> {
             *x = positive_normal(r.f32())?;
         }
         let risk_slip_ratio = positive_finite(r.f32())?;
+        let cubed_critical_gain = r.f32();
         // On the bits (positive f32 order as their bits): 2^-40 <= c <= 1, A within
-        // `SLIP_GAIN_LIMIT`, mu at most 128 (the f32 of a mu below 128).
+        // `SLIP_GAIN_LIMIT`, mu at most 128 (the f32 of a mu below 128), B^3 0 or in
+        // the hot path's [2^-120, 2^39] (whether it is B's cube takes floating point:
+        // like A against B, it is the writer's).
         let bits = |x: f32| x.to_bits();
         value(
-            bits(SMALL_THETA) <= bits(c[0])
+            bits(MIN_RADIUS_FACTOR) <= bits(c[0])
                 && bits(c[0]) <= bits(1.0)
                 && bits(c[2]) <= bits(SLIP_GAIN_LIMIT)
-                && bits(c[4]) <= bits(FRICTION_LIMIT as f32),
+                && bits(c[4]) <= bits(FRICTION_LIMIT as f32)
+                && (bits(cubed_critical_gain) == 0
+                    || (bits(HOT_GAIN_MIN) <= bits(cubed_critical_gain)
+                        && bits(cubed_critical_gain) <= bits(HOT_GAIN_MAX))),
         )?;
         Ok(EllipticScene {
             radius_factor: c[0],
@@ -428,6 +553,8 @@ impl<'t> EllipticScene<'t> {
             friction: c[4],
             hertz_gain: c[5],
             risk_slip_ratio,
+            risk_offset: risk_offset(risk_slip_ratio),
+            cubed_critical_gain,
             tables,
         })
     }
@@ -448,5 +575,68 @@ mod prepared_tests {
             bound <= limit && limit <= bound * (1.0 + 1e-5),
             "{bound} {limit}"
         );
+    }
+}
+
+#[cfg(test)]
+mod hot_path_tests {
+    use super::{EllipticScene, Parts};
+    use crate::Scene;
+
+    /// The general path's parts, as `estimate` finishes them.
+    fn general(core: &EllipticScene<'_>, load: f32, phi: f32) -> Option<(f32, f32, Option<f32>)> {
+        let p: Parts = core.general_parts(load, phi).ok()?;
+        Some((p.slip_ratio, p.signed_limit, p.critical_angle))
+    }
+
+    /// Wherever the hot path answers, the general path answers the same to the bit:
+    /// over scenes of equal and unequal radii and the edges of the hot path's range
+    /// (|phi| up to 1, B^3 P up to 1/2, theta near the g table's first octave).
+    #[test]
+    fn the_hot_path_is_the_general_one_to_the_bit() {
+        let scenes = [
+            Scene::DEMO,
+            Scene::new(0.02, 0.5, 79.3e9, 0.3, 0.15).unwrap(),
+            Scene::new(1e-3, 1e-3, 1e9, 0.45, 0.6).unwrap(),
+            Scene::new(2.0, 3.0, 80e9, 0.28, 0.05).unwrap(),
+        ];
+        let (mut hot, mut total) = (0, 0);
+        for scene in scenes {
+            let core = EllipticScene::new(&scene).unwrap();
+            for i in 0..4000u32 {
+                // Loads from 1e-6 to 1e12 N, angles from 1e-12 to 1.2 rad, both signs.
+                let u = i as f32 / 4000.0;
+                let load = libm::powf(10.0, -6.0 + 18.0 * u);
+                let v = (i as f32 * 0.618_034).fract();
+                let phi = libm::powf(10.0, -12.0 + 12.1 * v) * if i % 2 == 0 { 1.0 } else { -1.0 };
+                total += 1;
+                if let Some(p) = core.hot_parts(load, phi, phi.abs()) {
+                    hot += 1;
+                    assert_eq!(
+                        Some((p.slip_ratio, p.signed_limit, p.critical_angle)),
+                        general(&core, load, phi),
+                        "{load:e} {phi:e}"
+                    );
+                }
+            }
+        }
+        assert!(hot > total / 4, "{hot} of {total} on the hot path");
+    }
+
+    /// B^3 outside [2^-120, 2^39] (here a scene of A near 1e16: stiff, huge rollers,
+    /// almost no friction): no hot path, every sample through the general one, which
+    /// still answers as the reference does.
+    #[test]
+    fn scenes_without_a_hot_path_still_answer() {
+        let scene = Scene::new(1e6, 1e6, 1e12, 0.3, 1e-8).unwrap();
+        let core = EllipticScene::new(&scene).unwrap();
+        assert_eq!(core.cubed_critical_gain, 0.0);
+        for (load, phi) in [(1e3f32, 1e-3f32), (1e20, 0.3), (1e-20, -1e-6)] {
+            let e = core.estimate(load, phi).unwrap();
+            let r = crate::reference::elliptic(&scene, load as f64, phi as f64).unwrap();
+            let close = |a: f32, b: f64| (a as f64 / b - 1.0).abs() < 2e-6;
+            assert!(close(e.slip_ratio, r.slip_ratio), "{load} {phi}");
+            assert!(close(e.axial_force, r.axial_force), "{load} {phi}");
+        }
     }
 }

@@ -46,7 +46,6 @@ use crate::float::kernels::axial_force_inverse::{
     force_over_slip_limit, force_ratio_slope, slip_ratio_of_force_over_slip,
     slip_ratio_of_force_ratio,
 };
-use crate::float::kernels::cbrt::cbrt;
 use crate::float::kernels::sqrt::{inv_sqrt, sqrt};
 use crate::reference::ContactModel;
 use crate::reference::inverse::{Inconsistency, Inverse, angle_trivial, friction_trivial};
@@ -163,8 +162,9 @@ impl EllipticScene<'_> {
             return Ok(answer);
         }
         let g = self.g_of_theta(theta)?;
-        // K = mu d/b = (A mu) g P^(-1/3) (eq 16), A mu independent of mu.
-        let k = self.slip_gain * self.friction * g / cbrt(load);
+        // K = mu d/b = (A mu) g P^(-1/3) (eq 16), A mu independent of mu: mu times d/b
+        // formed as the forward estimate has it, g / g0.
+        let k = self.friction * (g / self.critical_g(load));
         Ok(friction_from_ratio(
             force.abs() / load,
             k,
@@ -190,7 +190,8 @@ impl EllipticScene<'_> {
         if abs_force > saturated * (1.0 + ROUNDING_ABOVE_SATURATION) {
             return Ok(Inverse::Inconsistent(Inconsistency::AboveModel));
         }
-        let g_per_slip = self.critical_gain * cbrt(load); // eq (16): g = s P^(1/3) / A
+        // eq (16): g = s P^(1/3) / A = s g0, g0 formed as the forward estimate has it.
+        let g_per_slip = self.critical_g(load);
         let answer = if abs_force >= saturated {
             // Gross slip: only |phi| >= phi0 (eq 18 at d/b = 1).
             match self.theta_of_g(g_per_slip)? {

@@ -6,9 +6,9 @@
 //! the critical angle phi0 at this load, the margin to it and a microslip-risk flag.
 //!
 //! The elliptic path (sections 5-7) is `theta = c |phi|` (eq 4), `g(theta) = m n theta`
-//! from a table, `d/b = A g P^(-1/3)` (eq 16), F from eq (21) by a kernel, and
-//! `phi0 = theta(B P^(1/3)) / c` (eq 18 at d/b = 1) from the inverse table; the line
-//! path (section 8) needs no table at all. Each type links only what it uses:
+//! from a table, `g0 = (B^3 P)^(1/3)` (eq 18 at d/b = 1, one cube root), `d/b = g / g0`
+//! (eq 16), F from eq (21) by a kernel, and `phi0 = theta(g0) / c` from the inverse
+//! table; the line path (section 8) needs no table at all. Each type links only what it uses:
 //! [`EllipticScene`] and [`LineScene`] are one model each and never switch;
 //! [`Auto`] applies section 9's model choice per sample, as `reference::estimate` does.
 

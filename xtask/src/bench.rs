@@ -1,4 +1,4 @@
-//! `cargo xtask bench [--csv] [--short]`: speed against error, in one run.
+//! `cargo xtask bench [--csv] [--short] [--cpu ID]`: speed against error, in one run.
 //!
 //! Speed: the benchmark image (harness/src/bin/bench.rs) on the Cortex-M0, M3, M4F and
 //! M7 in QEMU with `-icount` (instructions per call, mean and maximum over the
@@ -6,7 +6,9 @@
 //! the built-in scenario, and its profile). Error: the same code on the host against the
 //! independent reference data (tests/data/vectors_scene.csv and
 //! vectors_line.csv, or `$MISALIGN_REFERENCE_DIR`). Writes docs/bench.csv, docs/speed-vs-error.svg and the README's
-//! "Accuracy and cost" table; `--csv` prints the CSV, else a readable table.
+//! "Accuracy and cost" table; `--csv` prints the CSV, else a readable table. `--cpu ID`
+//! (`cortex-m4f`, ...) runs the image on that core only, for iterating on one core's
+//! code; such a partial run writes nothing.
 
 use crate::cross::{self, CPUS};
 use crate::figures::BenchRow;
@@ -15,6 +17,7 @@ use misalign::fixed::logexp::{exp2_fixed, log2_u32};
 use misalign::fixed::tables::{LOG_G_HIGH, LOG_G_LOW};
 use misalign::fixed::uniform::ONE;
 use misalign::fixed::{FixedEllipticScene, FixedLineScene, exact_lsb};
+use misalign::float::kernels::theta_top::theta_of_g_top;
 use misalign::float::kernels::{axial_force::axial_force_ratio, cbrt::cbrt, sqrt::inv_sqrt};
 use misalign::float::{EllipticScene, G_OF_THETA, LineScene, THETA_OF_G};
 use misalign::reference;
@@ -372,7 +375,12 @@ fn f32_kernel_errors(e: &mut Errors, row: &Record) {
     put(e, Model::F32, Operation::TableG, rel(g_table, g));
     let theta0 = num(row, "theta0");
     let g0 = reference::normal::ellipse_shape(theta0).map_or(f64::NAN, |sh| sh.g());
-    let theta_table = THETA_OF_G.eval(g0 as f32).map_or(f64::NAN, f64::from);
+    // From g = 1 the core reads theta(g) from the finer table of that octave.
+    let theta_table = if g0 >= 1.0 {
+        f64::from(theta_of_g_top(g0 as f32))
+    } else {
+        THETA_OF_G.eval(g0 as f32).map_or(f64::NAN, f64::from)
+    };
     put(
         e,
         Model::F32,
@@ -448,12 +456,12 @@ fn fixed_kernel_errors(e: &mut Errors, row: &Record) {
 /// One measurement of the benchmark image: `(cpu, model, operation, mean, max)`.
 type Measured = (&'static str, Model, Operation, u64, u64);
 
-/// Builds and runs the benchmark image on every CPU.
-fn measure(samples: usize) -> Result<Vec<Measured>, String> {
+/// Builds and runs the benchmark image on every CPU (or only on `only`).
+fn measure(samples: usize, only: Option<&str>) -> Result<Vec<Measured>, String> {
     crate::firmware::preflight()?;
     let mut out = Vec::new();
     let mut built: HashMap<&str, std::path::PathBuf> = HashMap::new();
-    for cpu in &CPUS {
+    for cpu in CPUS.iter().filter(|c| only.is_none_or(|id| c.id == id)) {
         if !built.contains_key(cpu.target) {
             let mut cmd = cross::harness_build(cpu.target);
             cmd.env("MISALIGN_BENCH_SAMPLES", samples.to_string())
@@ -569,20 +577,20 @@ fn table_bytes(model: Model, operation: Operation) -> Option<usize> {
     use misalign::float::tables as t;
     use std::mem::size_of_val as size;
     let force = size(&t::AXIAL_FORCE_LOW) + size(&t::AXIAL_FORCE_HIGH);
+    // theta(g): its table and the finer one of its top octave.
+    let theta_of_g = size(&t::THETA_OF_G_ROWS) + size(&t::THETA_OF_G_TOP);
     let log_exp = size(x::LOG2_MANTISSA.values) + size(x::EXP2_FRACTION.values);
     let log_g = size(x::LOG_G_LOW.values) + size(x::LOG_G_HIGH.values);
     let log_theta = size(x::LOG_THETA_LOW.values) + size(x::LOG_THETA_HIGH.values);
     use Operation as O;
     Some(match (model, operation) {
-        (Model::F32, O::Estimate) => size(&t::G_OF_THETA_ROWS) + size(&t::THETA_OF_G_ROWS) + force,
+        (Model::F32, O::Estimate) => size(&t::G_OF_THETA_ROWS) + theta_of_g + force,
         (Model::F32, O::TableG) => size(&t::G_OF_THETA_ROWS),
-        (Model::F32, O::TableThetaOfG) => size(&t::THETA_OF_G_ROWS),
+        (Model::F32, O::TableThetaOfG) => theta_of_g,
         (Model::F32, O::KernelAxialForce) => force,
         (Model::F32, O::EstimateLine | O::KernelCbrt | O::KernelInvSqrt) => 0,
         (Model::F32, O::InverseMu) => size(&t::G_OF_THETA_ROWS) + force,
-        (Model::F32, O::InversePhi) => {
-            size(&t::G_OF_THETA_ROWS) + size(&t::THETA_OF_G_ROWS) + force
-        }
+        (Model::F32, O::InversePhi) => size(&t::G_OF_THETA_ROWS) + theta_of_g + force,
         (Model::F32, O::InverseMuLine | O::InversePhiLine) => 0,
         (Model::Fixed, O::Estimate) => {
             log_exp + log_g + log_theta + size(x::LOG_FORCE_OVER_S.values)
@@ -678,9 +686,9 @@ fn pipeline(rows: &[Row]) -> String {
 }
 
 /// Errors on the host and instructions in QEMU, paired per (model, operation).
-fn rows(samples: usize) -> Result<Vec<Row>, String> {
+fn rows(samples: usize, only: Option<&str>) -> Result<Vec<Row>, String> {
     let errors = errors()?;
-    let measured = measure(samples)?;
+    let measured = measure(samples, only)?;
     Ok(measured
         .into_iter()
         .map(|(cpu, model, operation, mean, max)| Row {
@@ -710,9 +718,14 @@ fn write_outputs(rows: &[Row]) -> Result<(), String> {
     crate::write_readme_section("bench", &tables)
 }
 
-pub fn run(csv: bool, short: bool) -> ExitCode {
+pub fn run(csv: bool, short: bool, only: Option<&str>) -> ExitCode {
+    if let Some(id) = only.filter(|id| !CPUS.iter().any(|c| c.id == *id)) {
+        let ids: Vec<&str> = CPUS.iter().map(|c| c.id).collect();
+        eprintln!("xtask bench: no cpu {id} (one of {})", ids.join(", "));
+        return ExitCode::from(2);
+    }
     let samples = if short { 32 } else { 256 };
-    let rows = match rows(samples) {
+    let rows = match rows(samples, only) {
         Ok(rows) => rows,
         Err(e) => {
             eprintln!("xtask bench: {e}");
@@ -724,7 +737,9 @@ pub fn run(csv: bool, short: bool) -> ExitCode {
     } else {
         print!("{}\n{}", readable(&rows), pipeline(&rows));
     }
-    if !short {
+    if only.is_some() && !short {
+        eprintln!("xtask bench: a run on one cpu writes nothing");
+    } else if !short {
         if let Err(e) = write_outputs(&rows) {
             eprintln!("xtask bench: {e}");
             return ExitCode::FAILURE;

@@ -34,11 +34,13 @@ tasks:
                                    error from docs/bench.csv, the table shapes from
                                    docs/shapes.csv, if any) as SVG to docs/
                                    (--check: fail if a committed SVG differs)
-    bench [--csv] [--short]        speed against error: the benchmark image on Cortex-M0, M3,
+    bench [--csv] [--short] [--cpu ID]
+                                   speed against error: the benchmark image on Cortex-M0, M3,
                                    M4F, M7 in QEMU (instructions) and the same code on the
                                    host against the reference data (error); writes
                                    docs/bench.csv, docs/speed-vs-error.svg and the README
-                                   table (--short: fewer samples, writes nothing)
+                                   table (--short: fewer samples, writes nothing; --cpu
+                                   cortex-m4f etc.: that core only, writes nothing)
     shapes [--short] [--csv]       the table shapes weighed (f32: variable, segments, degree;
                                    fixed point: spacing, interpolation, one table or two):
                                    instructions in QEMU (f32 on the Cortex-M4F, fixed point
@@ -114,8 +116,14 @@ fn main() -> ExitCode {
         }
         Some("tables") => tables_task(flag("--check")),
         Some("figures") => figures::run(&root().join("docs"), flag("--check")),
-        Some("bench") => bench::run(flag("--csv"), flag("--short")),
         Some("shapes") => shapes::run(flag("--short"), flag("--csv")),
+        Some("bench") => {
+            let cpu = args
+                .iter()
+                .position(|a| a == "--cpu")
+                .map(|i| args.get(i + 1).map(String::as_str).unwrap_or(""));
+            bench::run(flag("--csv"), flag("--short"), cpu)
+        }
         Some("firmware") => firmware::run(flag("--readme")),
         Some("nopanic") => nopanic::run(),
         _ => {

@@ -35,7 +35,7 @@ use crate::fixed_tables::{self, UniformSpec};
 use crate::tables::{self, OctaveSpec};
 use misalign::fixed::tables as fixed_lib;
 use misalign::fixed::uniform::{ONE, UniformTable};
-use misalign::float::octave::{OctaveTable, Row};
+use misalign::float::octave::{OctaveTable, Row, WIDE};
 use std::collections::HashMap;
 use std::f64::consts::{FRAC_PI_2, LN_2};
 use std::fmt::Write as _;
@@ -55,8 +55,8 @@ struct F32Table {
     /// The library's spec (its domain, function, shape).
     spec: OctaveSpec,
     /// The library's kernel and its rows.
-    library: OctaveTable<'static>,
-    rows: &'static [Row],
+    library: OctaveTable<'static, WIDE>,
+    rows: &'static [Row<WIDE>],
 }
 
 fn f32_tables() -> [F32Table; 2] {
@@ -87,13 +87,6 @@ struct F32Shape {
     /// Degree.
     d: usize,
 }
-
-/// The shape the library ships (src/float/octave.rs).
-const F32_SHIPPED: F32Shape = F32Shape {
-    t: false,
-    m: 0,
-    d: misalign::float::octave::DEGREE,
-};
 
 impl F32Shape {
     fn id(&self) -> String {
@@ -465,30 +458,36 @@ fn generate() -> Result<(String, Vec<Weighed>), String> {
     let mut f32_src = String::new();
     for table in f32_tables() {
         let grid = f32_grid(&table.spec);
-        let library = worst_f32(&grid, |x| table.library.eval(x));
-        let shipped = F32_SHIPPED.spec(&table.spec);
+        // As the core reads it: theta(g) from g = 1 from its top octave's own table.
+        let top = table.name == "theta_of_g";
+        let library = worst_f32(&grid, |x| {
+            if top && x >= 1.0 {
+                Some(misalign::float::kernels::theta_top::theta_of_g_top(x))
+            } else {
+                table.library.eval(x)
+            }
+        });
+        let top_bytes = if top {
+            std::mem::size_of_val(&misalign::float::tables::THETA_OF_G_TOP)
+        } else {
+            0
+        };
+        // The library's shape lies outside the family weighed here: two segments per
+        // octave in the centred variable u - 3/2, fitted for the least relative error
+        // (src/float/octave.rs); it is measured beside the family, as itself.
         weighed.push(Weighed {
             table: table.name,
             core: "f32",
             shape: "library".into(),
-            variable: "u",
-            segments: "1".into(),
-            degree: shipped.degree as u32,
-            bytes: std::mem::size_of_val(table.rows),
+            variable: "u-3/2",
+            segments: format!("{}", 1 << misalign::float::octave::SEGMENTS_LOG2),
+            degree: misalign::float::octave::DEGREE as u32,
+            bytes: std::mem::size_of_val(table.rows) + top_bytes,
             error: library,
             shipped: true,
         });
         for shape in f32_shapes() {
             let coeffs = fit_f32(&table.spec, shape);
-            if shape == F32_SHIPPED {
-                let rows = padded::<8>(&coeffs);
-                if rows.as_slice() != table.rows {
-                    return Err(format!(
-                        "{}: the shipped shape's fit is not the library's table (cargo xtask tables --check)",
-                        table.name
-                    ));
-                }
-            }
             let error =
                 with_f32_shape!(shape, f32_error(table.spec.first_exponent, &coeffs, &grid));
             let w = shape.width();
@@ -501,7 +500,7 @@ fn generate() -> Result<(String, Vec<Weighed>), String> {
                 degree: shape.d as u32,
                 bytes: coeffs.len() * w * 4,
                 error,
-                shipped: shape == F32_SHIPPED,
+                shipped: false,
             });
             write_f32_shape(&mut f32_src, table.name, &table.spec, shape, &coeffs);
         }
@@ -744,10 +743,13 @@ fn rows(weighed: &[Weighed], counts: &Counts) -> Result<Vec<ShapeRow>, String> {
 /// instructions.
 fn check_baselines(rows: &[ShapeRow]) -> Result<(), String> {
     for lib in rows.iter().filter(|r| r.kind == "library") {
-        let shipped = rows
+        // The f32 library's shape is not in the family weighed: nothing to hold it to.
+        let Some(shipped) = rows
             .iter()
             .find(|r| r.kind == "shipped" && r.cpu == lib.cpu && r.table == lib.table)
-            .ok_or_else(|| format!("{} {}: no shipped shape", lib.cpu, lib.table))?;
+        else {
+            continue;
+        };
         if shipped.error != lib.error || shipped.bytes != lib.bytes {
             return Err(format!(
                 "{} {}: the shipped shape ({:e}, {} bytes) is not the library's kernel ({:e}, {} bytes)",
@@ -852,34 +854,12 @@ fn run_inner(short: bool, csv: bool) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use misalign::float::{G_OF_THETA, G_OF_THETA_ROWS, THETA_OF_G};
+    use misalign::float::THETA_OF_G;
 
-    /// The evaluator of the shipped f32 shape is the library's kernel: the same value,
-    /// bit for bit, everywhere in the table and outside it.
-    #[test]
-    fn the_shipped_octave_evaluator_is_the_librarys() {
-        let ours = Octaves::<0, 6, 8, false>::new(-40, &G_OF_THETA_ROWS);
-        let (lo, hi) = (G_OF_THETA.lower().to_bits() - 99, 2f32.to_bits() + 99);
-        for bits in (lo..hi).step_by(4099) {
-            let x = f32::from_bits(bits);
-            assert_eq!(
-                ours.eval(x).map(f32::to_bits),
-                G_OF_THETA.eval(x).map(f32::to_bits),
-                "{x:e}"
-            );
-        }
-        for x in [0.0, -1.0, f32::NAN, f32::INFINITY, 1e-30, 4.0] {
-            assert_eq!(ours.eval(x), G_OF_THETA.eval(x));
-        }
-    }
-
-    /// Generating the shapes the library ships gives the library's tables.
+    /// Generating the fixed-point shapes the library ships gives the library's tables
+    /// (the f32 library's shape lies outside the family weighed: measured as itself).
     #[test]
     fn the_shipped_shapes_are_the_librarys_tables() {
-        for table in f32_tables() {
-            let rows = padded::<8>(&fit_f32(&table.spec, F32_SHIPPED));
-            assert_eq!(rows.as_slice(), table.rows, "{}", table.name);
-        }
         for table in fixed_tables() {
             let pieces = fixed_pieces(&table, FIXED_SHIPPED);
             for (p, l) in pieces.iter().zip(&table.library) {
@@ -902,10 +882,10 @@ mod tests {
             d: 3,
         };
         let coeffs = fit_f32(&g.spec, shape);
-        assert_eq!(coeffs.len(), 41 * 4 - 1);
+        assert_eq!(coeffs.len(), g.spec.octaves as usize * 4 - 1);
         let rows = padded::<4>(&coeffs);
-        let table = Octaves::<2, 3, 4, true>::new(-40, &rows);
-        for x in [1e-12f32, 1e-3, 0.3, 1.5] {
+        let table = Octaves::<2, 3, 4, true>::new(g.spec.first_exponent, &rows);
+        for x in [1e-9f32, 1e-3, 0.3, 1.5] {
             let want = (g.spec.f)(x as f64);
             let got = table.eval(x).unwrap() as f64;
             assert!((got / want - 1.0).abs() < 1e-5, "{x}: {got} {want}");
@@ -935,7 +915,6 @@ mod tests {
 
     #[test]
     fn shapes_are_named_by_their_dimensions() {
-        assert_eq!(F32_SHIPPED.id(), "u-s1-d6");
         assert_eq!(
             F32Shape {
                 t: true,
@@ -955,7 +934,8 @@ mod tests {
         let grid = [(0.5f32, (g_of_half()))];
         for shape in f32_shapes() {
             let coeffs = fit_f32(&f32_tables()[0].spec, shape);
-            let e = with_f32_shape!(shape, f32_error(-40, &coeffs, &grid));
+            let first = f32_tables()[0].spec.first_exponent;
+            let e = with_f32_shape!(shape, f32_error(first, &coeffs, &grid));
             assert!(e < 2e-2, "{}: {e}", shape.id());
         }
     }

@@ -7,8 +7,9 @@
 use misalign::fixed::logexp::{exp2_fixed, log2_u32};
 use misalign::fixed::uniform::ONE;
 use misalign::float::kernels::axial_force::axial_force_ratio;
-use misalign::float::kernels::cbrt::cbrt;
+use misalign::float::kernels::cbrt::{cbrt, cbrt_hot};
 use misalign::float::kernels::sqrt::inv_sqrt;
+use misalign::float::kernels::theta_top::theta_of_g_top;
 use misalign::float::tables::{G_OF_THETA, INV_M_OF_THETA, THETA_OF_G};
 use misalign::reference::{normal, tangential};
 use std::fmt::Write;
@@ -104,6 +105,14 @@ pub fn run(quick: bool) -> Vec<Row> {
             |x| (cbrt(x), (x as f64).cbrt()),
         ),
         f32_row(
+            "cbrt_hot",
+            "all f32 in [2^-81, 1/2)",
+            libm::ldexpf(1.0, -81),
+            0.5,
+            s,
+            |x| (cbrt_hot(x), (x as f64).cbrt()),
+        ),
+        f32_row(
             "inv_sqrt",
             "all positive finite f32",
             f32::from_bits(1),
@@ -131,7 +140,8 @@ pub fn run(quick: bool) -> Vec<Row> {
     rows.push(f32_row(
         "table g(theta)",
         &format!(
-            "theta in [2^-40, pi/2], every 2^{}-th f32",
+            "theta in [2^{}, pi/2], every 2^{}-th f32",
+            G_OF_THETA.first_exponent(),
             t.trailing_zeros()
         ),
         G_OF_THETA.lower(),
@@ -147,7 +157,8 @@ pub fn run(quick: bool) -> Vec<Row> {
     rows.push(f32_row(
         "table 1/m(theta)",
         &format!(
-            "theta in [2^-40, pi/2], every 2^{}-th f32",
+            "theta in [2^{}, pi/2], every 2^{}-th f32",
+            INV_M_OF_THETA.first_exponent(),
             t.trailing_zeros()
         ),
         INV_M_OF_THETA.lower(),
@@ -160,17 +171,24 @@ pub fn run(quick: bool) -> Vec<Row> {
             )
         },
     ));
+    // From g = 1 the core reads theta(g) from the finer top-octave table, as here.
     rows.push(f32_row(
         "table theta(g)",
-        &format!("g in [2^-27, pi/2], every 2^{}-th f32", t.trailing_zeros()),
+        &format!(
+            "g in [2^{}, pi/2] (from 1 its top-octave table), every 2^{}-th f32",
+            THETA_OF_G.first_exponent(),
+            t.trailing_zeros()
+        ),
         THETA_OF_G.lower(),
         top,
         t,
         |x| {
-            (
-                THETA_OF_G.eval(x).unwrap_or(f32::NAN),
-                normal::theta_for_g(x as f64).unwrap().theta,
-            )
+            let got = if x >= 1.0 {
+                theta_of_g_top(x)
+            } else {
+                THETA_OF_G.eval(x).unwrap_or(f32::NAN)
+            };
+            (got, normal::theta_for_g(x as f64).unwrap().theta)
         },
     ));
     // Fixed point: log2 of every u32 (error in log2 units, given as "ulps" of 2^-24).

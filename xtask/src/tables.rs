@@ -3,11 +3,12 @@
 //!
 //! Every table here is an "octave table": the input x > 0 is split by its f32 bits into
 //! segments (2^M per octave of x), and on each segment the function is one polynomial of
-//! degree D in the segment's local variable t in [0, 1), the x bits below the segment
-//! index. The firmware finds the segment with a shift and evaluates by Horner: no
-//! logarithm, no search.
+//! degree D in the local variable `t = u - 3/2`, u the mantissa of x in [1, 2) (so t in
+//! [-1/2, 1/2), each segment a part of it). The firmware finds the segment with a shift
+//! and evaluates by Horner: no logarithm, no search.
 
-use crate::fit::{chebyshev_fit, horner_f32};
+use crate::fit::{horner_f32, minimax_relative_fit, minimax_weighted_fit};
+use misalign::float::octave::{CENTER, COMPACT, DEGREE, SEGMENTS_LOG2, WIDE};
 use misalign::reference::{normal, tangential};
 use std::f64::consts::FRAC_PI_2;
 use std::fmt::Write;
@@ -27,6 +28,8 @@ pub struct OctaveSpec {
     pub segments_log2: u32,
     /// Polynomial degree D.
     pub degree: usize,
+    /// Floats per segment in the generated source (the degree's, or padded).
+    pub width: usize,
     /// x above this is outside the domain (fit only up to it).
     pub domain_max: f64,
     /// The function, in f64.
@@ -54,11 +57,13 @@ pub fn specs() -> [OctaveSpec; 3] {
     [
         OctaveSpec {
             name: "G_OF_THETA",
-            doc: "g(theta) = m n theta (eqs 5, 6), theta from 2^-40 to pi/2.",
-            first_exponent: -40,
-            octaves: 41,
-            segments_log2: 0,
-            degree: 6,
+            doc: "g(theta) = m n theta (eqs 5, 6), theta from 2^-32 to pi/2 (below, the\n\
+                  /// small-theta asymptotics), in wide segments.",
+            first_exponent: -32,
+            octaves: 33,
+            segments_log2: SEGMENTS_LOG2,
+            degree: DEGREE,
+            width: WIDE,
             domain_max: FRAC_PI_2,
             f: g_of_theta,
         },
@@ -67,22 +72,43 @@ pub fn specs() -> [OctaveSpec; 3] {
             doc: "1/m(theta) (eqs 5, 6), theta from 2^-40 to pi/2; n = g / (m theta).",
             first_exponent: -40,
             octaves: 41,
-            segments_log2: 0,
-            degree: 6,
+            segments_log2: SEGMENTS_LOG2,
+            degree: DEGREE,
+            width: COMPACT,
             domain_max: FRAC_PI_2,
             f: inv_m_of_theta,
         },
         OctaveSpec {
             name: "THETA_OF_G",
-            doc: "theta(g), the inverse of g(theta), g from 2^-27 to pi/2.",
+            doc: "theta(g), the inverse of g(theta), g from 2^-27 to pi/2, in wide segments\n\
+                  /// (its top octave, from g = 1, is less accurate than the rest: the estimate\n\
+                  /// reads a finer table there).",
             first_exponent: -27,
             octaves: 28,
-            segments_log2: 0,
-            degree: 6,
+            segments_log2: SEGMENTS_LOG2,
+            degree: DEGREE,
+            width: WIDE,
             domain_max: FRAC_PI_2,
             f: theta_of_g,
         },
     ]
+}
+
+/// theta(g) on its top octave, g in [1, pi/2], where theta(g) bends the most (theta
+/// near pi/2): four segments instead of two.
+pub fn theta_top_spec() -> OctaveSpec {
+    OctaveSpec {
+        name: "THETA_OF_G_TOP",
+        doc: "theta(g) for g from 1 to pi/2, four segments (the octave of [`THETA_OF_G`] there\n\
+              /// is the least accurate).",
+        first_exponent: 0,
+        octaves: 1,
+        segments_log2: 2,
+        degree: DEGREE,
+        width: COMPACT,
+        domain_max: FRAC_PI_2,
+        f: theta_of_g,
+    }
 }
 
 /// x at local coordinate t of segment `seg` (counted from the table's first segment).
@@ -98,22 +124,22 @@ pub fn segments(spec: &OctaveSpec) -> usize {
     (spec.octaves as usize) << spec.segments_log2
 }
 
-/// The fitted f32 coefficients, segment by segment.
+/// The fitted f32 coefficients, segment by segment: in t = u - 3/2 on the segment's
+/// part of [-1/2, 1/2) (cut at the domain's end), smallest maximum relative error.
 pub fn fit(spec: &OctaveSpec) -> Vec<Vec<f32>> {
     (0..segments(spec))
         .map(|seg| {
+            let scale = 2f64.powi(spec.first_exponent + (seg >> spec.segments_log2) as i32);
             let (x0, x1) = (x_of(spec, seg, 0.0), x_of(spec, seg, 1.0));
-            let span = if x1 > spec.domain_max {
-                (spec.domain_max - x0) / (x1 - x0)
-            } else {
-                1.0
-            };
-            // Local variable: the mantissa X = 1 + t in [1, 2), which the firmware gets
-            // from the bits with no subtraction (one instruction less per lookup).
-            chebyshev_fit(
-                |u| (spec.f)(x_of(spec, seg, u - 1.0)),
-                1.0,
-                span + 1.0,
+            if x0 >= spec.domain_max {
+                // Beyond the domain (the top table's last quarter): never read.
+                return vec![0.0; spec.degree + 1];
+            }
+            let (u0, u1) = (x0 / scale, x1.min(spec.domain_max) / scale);
+            minimax_relative_fit(
+                |t| (spec.f)(scale * (t + CENTER)),
+                u0 - CENTER,
+                u1 - CENTER,
                 spec.degree,
             )
             .iter()
@@ -128,8 +154,8 @@ pub fn eval(spec: &OctaveSpec, coeffs: &[Vec<f32>], x: f32) -> Option<f32> {
     let shift = 23 - spec.segments_log2;
     let base = ((spec.first_exponent + 127) as u32) << spec.segments_log2;
     let index = (x.to_bits() >> shift).checked_sub(base)? as usize;
-    let t = (x.to_bits() & ((1 << shift) - 1)) as f32 * (1.0 / (1u32 << shift) as f32);
-    coeffs.get(index).map(|c| horner_f32(c, t + 1.0))
+    let u = f32::from_bits((x.to_bits() & 0x007f_ffff) | 0x3f80_0000);
+    coeffs.get(index).map(|c| horner_f32(c, u - CENTER as f32))
 }
 
 /// Worst relative error of the f32 table against the f64 function over `samples`
@@ -139,7 +165,7 @@ pub fn measure(spec: &OctaveSpec, coeffs: &[Vec<f32>], samples: usize) -> (f64, 
     for seg in 0..segments(spec) {
         for k in 0..samples {
             let x = x_of(spec, seg, (k as f64 + 0.5) / samples as f64) as f32;
-            if x as f64 > spec.domain_max {
+            if x as f64 >= spec.domain_max {
                 continue;
             }
             let got = eval(spec, coeffs, x).expect("inside the table") as f64;
@@ -154,7 +180,7 @@ pub fn measure(spec: &OctaveSpec, coeffs: &[Vec<f32>], samples: usize) -> (f64, 
 }
 
 /// Degrees of the two pieces of the axial-force kernel (chosen by `--explore`).
-pub const AXIAL_FORCE_DEGREES: (usize, usize) = (6, 5);
+pub const AXIAL_FORCE_DEGREES: (usize, usize) = (5, 4);
 
 /// `F/(mu P) / s` as a polynomial in s on [0, 1/2] (eq 21 is analytic there), and
 /// `(1 - F/(mu P)) / u^5` as a polynomial in `u = sqrt(1 - s)` on [0, sqrt(1/2)]
@@ -167,7 +193,8 @@ pub fn fit_axial_force(low: usize, high: usize) -> (Vec<f32>, Vec<f32>) {
             tangential::axial_force_ratio(s) / s
         }
     };
-    let lo = chebyshev_fit(ratio, 0.0, 0.5, low);
+    // The relative error of F/(mu P) itself, smallest at its largest.
+    let lo = minimax_relative_fit(ratio, 0.0, 0.5, low);
     let tail = |u: f64| {
         if u == 0.0 {
             0.8 * std::f64::consts::SQRT_2 // the limit (4 sqrt 2 / 5)
@@ -175,29 +202,24 @@ pub fn fit_axial_force(low: usize, high: usize) -> (Vec<f32>, Vec<f32>) {
             (1.0 - tangential::axial_force_ratio((1.0 - u) * (1.0 + u))) / u.powi(5)
         }
     };
-    let hi = chebyshev_fit(tail, 0.0, 0.5f64.sqrt(), high);
+    // An error of the tail counts (1 - F/(mu P)) / (F/(mu P)) times in F/(mu P).
+    let weight = |u: f64| {
+        let f = tangential::axial_force_ratio((1.0 - u) * (1.0 + u));
+        ((1.0 - f) / f).max(1e-12)
+    };
+    // From u = 1/50: below, 1 - F/(mu P) < 4e-9 is lost to f64's rounding of F/(mu P),
+    // and its weight is as small (the polynomial carries on to u = 0).
+    let hi = minimax_weighted_fit(tail, weight, 0.02, 0.5f64.sqrt(), high);
     let f32s = |v: Vec<f64>| v.iter().map(|&c| c as f32).collect();
     (f32s(lo), f32s(hi))
 }
 
-fn write_coeffs(out: &mut String, coeffs: &[Vec<f32>]) {
-    for c in coeffs {
-        out.push_str("    [");
-        let padded: Vec<f32> = c
-            .iter()
-            .copied()
-            .chain(std::iter::repeat(0.0))
-            .take(8)
-            .collect();
-        for (i, x) in padded.iter().enumerate() {
-            if i > 0 {
-                out.push_str(", ");
-            }
-            // {:?} prints the shortest text that reads back to the same f32.
-            write!(out, "{x:?}").unwrap();
-        }
-        out.push_str("],\n");
-    }
+/// One segment's coefficients as Rust: `[c0, c1, ...]`, padded with zeros to `width`.
+fn segment_text(c: &[f32], width: usize) -> String {
+    // {:?} prints the shortest text that reads back to the same f32.
+    let pad = std::iter::repeat_n(&0.0, width.saturating_sub(c.len()));
+    let items: Vec<String> = c.iter().chain(pad).map(|x| format!("{x:?}")).collect();
+    format!("[{}]", items.join(", "))
 }
 
 /// The generated files: `(path under the repository root, text)`.
@@ -216,40 +238,90 @@ pub fn source() -> String {
         "//! Tables of the f32 core (octave polynomials; the axial force's two pieces),\n\
          //! generated from the f64 reference by `cargo xtask tables` (xtask/src/tables.rs).\n\
          //! Do not edit: a test regenerates this file and fails on any drift.\n\n\
-         use super::octave::{OctaveTable, Row};\n\n",
+         use super::octave::{OctaveTable, Row, Segment};\n\n",
     );
     for spec in specs() {
-        assert_eq!(
-            spec.segments_log2, 0,
-            "the library reads one segment per octave"
-        );
         let coeffs = fit(&spec);
-        let (n, d) = (coeffs.len(), spec.degree + 1);
-        let (worst, _) = measure(&spec, &coeffs, 64);
+        let per = 1usize << spec.segments_log2;
+        // theta(g)'s top octave is THETA_OF_G_TOP's: the check covers the octaves below.
+        let checked = if spec.name == "THETA_OF_G" {
+            OctaveSpec {
+                octaves: spec.octaves - 1,
+                ..spec
+            }
+        } else {
+            spec
+        };
+        let (worst, _) = measure(&checked, &coeffs[..segments(&checked)], 64);
         writeln!(
             out,
-            "/// Coefficients of [`{}`], one row per octave.",
+            "/// Coefficients of [`{}`], one row per octave: its {per} segments.",
             spec.name
         )
         .unwrap();
-        assert_eq!(d, 7, "the library's rows hold degree 6");
-        writeln!(out, "pub const {}_ROWS: [Row; {n}] = [", spec.name).unwrap();
-        write_coeffs(&mut out, &coeffs);
+        let row = if spec.width == COMPACT {
+            "Row".to_string()
+        } else {
+            format!("Row<{}>", spec.width)
+        };
+        writeln!(
+            out,
+            "pub const {}_ROWS: [{row}; {}] = [",
+            spec.name, spec.octaves
+        )
+        .unwrap();
+        for octave in coeffs.chunks(per) {
+            let segs: Vec<String> = octave.iter().map(|c| segment_text(c, spec.width)).collect();
+            writeln!(out, "    [{}],", segs.join(", ")).unwrap();
+        }
         out.push_str("];\n\n");
         writeln!(out, "/// {}", spec.doc).unwrap();
         writeln!(
             out,
-            "/// Degree {} per octave from 2^{}; worst relative error {worst:.1e} at the generator's check.",
-            spec.degree, spec.first_exponent
+            "/// Degree {} on each half octave from 2^{}; worst relative error {worst:.1e} at the generator's check{}.",
+            spec.degree,
+            spec.first_exponent,
+            if checked.octaves < spec.octaves {
+                " below its top octave"
+            } else {
+                ""
+            }
         )
         .unwrap();
         writeln!(
             out,
-            "pub const {0}: OctaveTable<'static> = OctaveTable::new({1}, &{0}_ROWS);\n",
-            spec.name, spec.first_exponent
+            "pub const {0}: OctaveTable<'static{2}> = OctaveTable::new({1}, &{0}_ROWS);\n",
+            spec.name,
+            spec.first_exponent,
+            if spec.width == COMPACT {
+                String::new()
+            } else {
+                format!(", {}", spec.width)
+            }
         )
         .unwrap();
     }
+    let top = theta_top_spec();
+    let coeffs = fit(&top);
+    let (worst, _) = measure(&top, &coeffs, 64);
+    writeln!(out, "/// {}", top.doc).unwrap();
+    writeln!(
+        out,
+        "/// Degree {}; worst relative error {worst:.1e} at the generator's check.",
+        top.degree
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "pub const {}: [Segment; {}] = [",
+        top.name,
+        coeffs.len()
+    )
+    .unwrap();
+    for c in &coeffs {
+        writeln!(out, "    {},", segment_text(c, top.width)).unwrap();
+    }
+    out.push_str("];\n\n");
     let (lo, hi) = fit_axial_force(AXIAL_FORCE_DEGREES.0, AXIAL_FORCE_DEGREES.1);
     let pieces = [
         (
@@ -279,7 +351,7 @@ pub fn source() -> String {
 pub fn explore() {
     println!("table,segments_per_octave,degree,bytes,max_rel_error,at");
     for spec in specs() {
-        for m in 0..=1 {
+        for m in 0..=2 {
             for d in 3..=7 {
                 let s = OctaveSpec {
                     segments_log2: m,

@@ -14,9 +14,9 @@ misalign_harness::exit_on_panic!();
 #[cortex_m_rt::entry]
 fn main() -> ! {
     use misalign::Scene;
-    use misalign::float::octave::OctaveTable;
+    use misalign::float::octave::{OctaveTable, WIDE};
     use misalign::float::{EllipticScene, Tables};
-    const NONE: OctaveTable<'static> = OctaveTable::new(0, &[]);
+    const NONE: OctaveTable<'static, WIDE> = OctaveTable::new(0, &[]);
     let empty = Tables {
         g: NONE,
         theta_of_g: NONE,

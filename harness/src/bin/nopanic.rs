@@ -56,7 +56,7 @@ const RECORD_LEN: usize = misalign::storage::codec::record_len(
 mod paths {
     use misalign::fixed::FixedAuto;
     use misalign::fixed::{FixedEllipticScene, FixedLineScene};
-    use misalign::float::octave::{OctaveTable, Row, narrow_rows};
+    use misalign::float::octave::{OctaveTable, Row, WIDE, narrow_rows};
     use misalign::float::{Auto, EllipticScene, LineScene, Tables};
     use misalign::float::{G_OF_THETA_ROWS, THETA_OF_G_ROWS};
     use misalign::monitor::{Config, Monitor, Sample, model_for_range};
@@ -64,8 +64,8 @@ mod paths {
     use misalign_harness::io;
 
     // Narrowed tables (theta from 2^-20 to 2^-6), as in tests/narrow_tables.rs.
-    static G_ROWS: [Row; 14] = narrow_rows(&G_OF_THETA_ROWS, 20);
-    static THETA_ROWS: [Row; 10] = narrow_rows(&THETA_OF_G_ROWS, 13);
+    static G_ROWS: [Row<WIDE>; 14] = narrow_rows(&G_OF_THETA_ROWS, 12);
+    static THETA_ROWS: [Row<WIDE>; 10] = narrow_rows(&THETA_OF_G_ROWS, 13);
     const NARROW: Tables<'static> = Tables {
         g: OctaveTable::new(-20, &G_ROWS),
         theta_of_g: OctaveTable::new(-14, &THETA_ROWS),

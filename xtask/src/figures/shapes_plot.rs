@@ -462,6 +462,16 @@ fn panel(root: &Area, area: &Area, rows: &[&ShapeRow]) -> Res<Labels> {
             named.push(r);
         }
     }
+    // A library whose shape is not among those weighed (the f32 tables: half
+    // octaves in the centred mantissa) is named at its ring.
+    if !named.iter().any(|r| r.kind == "shipped")
+        && let Some(l) = library.filter(|l| l.error.is_finite())
+    {
+        let name = format!("library · {}", bytes(l.bytes));
+        let at = chart.backend_coord(&(l.mean, l.error));
+        let (h, v, pos) = labels.place(at, &name, POINT);
+        root.draw_text(&name, &text(POINT, BLACK, h, v), pos)?;
+    }
     for r in named {
         let name = format!("{} · {}", r.shape, bytes(r.bytes));
         let at = chart.backend_coord(&(r.mean, r.error));
@@ -489,7 +499,7 @@ fn draw_key(root: &Area, key: &Area) -> Res<()> {
             (Glyph::None, "f32 (M4F):".into()),
             (
                 Glyph::Mark(Mark::Circle, BLUE_, 6),
-                "u, the segment's mantissa in [1, 2) (library)".into(),
+                "u, the segment's mantissa in [1, 2)".into(),
             ),
             (Glyph::Mark(Mark::Circle, ORANGE, 6), "t = u − 1".into()),
             (grey(Mark::Circle), "1".into()),
