@@ -23,8 +23,7 @@ impl EnergySum {
     pub fn add(&mut self, term: f32) {
         let y = term + self.compensation;
         let t = self.sum + y;
-        // Not finite, by the bits (no soft-float comparison).
-        if t.to_bits() & 0x7fff_ffff > f32::MAX.to_bits() {
+        if !super::condition::finite(t) {
             return;
         }
         // Fast2Sum: t + (lost) == sum + y exactly.

@@ -92,19 +92,9 @@ impl fmt::Display for CodecError {
 #[cfg(feature = "std")]
 impl std::error::Error for CodecError {}
 
-/// CRC-32 (IEEE 802.3, reflected, as zlib's `crc32`), bit by bit: no table in flash.
-#[must_use]
-pub fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = !0u32;
-    for &byte in bytes {
-        crc ^= u32::from(byte);
-        for _ in 0..8 {
-            let mask = (crc & 1).wrapping_neg();
-            crc = (crc >> 1) ^ (0xEDB8_8320 & mask);
-        }
-    }
-    !crc
-}
+/// CRC-32 of the records: the prepared scenes' own (IEEE 802.3, reflected, as
+/// zlib's `crc32`), one routine in the image for both.
+pub use crate::prepared::crc32;
 
 /// Writes little-endian fields into a payload, never past its end.
 #[derive(Debug)]
