@@ -6,18 +6,31 @@ use super::config::{SPIKE_WINDOW_CAPACITY, SpikeFilter};
 const CAP: usize = SPIKE_WINDOW_CAPACITY;
 
 /// The Hampel window of one channel: the last `size` values in arrival order (a ring
-/// of `size` slots) and the same values sorted, so that the median is read, not
-/// sorted, per sample. Both hold order keys ([`key`]): every comparison is an integer
-/// one, a few instructions on any core (a soft-float comparison on a Cortex-M0 costs
-/// ten times more), and a new value takes the oldest one's place in the sorted values
-/// by one pass of moves (the window's per-sample cost is in the `cargo xtask bench`
-/// profile).
+/// of `size` slots) as order keys ([`key`]: integer comparisons, a few instructions on
+/// any core where a soft-float one costs ten times more), and keys bounding them.
+///
+/// The usual sample is decided without the median: the median lies between the
+/// window's least and greatest values, so a value within `floor` of both bounds is
+/// within `floor` of the median and never a spike. Only a value outside that interval
+/// sorts a copy of the window for the median and the MAD (and tightens the bounds to
+/// its ends): the verdict is always the exact test's (a test checks it against a sort
+/// on random streams). A pushed value widens the bounds, an evicted one leaves them
+/// loose but still bounds; the interval's keys are formed again only after the bounds
+/// moved (two float operations: soft float on a Cortex-M0). The window's per-sample
+/// cost is in the `cargo xtask bench` profile.
 #[derive(Debug, Clone)]
 pub(crate) struct Window {
     /// Keys in arrival order: slots `0..len` while filling, then a ring from `head`.
     ring: [i32; CAP],
-    /// The same keys ascending.
-    sorted: [i32; CAP],
+    /// Keys at or below and at or above every key held (loose after an eviction).
+    lo: i32,
+    hi: i32,
+    /// The keys between which a value is within the floor of every value between
+    /// `lo` and `hi` (one key inside the rounded bounds), when `fresh`.
+    accept_lo: i32,
+    accept_hi: i32,
+    /// Whether `accept_lo`, `accept_hi` are those of the current `lo`, `hi`.
+    fresh: bool,
     /// Slot of the oldest value once full (0 before).
     head: u8,
     /// Values held, at most `size`.
@@ -56,21 +69,6 @@ pub(crate) fn ge(a: f32, b: f32) -> bool {
     }
 }
 
-/// `lo <= x <= hi` for `lo`, `hi` not NaN; false for a NaN `x`. As [`ge`]: the FPU's
-/// comparisons or integers, the same answer.
-#[inline(always)]
-pub(crate) fn within(x: f32, lo: f32, hi: f32) -> bool {
-    #[cfg(target_abi = "eabihf")]
-    {
-        x >= lo && x <= hi
-    }
-    #[cfg(not(target_abi = "eabihf"))]
-    {
-        let k = order(x);
-        k >= order(lo) && k <= order(hi)
-    }
-}
-
 /// Whether `x` is finite, by its bits: an integer comparison on every core (`f32`'s
 /// own test is a soft-float comparison without an FPU).
 #[inline(always)]
@@ -92,7 +90,11 @@ impl Window {
     pub(crate) const fn new() -> Self {
         Window {
             ring: [0; CAP],
-            sorted: [0; CAP],
+            lo: 0,
+            hi: 0,
+            accept_lo: 0,
+            accept_hi: -1,
+            fresh: false,
             head: 0,
             len: 0,
             size: CAP as u8,
@@ -122,12 +124,22 @@ impl Window {
         self.ring.get(i).map_or(0.0, |&k| value(k))
     }
 
-    /// The sorted keys.
-    fn sorted(&self) -> &[i32] {
-        self.sorted.get(..self.len()).unwrap_or(&[])
+    /// The keys held, in slot order.
+    fn keys(&self) -> &[i32] {
+        self.ring.get(..self.len()).unwrap_or(&[])
+    }
+
+    /// The keys held, ascending, and how many.
+    fn sorted(&self) -> ([i32; CAP], usize) {
+        let keys = self.keys();
+        let mut sorted = self.ring;
+        let n = keys.len();
+        sort(&mut sorted, n);
+        (sorted, n)
     }
 
     /// Appends a finite value, dropping the oldest beyond `n` values (n >= 1).
+    #[inline(always)]
     pub(crate) fn push_back(&mut self, x: f32, n: usize) {
         if n != usize::from(self.size) {
             self.resize(n.clamp(1, CAP));
@@ -135,34 +147,27 @@ impl Window {
         let n = usize::from(self.size).min(CAP);
         let k = key(x);
         let len = usize::from(self.len);
-        if len >= n {
-            self.replace_oldest(k, n);
-            return;
+        let slot = if len < n {
+            self.len = (len + 1) as u8;
+            len
+        } else {
+            // Full: the oldest slot. `head < n`: it only ever counts up to `n` and
+            // wraps to 0.
+            let head = usize::from(self.head);
+            self.head = if head + 1 >= n { 0 } else { head + 1 } as u8;
+            head
+        };
+        if let Some(s) = self.ring.get_mut(slot) {
+            *s = k;
         }
-        // Filling: slot `len`, then into the sorted keys after the ones <= k.
-        let (Some(slot), Some(sorted)) = (self.ring.get_mut(len), self.sorted.get_mut(..=len))
-        else {
-            return; // not reached: len < n <= CAP
-        };
-        *slot = k;
-        insert(sorted, len, k);
-        self.len = (len + 1) as u8;
-    }
-
-    /// A full window of `n` (at most `CAP`): `k` takes the oldest key's slot in the
-    /// ring, and its place among the sorted keys, moved from there to where it belongs.
-    #[inline(always)]
-    fn replace_oldest(&mut self, k: i32, n: usize) {
-        // `head < n`: it only ever counts up to `n` and wraps to 0.
-        let head = usize::from(self.head);
-        let (Some(slot), Some(sorted)) = (self.ring.get_mut(head), self.sorted.get_mut(..n)) else {
-            return;
-        };
-        let old = core::mem::replace(slot, k);
-        self.head = if head + 1 >= n { 0 } else { head + 1 } as u8;
-        // The oldest key is held (keys are the values, bit for bit).
-        let i = sorted.iter().position(|&v| v == old).unwrap_or(0);
-        insert(sorted, i, k);
+        // An evicted value leaves the bounds loose, still bounds.
+        if len == 0 {
+            (self.lo, self.hi, self.fresh) = (k, k, false);
+        } else if k < self.lo {
+            (self.lo, self.fresh) = (k, false);
+        } else if k > self.hi {
+            (self.hi, self.fresh) = (k, false);
+        }
     }
 
     /// Lays the window out for `n` values, empty: a monitor's window length never
@@ -173,60 +178,14 @@ impl Window {
         self.size = n as u8;
     }
 
-    /// The median of a non-empty window.
-    #[inline(always)]
-    fn median(&self) -> f32 {
-        // n / 2 < n <= CAP.
-        let n = usize::from(self.len).min(CAP);
-        let upper = value(self.sorted.get(n / 2).copied().unwrap_or(0));
-        if n % 2 == 1 {
-            upper
-        } else {
-            let lower = value(
-                self.sorted
-                    .get((n / 2).saturating_sub(1))
-                    .copied()
-                    .unwrap_or(0),
-            );
-            0.5 * (lower + upper)
-        }
-    }
-
-    /// The median absolute deviation from `med`, the window's median. The deviations
-    /// of the sorted values grow outwards from the middle on both sides: the two
-    /// sequences are merged up to the middle, `n/2 + 1` steps, no sort.
-    #[cold]
-    fn mad(&self, med: f32) -> f32 {
-        let sorted = self.sorted();
-        let n = sorted.len();
-        // |value - med| at index i; +inf past either end.
-        let deviation = |i: usize| {
-            sorted
-                .get(i)
-                .map_or(f32::INFINITY, |&k| (value(k) - med).abs())
-        };
-        // The next left index is `left - 1`, the next right one `right`. Absolute
-        // values (-0 is 0) and +inf: their bits order them.
-        let (mut left, mut right) = (n / 2, n / 2);
-        let mut next = || {
-            let (a, b) = (deviation(left.wrapping_sub(1)), deviation(right));
-            if a.to_bits() <= b.to_bits() {
-                left = left.wrapping_sub(1);
-                a
-            } else {
-                right = right.wrapping_add(1);
-                b
-            }
-        };
-        for _ in 0..n.saturating_sub(1) / 2 {
-            next();
-        }
-        if n.is_multiple_of(2) {
-            let lower = next();
-            0.5 * (lower + next())
-        } else {
-            next()
-        }
+    /// The keys of values within `floor` of every value from `lo` to `hi`:
+    /// `[hi - floor, lo + floor]`, one key inside each rounded end, so that a value
+    /// between them is within the floor of the exact median (empty when the window
+    /// spreads over more than twice the floor).
+    fn refresh(&mut self, floor: f32) {
+        self.accept_lo = key(value(self.hi) - floor).wrapping_add(1);
+        self.accept_hi = key(value(self.lo) + floor).wrapping_sub(1);
+        self.fresh = true;
     }
 
     /// The Hampel test of a finite value `x`: `Some(median)` when `x` is a spike
@@ -238,47 +197,76 @@ impl Window {
         let n = usize::from(filter.window);
         let mut verdict = None;
         if usize::from(self.len) >= n && n > 0 {
-            let med = self.median();
-            let deviation = (x - med).abs();
-            // Within the floor a value is never a spike: the MAD (a second median) is
-            // needed only beyond it, which keeps the usual sample cheap. Both sides
-            // are >= 0: their bits order them.
-            if deviation.to_bits() > floor.to_bits()
-                && deviation.to_bits() > (filter.k * MAD_SCALE * self.mad(med) + floor).to_bits()
-            {
-                verdict = Some(med);
+            if !self.fresh {
+                self.refresh(floor);
+            }
+            let k = key(x);
+            if k < self.accept_lo || k > self.accept_hi {
+                verdict = self.exact(x, filter, floor);
             }
         }
         self.push_back(x, n);
         verdict
     }
+
+    /// The exact test, for a value outside the bounds' interval: the median and the
+    /// MAD of a sorted copy of the window, whose ends tighten the bounds.
+    #[cold]
+    #[inline(never)]
+    fn exact(&mut self, x: f32, filter: &SpikeFilter, floor: f32) -> Option<f32> {
+        let (sorted, n) = self.sorted();
+        let sorted = sorted.get(..n).unwrap_or(&[]);
+        if let (Some(&lo), Some(&hi)) = (sorted.first(), sorted.last())
+            && (lo, hi) != (self.lo, self.hi)
+        {
+            (self.lo, self.hi, self.fresh) = (lo, hi, false);
+        }
+        let med = median(sorted);
+        let deviation = (x - med).abs();
+        // Within the floor a value is never a spike. Both sides are >= 0: their bits
+        // order them.
+        let spike = deviation.to_bits() > floor.to_bits()
+            && deviation.to_bits() > (filter.k * MAD_SCALE * mad(sorted, med) + floor).to_bits();
+        spike.then_some(med)
+    }
 }
 
-/// Puts `k` into the sorted keys in place of the one at `i`: the keys between are
-/// moved one place towards `i`, so that all stay sorted.
-#[inline(always)]
-fn insert(sorted: &mut [i32], mut i: usize, k: i32) {
-    // Every index is checked (`get`): no panic path, and as cheap as indexing.
-    while let Some(&next) = sorted.get(i.wrapping_add(1)) {
-        if next >= k {
-            break;
-        }
-        if let Some(slot) = sorted.get_mut(i) {
-            *slot = next;
-        }
-        i = i.wrapping_add(1);
+/// The median of sorted keys' values (0 for none).
+fn median(sorted: &[i32]) -> f32 {
+    let n = sorted.len();
+    let upper = value(sorted.get(n / 2).copied().unwrap_or(0));
+    if n % 2 == 1 {
+        upper
+    } else {
+        let lower = value(sorted.get((n / 2).wrapping_sub(1)).copied().unwrap_or(0));
+        0.5 * (lower + upper)
     }
-    while let Some(&prev) = sorted.get(i.wrapping_sub(1)) {
-        if prev <= k {
-            break;
-        }
-        if let Some(slot) = sorted.get_mut(i) {
-            *slot = prev;
-        }
-        i = i.wrapping_sub(1);
+}
+
+/// The median absolute deviation from `med`, the median of the sorted keys' values:
+/// the deviations' keys (their bits, >= 0) sorted, and their median.
+fn mad(sorted: &[i32], med: f32) -> f32 {
+    let mut deviations = [0; CAP];
+    for (d, &k) in deviations.iter_mut().zip(sorted) {
+        *d = key((value(k) - med).abs());
     }
-    if let Some(slot) = sorted.get_mut(i) {
-        *slot = k;
+    let n = sorted.len();
+    sort(&mut deviations, n);
+    median(deviations.get(..n).unwrap_or(&[]))
+}
+
+/// Sorts the first `n` keys ascending (insertion: a window holds at most seven).
+fn sort(keys: &mut [i32; CAP], n: usize) {
+    let n = n.min(CAP);
+    for j in 1..n {
+        // j < n <= CAP: every index below is in bounds, as the compiler sees.
+        let k = keys[j];
+        let mut i = j;
+        while i > 0 && keys[i - 1] > k {
+            keys[i] = keys[i - 1];
+            i -= 1;
+        }
+        keys[i] = k;
     }
 }
 
@@ -320,33 +308,112 @@ fn one_minus_exp_neg(x: f32) -> f32 {
     -e
 }
 
-/// The smoothing weight of the last time step, kept so that a repeated step (a
-/// regular sampling period) does not compute `expm1f` and a division per sample (in
-/// soft float on a Cortex-M0 that is most of the smoothing's cost). The same value as
-/// [`smoothing_weight`] for every step: only its recomputation is skipped.
+/// The time step in s and the smoothing weight of the last step, kept so that a
+/// repeated step (a regular sampling period) converts nothing and computes no
+/// exponential per sample (in soft float on a Cortex-M0 that is most of the
+/// smoothing's cost). The same values as computed afresh for every step.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct WeightCache {
-    /// The step (ms) `weight` is for; `u32::MAX`, never a forward step, for none.
+pub(crate) struct StepCache {
+    /// The step (ms) the values are for; `u32::MAX`, never a forward step, for none.
     dt_ms: u32,
-    weight: f32,
+    step: StepValues,
 }
 
-impl WeightCache {
+/// A time step's values.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepValues {
+    /// The step (s).
+    pub(crate) dt_s: f32,
+    /// [`smoothing_weight`] of the step.
+    pub(crate) weight: f32,
+}
+
+impl StepCache {
     pub(crate) const fn new() -> Self {
-        WeightCache {
+        StepCache {
             dt_ms: u32::MAX,
-            weight: 0.0,
+            step: StepValues {
+                dt_s: 0.0,
+                weight: 0.0,
+            },
         }
     }
 
-    /// [`smoothing_weight`] of a step of `dt_ms` for the time constant `tau_s`, which
-    /// must be the same at every call (the monitor's configuration).
-    pub(crate) fn weight(&mut self, dt_ms: u32, tau_s: f32) -> f32 {
+    /// The values of a step of `dt_ms` for the time constant `tau_s`, which must be
+    /// the same at every call (the monitor's configuration).
+    #[inline(always)]
+    pub(crate) fn get(&mut self, dt_ms: u32, tau_s: f32) -> StepValues {
         if dt_ms != self.dt_ms {
-            self.weight = smoothing_weight(dt_ms as f32 * 1e-3, tau_s);
-            self.dt_ms = dt_ms;
+            self.refresh(dt_ms, tau_s);
         }
-        self.weight
+        self.step
+    }
+
+    #[cold]
+    fn refresh(&mut self, dt_ms: u32, tau_s: f32) {
+        let dt_s = dt_ms as f32 * 1e-3;
+        self.step = StepValues {
+            dt_s,
+            weight: smoothing_weight(dt_s, tau_s),
+        };
+        self.dt_ms = dt_ms;
+    }
+}
+
+/// A closed range `[lo, hi]` of f32 (ends not NaN) as the per-sample checks compare
+/// it: the FPU's comparisons where there is one (`eabihf`), else the ends' order keys
+/// ([`order`]), formed once. A NaN is outside.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Range {
+    lo: Ordered,
+    hi: Ordered,
+}
+
+/// A value as the target compares it fastest.
+#[cfg(target_abi = "eabihf")]
+type Ordered = f32;
+#[cfg(not(target_abi = "eabihf"))]
+type Ordered = i32;
+
+#[inline(always)]
+fn ordered(x: f32) -> Ordered {
+    #[cfg(target_abi = "eabihf")]
+    {
+        x
+    }
+    #[cfg(not(target_abi = "eabihf"))]
+    {
+        order(x)
+    }
+}
+
+impl Range {
+    pub(crate) fn new(lo: f32, hi: f32) -> Self {
+        Range {
+            lo: ordered(lo),
+            hi: ordered(hi),
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn contains(&self, x: f32) -> bool {
+        let x = ordered(x);
+        x >= self.lo && x <= self.hi
+    }
+}
+
+/// A lower limit (not NaN): whether a value reaches it, as [`ge`] answers.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AtLeast(Ordered);
+
+impl AtLeast {
+    pub(crate) fn new(limit: f32) -> Self {
+        AtLeast(ordered(limit))
+    }
+
+    #[inline(always)]
+    pub(crate) fn reached(&self, x: f32) -> bool {
+        ordered(x) >= self.0
     }
 }
 
@@ -405,13 +472,18 @@ mod tests {
                 assert_eq!(ge(a, b), a >= b, "{a} {b}");
                 assert_eq!(order(a) >= order(b), a >= b, "{a} {b}");
                 assert!(finite(a));
-                assert_eq!(within(a, b, 1.0), b <= a && a <= 1.0, "{a} {b}");
+                assert_eq!(
+                    Range::new(b, 1.0).contains(a),
+                    b <= a && a <= 1.0,
+                    "{a} {b}"
+                );
+                assert_eq!(AtLeast::new(b).reached(a), a >= b, "{a} {b}");
             }
             assert!(!finite(f32::INFINITY) && !finite(f32::NEG_INFINITY));
             // A NaN of either sign is outside every finite range.
             for nan in [f32::NAN, -f32::NAN] {
                 assert!(order(nan) > order(f32::INFINITY) || order(nan) < order(f32::NEG_INFINITY));
-                assert!(!within(nan, f32::NEG_INFINITY, f32::INFINITY));
+                assert!(!Range::new(f32::NEG_INFINITY, f32::INFINITY).contains(nan));
                 assert!(!finite(nan));
             }
         }
@@ -460,30 +532,89 @@ mod tests {
                 assert_eq!(held, want, "window {n} after {pushed}");
                 let mut sorted: std::vec::Vec<i32> = last.iter().map(|&x| key(x)).collect();
                 sorted.sort();
-                assert_eq!(w.sorted(), &sorted[..], "window {n} after {pushed}");
+                let (held_sorted, len) = w.sorted();
+                assert_eq!(
+                    &held_sorted[..len],
+                    &sorted[..],
+                    "window {n} after {pushed}"
+                );
+                // The bounds hold every value.
+                assert!(sorted.iter().all(|&k| w.lo <= k && k <= w.hi));
                 // The median and the MAD as a plain sort gives them.
-                let med = |v: &[f32]| {
-                    let mut v = v.to_vec();
-                    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
-                    let m = v.len();
-                    if m % 2 == 1 {
-                        v[m / 2]
-                    } else {
-                        0.5 * (v[m / 2 - 1] + v[m / 2])
-                    }
-                };
-                let m = med(last);
-                assert_eq!(w.median(), m, "window {n} after {pushed}");
+                let m = plain_median(last);
+                assert_eq!(median(&sorted), m, "window {n} after {pushed}");
                 let deviations: std::vec::Vec<f32> = last.iter().map(|x| (x - m).abs()).collect();
-                assert_eq!(w.mad(m), med(&deviations), "window {n} after {pushed}");
+                assert_eq!(
+                    mad(&sorted, m),
+                    plain_median(&deviations),
+                    "window {n} after {pushed}"
+                );
             }
             // Another length starts the window afresh.
             w.push_back(7.0, 1);
             assert_eq!(w.iter().collect::<std::vec::Vec<_>>(), [7.0]);
-            assert_eq!(w.sorted(), [key(7.0)]);
+            assert_eq!(w.sorted().1, 1);
             w.clear();
             assert_eq!(w.iter().count(), 0);
-            assert!(w.sorted().is_empty());
+            assert_eq!(w.sorted().1, 0);
+        }
+    }
+
+    fn plain_median(v: &[f32]) -> f32 {
+        let mut v = v.to_vec();
+        v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        let m = v.len();
+        if m % 2 == 1 {
+            v[m / 2]
+        } else {
+            0.5 * (v[m / 2 - 1] + v[m / 2])
+        }
+    }
+
+    /// The Hampel verdict, decided by the bounds where it can be, against the plain
+    /// test (median and MAD of a sort of the window) on random streams: noise near the
+    /// floor, drifts, steps and spikes, both signs, every window length.
+    #[test]
+    fn hampel_is_the_exact_test() {
+        let mut rng = 0x1234_5678u32;
+        let mut uniform = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 17;
+            rng ^= rng << 5;
+            (rng >> 8) as f32 / 16_777_216.0
+        };
+        for n in 3..=CAP {
+            for (floor, noise) in [(1.0f32, 0.3f32), (1.0, 0.6), (1.0, 2.0), (2e-5, 3e-6)] {
+                let filter = SpikeFilter {
+                    window: n as u8,
+                    k: 4.0,
+                    load_floor: floor,
+                    angle_floor: floor,
+                };
+                let mut w = Window::new();
+                let mut last: std::vec::Vec<f32> = std::vec::Vec::new();
+                for i in 0..4000 {
+                    let mut x = (i as f32 * 1e-3 - 1.0) * floor + noise * (uniform() - 0.5);
+                    if i % 97 == 0 {
+                        x += 10.0 * floor * (uniform() - 0.5);
+                    }
+                    if i % 500 == 250 {
+                        x = -x;
+                    }
+                    let want = (last.len() >= n).then(|| {
+                        let window = &last[last.len() - n..];
+                        let m = plain_median(window);
+                        let devs: std::vec::Vec<f32> =
+                            window.iter().map(|v| (v - m).abs()).collect();
+                        let d = (x - m).abs();
+                        (d > floor && d > filter.k * MAD_SCALE * plain_median(&devs) + floor)
+                            .then_some(m)
+                    });
+                    let got = w.hampel(x, &filter, floor);
+                    assert_eq!(got, want.flatten(), "n {n} floor {floor} sample {i}");
+                    last.push(x);
+                }
+            }
         }
     }
 }

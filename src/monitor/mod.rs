@@ -98,7 +98,7 @@ pub use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 
 use crate::recip::recip;
 use crate::{Estimator, FrictionInverse};
-use condition::{finite, ge};
+use condition::{AtLeast, Range, finite, ge};
 use sample::Step;
 
 /// A sample that was estimated: its conditioned load (N) and angle (rad) and its time
@@ -116,10 +116,11 @@ pub struct Monitor<E> {
     estimator: E,
     config: Config,
     levels: risk::Levels,
+    limits: Limits,
     status: Status,
-    load_window: condition::Window,
-    angle_window: condition::Window,
-    weight: condition::WeightCache,
+    /// The spike windows of load and angle.
+    windows: [condition::Window; 2],
+    step_cache: condition::StepCache,
     trend: trend::TrendBuffer,
     events: events::EventQueue,
 }
@@ -139,23 +140,80 @@ impl<E> defmt::Format for Monitor<E> {
     }
 }
 
-/// Checks one channel's value: non-finite, then out of `[lo, hi]`.
-#[inline(always)]
-fn check(x: f32, lo: f32, hi: f32, channel: Channel) -> Option<FaultCause> {
-    // One pair of comparisons on the usual path: a NaN lies outside.
-    if condition::within(x, lo, hi) {
-        None
-    } else {
-        Some(out_of_range(x, channel))
-    }
+/// Bytes of a monitor's configuration: the [`Config`] and what is formed from it
+/// once (the state budget leaves them out).
+const CONFIGURATION_BYTES: usize = core::mem::size_of::<Config>()
+    + core::mem::size_of::<Limits>()
+    + core::mem::size_of::<risk::Levels>();
+
+/// The configuration's limits as the per-sample checks compare them, formed once.
+#[derive(Debug, Clone, Copy)]
+struct Limits {
+    load: Range,
+    angle: Range,
+    speed: Range,
+    force: Range,
+    stop_load: AtLeast,
+    stop_speed: AtLeast,
+    nominal_speed: f32,
+    /// The gap (ms); `u32::MAX`, never exceeded, when off.
+    gap_ms: u32,
+    stuck_ms: u32,
+    /// Whether the smoothing is on.
+    smoothing: bool,
 }
 
-#[cold]
-fn out_of_range(x: f32, channel: Channel) -> FaultCause {
-    if x.is_finite() {
-        FaultCause::OutOfRange(channel)
-    } else {
-        FaultCause::NonFinite(channel)
+impl Limits {
+    fn new(config: &Config) -> Self {
+        Limits {
+            load: Range::new(config.load_min, config.load_max),
+            angle: Range::new(-config.angle_max, config.angle_max),
+            speed: Range::new(0.0, config.speed_max),
+            force: Range::new(-config.force_max, config.force_max),
+            stop_load: AtLeast::new(config.stop_load),
+            stop_speed: AtLeast::new(config.stop_speed),
+            nominal_speed: config.nominal_speed,
+            gap_ms: if config.gap_ms > 0 {
+                config.gap_ms
+            } else {
+                u32::MAX
+            },
+            stuck_ms: config.stuck_ms,
+            // Above zero, by the bits (validated finite and not negative).
+            smoothing: config.smoothing_tau_s.to_bits() as i32 > 0,
+        }
+    }
+
+    /// The first fault of a sample that failed the checks at speed `speed`: a
+    /// sensor's report, a driver's, then load, angle, speed and axial force, each
+    /// non-finite or out of range.
+    #[cold]
+    #[inline(never)]
+    fn cause(&self, sample: &Sample, speed: f32) -> FaultCause {
+        if let Some(f) = sample.sensor_fault {
+            return FaultCause::Sensor(f);
+        }
+        if let Some(c) = sample.driver_fault {
+            return FaultCause::Driver(c);
+        }
+        let force = sample.axial_force.unwrap_or(0.0);
+        let checks = [
+            (sample.load, &self.load, Channel::Load),
+            (sample.phi, &self.angle, Channel::Angle),
+            (speed, &self.speed, Channel::Speed),
+            (force, &self.force, Channel::AxialForce),
+        ];
+        for (x, range, channel) in checks {
+            if !range.contains(x) {
+                return if finite(x) {
+                    FaultCause::OutOfRange(channel)
+                } else {
+                    FaultCause::NonFinite(channel)
+                };
+            }
+        }
+        // Not reached: the sample failed one of the checks above.
+        FaultCause::Estimator
     }
 }
 
@@ -169,11 +227,11 @@ impl<E: Estimator> Monitor<E> {
         Ok(Monitor {
             estimator,
             levels: risk::Levels::new(&config.thresholds),
+            limits: Limits::new(&config),
             config,
             status: Status::new(),
-            load_window: condition::Window::new(),
-            angle_window: condition::Window::new(),
-            weight: condition::WeightCache::new(),
+            windows: [condition::Window::new(), condition::Window::new()],
+            step_cache: condition::StepCache::new(),
             trend: trend::TrendBuffer::new(),
             events: events::EventQueue::new(),
         })
@@ -243,8 +301,9 @@ impl<E: Estimator> Monitor<E> {
     /// Clears the conditioning after a sample that was not estimated (a fault, a
     /// stop): the values before it say nothing about the ones after.
     fn restart_conditioning(&mut self) {
-        self.load_window.clear();
-        self.angle_window.clear();
+        for w in &mut self.windows {
+            w.clear();
+        }
         self.status.smoothed = None;
     }
 
@@ -295,9 +354,6 @@ impl<E: Estimator> Monitor<E> {
 
     /// [`process`](Self::process), and the sample that was estimated, if it was.
     fn step(&mut self, sample: Sample) -> (RiskState, Option<Estimated>) {
-        // Borrowed, not copied: a copy of the whole configuration costs more per
-        // sample than the fields read.
-        let config = &self.config;
         let st = &mut self.status;
         // The u64 counters and times add without saturating: at one sample a
         // microsecond, or in milliseconds, they cannot wrap in 500 000 years.
@@ -305,8 +361,8 @@ impl<E: Estimator> Monitor<E> {
         let held = st.alarm.state;
         let mut fault = None;
         let dt_ms = match st.clock.step(sample.time_ms) {
-            Step::First => 0,
             Step::Forward(d) => d,
+            Step::First => 0,
             Step::Repeated => {
                 let r = &mut st.stats.repeated_timestamps;
                 *r = r.saturating_add(1);
@@ -319,35 +375,30 @@ impl<E: Estimator> Monitor<E> {
         };
         let now = st.clock.elapsed_ms;
         // Each step counts for the state held during it.
-        let t = &mut st.stats.time_in_state_ms[held.index()];
-        *t = t.wrapping_add(u64::from(dt_ms));
-        if config.gap_ms > 0 && dt_ms > config.gap_ms {
+        if let Some(t) = st.stats.time_in_state_ms.get_mut(held.index()) {
+            *t = t.wrapping_add(u64::from(dt_ms));
+        }
+        let limits = &self.limits;
+        if dt_ms > limits.gap_ms {
             fault = Some(FaultCause::Gap);
         }
-        let st = &mut self.status;
-        // Sensor checks, the first fault found wins.
-        let speed = sample.speed.unwrap_or(config.nominal_speed);
-        fault = fault
-            .or(sample.sensor_fault.map(FaultCause::Sensor))
-            .or(sample.driver_fault.map(FaultCause::Driver))
-            .or_else(|| check(sample.load, config.load_min, config.load_max, Channel::Load))
-            .or_else(|| {
-                check(
-                    sample.phi,
-                    -config.angle_max,
-                    config.angle_max,
-                    Channel::Angle,
-                )
-            })
-            .or_else(|| check(speed, 0.0, config.speed_max, Channel::Speed))
-            .or_else(|| {
-                let f = sample.axial_force?;
-                check(f, -config.force_max, config.force_max, Channel::AxialForce)
-            });
-        let running = ge(sample.load, config.stop_load) && ge(speed, config.stop_speed);
-        if fault.is_none() && config.stuck_ms > 0 {
-            let load_stuck = st.stuck[0].stuck(sample.load, now, config.stuck_ms, !running);
-            let angle_stuck = st.stuck[1].stuck(sample.phi, now, config.stuck_ms, !running);
+        // Sensor checks: one pass of comparisons on the usual path; which check
+        // failed is found only for a faulty sample (the first found wins).
+        let speed = sample.speed.unwrap_or(limits.nominal_speed);
+        let valid = sample.sensor_fault.is_none()
+            && sample.driver_fault.is_none()
+            && limits.load.contains(sample.load)
+            && limits.angle.contains(sample.phi)
+            && limits.speed.contains(speed)
+            && sample.axial_force.is_none_or(|f| limits.force.contains(f));
+        if !valid && fault.is_none() {
+            fault = Some(limits.cause(&sample, speed));
+        }
+        let running = limits.stop_load.reached(sample.load) && limits.stop_speed.reached(speed);
+        if fault.is_none() && limits.stuck_ms > 0 {
+            let (limit, reset) = (limits.stuck_ms, !running);
+            let load_stuck = st.stuck[0].stuck(sample.load, now, limit, reset);
+            let angle_stuck = st.stuck[1].stuck(sample.phi, now, limit, reset);
             if load_stuck {
                 fault = Some(FaultCause::Stuck(Channel::Load));
             } else if angle_stuck {
@@ -360,14 +411,10 @@ impl<E: Estimator> Monitor<E> {
             None if !running => RiskState::Stopped,
             None => {
                 st.alarm.note_running(now);
-                match self.estimate(sample, dt_ms, held, now) {
-                    Ok(c) => {
-                        estimated = self.status.reading.map(|r| Estimated {
-                            load: r.load,
-                            phi: r.phi,
-                            dt_ms,
-                        });
-                        c
+                match self.estimate(&sample, speed, dt_ms, held, now) {
+                    Ok((level, at)) => {
+                        estimated = Some(at);
+                        level
                     }
                     Err(f) => {
                         fault = Some(f);
@@ -377,68 +424,81 @@ impl<E: Estimator> Monitor<E> {
             }
         };
         if let Some(f) = fault {
-            self.status.stats.faults.count(f);
-        }
-        if candidate == RiskState::SensorFault || candidate == RiskState::Stopped {
-            // Not estimated: what the windows and the filter hold is stale now.
+            self.not_estimated(f);
+        } else if candidate == RiskState::Stopped {
             self.restart_conditioning();
         }
-        let changed = self.status.alarm.offer(&self.config, candidate, now);
         let st = &mut self.status;
+        let changed = st.alarm.offer(&self.config, candidate, now);
         // Above zero (by its bits: a soft-float comparison costs more).
         if st.energy_step.to_bits() as i32 > 0 {
-            st.stats.energy[st.alarm.state.index()].add(st.energy_step);
+            if let Some(sum) = st.stats.energy.get_mut(st.alarm.state.index()) {
+                sum.add(st.energy_step);
+            }
             st.energy_step = 0.0;
         }
         if let Some(from) = changed {
-            let to = self.status.alarm.state;
-            let cause = if to == RiskState::SensorFault {
-                fault
-            } else {
-                None
-            };
-            self.emit(
-                EventKind::StateChange {
-                    from,
-                    to,
-                    fault: cause,
-                },
-                sample.time_ms,
-            );
+            self.state_changed(from, fault, sample.time_ms);
         }
-        self.approaching(sample.time_ms);
+        if self.status.time_to_critical_s.is_some() || !self.status.approaching_armed {
+            self.approaching(sample.time_ms);
+        }
         (self.status.alarm.state, estimated)
     }
 
-    /// Conditioning, estimate, wear and trend of a valid running sample; the slip
-    /// level it asks for, or the fault that stops it.
+    /// A sample that was not estimated for fault `f`: counted, and the conditioning
+    /// starts afresh.
+    #[cold]
+    fn not_estimated(&mut self, f: FaultCause) {
+        self.status.stats.faults.count(f);
+        self.restart_conditioning();
+    }
+
+    /// The event of a state change from `from`, naming the fault behind a change to
+    /// `SensorFault`.
+    #[cold]
+    fn state_changed(&mut self, from: RiskState, fault: Option<FaultCause>, time_ms: u32) {
+        let to = self.status.alarm.state;
+        let fault = if to == RiskState::SensorFault {
+            fault
+        } else {
+            None
+        };
+        self.emit(EventKind::StateChange { from, to, fault }, time_ms);
+    }
+
+    /// Conditioning, estimate, wear and trend of a valid running sample at speed
+    /// `speed`; the slip level it asks for and the conditioned sample, or the fault
+    /// that stops it.
+    #[inline(always)]
     fn estimate(
         &mut self,
-        sample: Sample,
+        sample: &Sample,
+        speed: f32,
         dt_ms: u32,
         held: RiskState,
         now: u64,
-    ) -> Result<RiskState, FaultCause> {
+    ) -> Result<(RiskState, Estimated), FaultCause> {
         let config = &self.config;
         let st = &mut self.status;
         let (mut load, mut phi) = (sample.load, sample.phi);
         if let Some(filter) = &config.spikes {
-            if let Some(m) = self.load_window.hampel(load, filter, filter.load_floor) {
-                load = m;
-                st.stats.spikes = st.stats.spikes.saturating_add(1);
+            // One loop over both channels: one copy of the window's code in the image.
+            let mut values = [load, phi];
+            let floors = [filter.load_floor, filter.angle_floor];
+            for ((w, x), floor) in self.windows.iter_mut().zip(&mut values).zip(floors) {
+                if let Some(m) = w.hampel(*x, filter, floor) {
+                    *x = m;
+                    st.stats.spikes = st.stats.spikes.saturating_add(1);
+                }
             }
-            if let Some(m) = self.angle_window.hampel(phi, filter, filter.angle_floor) {
-                phi = m;
-                st.stats.spikes = st.stats.spikes.saturating_add(1);
-            }
+            [load, phi] = values;
         }
-        let dt_s = dt_ms as f32 * 1e-3;
-        // Above zero, by the bits (validated finite and not negative).
-        if config.smoothing_tau_s.to_bits() as i32 > 0 {
+        let step = self.step_cache.get(dt_ms, config.smoothing_tau_s);
+        if self.limits.smoothing {
             if let Some([l, p]) = st.smoothed {
-                let w = self.weight.weight(dt_ms, config.smoothing_tau_s);
-                load = l + w * (load - l);
-                phi = p + w * (phi - p);
+                load = l + step.weight * (load - l);
+                phi = p + step.weight * (phi - p);
             }
             st.smoothed = Some([load, phi]);
         }
@@ -480,13 +540,13 @@ impl<E: Estimator> Monitor<E> {
         }
         // Wear (section 7): the power F phi V over the step ending here, for the
         // state reported after this sample (never `Stopped`: a running sample leaves it).
-        let speed = sample.speed.unwrap_or(config.nominal_speed);
-        st.energy_step = dissipated_power(force, phi, speed) * dt_s;
+        st.energy_step = dissipated_power(force, phi, speed) * step.dt_s;
         let level = if st.alarm.inhibited(config, now) {
             RiskState::Normal
         } else {
             risk::slip_level(&self.levels, e.slip_ratio, margin, held)
         };
+        let at = Estimated { load, phi, dt_ms };
         if let (Some(tc), Some(m)) = (config.trend, margin) {
             let iv = &mut st.trend_interval;
             if iv.count == 0 {
@@ -494,37 +554,46 @@ impl<E: Estimator> Monitor<E> {
             }
             iv.sum += m;
             iv.count = iv.count.saturating_add(1);
-            if now.saturating_sub(iv.start_ms) >= u64::from(tc.interval_ms) {
-                let point = TrendPoint {
-                    time_ms: now as u32,
-                    margin: iv.sum * recip(iv.count as f32),
-                };
-                *iv = TrendInterval::default();
-                // Points older than the window leave (after a stop, say).
-                let window = u64::from(tc.interval_ms) * u64::from(tc.points);
-                while let Some(old) = self.trend.front() {
-                    if u64::from((now as u32).wrapping_sub(old.time_ms)) > window {
-                        self.trend.pop_front();
-                    } else {
-                        break;
-                    }
-                }
-                trend::push(&mut self.trend, point, usize::from(tc.points));
-                // The fit waits for a full window: a shorter one mistakes the load's
-                // cycles for a drift.
-                if self.trend.len() < usize::from(tc.points) {
-                    st.time_to_critical_s = None;
-                    return Ok(level);
-                }
-                let mut points = [TrendPoint::default(); config::TREND_CAPACITY];
-                for (slot, p) in points.iter_mut().zip(self.trend.iter()) {
-                    *slot = *p;
-                }
-                let n = self.trend.len().min(config::TREND_CAPACITY);
-                st.time_to_critical_s = time_to_critical(&points[..n]);
+            if now.wrapping_sub(iv.start_ms) >= u64::from(tc.interval_ms) {
+                self.trend_point(tc, now);
             }
         }
-        Ok(level)
+        Ok((level, at))
+    }
+
+    /// Closes the trend's interval at `now`: its mean margin becomes a point, and
+    /// with a full window the time to critical is fitted anew.
+    #[cold]
+    fn trend_point(&mut self, tc: TrendConfig, now: u64) {
+        let st = &mut self.status;
+        let iv = &mut st.trend_interval;
+        let point = TrendPoint {
+            time_ms: now as u32,
+            margin: iv.sum * recip(iv.count as f32),
+        };
+        *iv = TrendInterval::default();
+        // Points older than the window leave (after a stop, say).
+        let window = u64::from(tc.interval_ms) * u64::from(tc.points);
+        while let Some(old) = self.trend.front() {
+            if u64::from((now as u32).wrapping_sub(old.time_ms)) > window {
+                self.trend.pop_front();
+            } else {
+                break;
+            }
+        }
+        trend::push(&mut self.trend, point, usize::from(tc.points));
+        // The fit waits for a full window: a shorter one mistakes the load's
+        // cycles for a drift.
+        if self.trend.len() < usize::from(tc.points) {
+            st.time_to_critical_s = None;
+            return;
+        }
+        let mut points = [TrendPoint::default(); config::TREND_CAPACITY];
+        for (slot, p) in points.iter_mut().zip(self.trend.iter()) {
+            *slot = *p;
+        }
+        let n = self.trend.len().min(config::TREND_CAPACITY);
+        st.time_to_critical_s = time_to_critical(&points[..n]);
     }
 
     /// The `Approaching` event: once when the time to critical falls below the

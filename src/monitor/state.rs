@@ -162,8 +162,8 @@ impl<E: Estimator> Monitor<E> {
     pub fn snapshot(&self) -> MonitorState {
         MonitorState {
             status: self.status,
-            load_window: Saved::from_iter(0.0, self.load_window.iter()),
-            angle_window: Saved::from_iter(0.0, self.angle_window.iter()),
+            load_window: Saved::from_iter(0.0, self.windows[0].iter()),
+            angle_window: Saved::from_iter(0.0, self.windows[1].iter()),
             trend: Saved::from_iter(TrendPoint::default(), self.trend.iter().copied()),
             events: Saved::from_iter(NO_EVENT, self.events.iter().copied()),
         }
@@ -184,11 +184,14 @@ impl<E: Estimator> Monitor<E> {
         let n = config
             .spikes
             .map_or(SPIKE_WINDOW_CAPACITY, |s| usize::from(s.window));
-        for x in state.load_window.iter() {
-            m.load_window.push_back(x, n);
-        }
-        for x in state.angle_window.iter() {
-            m.angle_window.push_back(x, n);
+        for (window, saved) in m
+            .windows
+            .iter_mut()
+            .zip([&state.load_window, &state.angle_window])
+        {
+            for x in saved.iter() {
+                window.push_back(x, n);
+            }
         }
         for p in state.trend.iter() {
             let _ = m.trend.push_back(p);
@@ -202,10 +205,9 @@ impl<E: Estimator> Monitor<E> {
 
 /// Issue 10's RAM budget of the monitor's state with the default capacities: the
 /// snapshot ([`MonitorState`]) and the live monitor without its estimator and its
-/// configuration (its buffers keep the spike windows sorted too) both fit, on every
-/// target (checked when the crate compiles).
+/// configuration (the [`Config`] and the limits and levels formed from it once) both
+/// fit, on every target (checked when the crate compiles).
 pub const STATE_BUDGET_BYTES: usize = 1024;
 const _: () = assert!(core::mem::size_of::<MonitorState>() <= STATE_BUDGET_BYTES);
-const _: () = assert!(
-    core::mem::size_of::<Monitor<()>>() - core::mem::size_of::<Config>() <= STATE_BUDGET_BYTES
-);
+const _: () =
+    assert!(core::mem::size_of::<Monitor<()>>() - super::CONFIGURATION_BYTES <= STATE_BUDGET_BYTES);
