@@ -155,31 +155,58 @@ pub(crate) struct Units {
     load_lsb: f32,
     /// rad per angle count.
     angle_lsb: f32,
-    /// Load counts per N and angle counts per rad: the per-sample conversion
-    /// multiplies (a division costs several times more in soft float).
-    per_load: f32,
-    per_angle: f32,
+    /// Load counts per N and angle counts per rad as [`split`] gives them: the
+    /// per-sample conversion multiplies their significands in integers.
+    per_load: (u32, i32),
+    per_angle: (u32, i32),
 }
 
-/// `x` truncated to an integer, for `0 <= x < 2^32`: `x as u32` from the bits (the
-/// cast, which saturates, calls soft-float comparisons on a core without an FPU).
+/// A finite non-negative f32's significand (below 2^24, the leading one of a normal
+/// number included) and the power of two it is scaled by: `x = significand
+/// 2^exponent`.
 #[inline(always)]
-fn truncate(x: f32) -> u32 {
-    let bits = x.to_bits();
-    let exponent = (bits >> 23) as i32 - 127; // at most 31 below 2^32
-    let mantissa = bits & 0x007f_ffff | 0x0080_0000;
-    if exponent < 0 {
-        0
-    } else if exponent >= 23 {
-        mantissa.wrapping_shl((exponent - 23) as u32)
+fn split(bits: u32) -> (u32, i32) {
+    let field = (bits >> 23) as i32;
+    if field == 0 {
+        (bits, -149) // zero or subnormal
     } else {
-        mantissa >> (23 - exponent)
+        (bits & 0x007f_ffff | 0x0080_0000, field - 150)
     }
 }
 
-/// Largest f32 below 2^32 and 2^31: counts that fit u32 and i32.
-const U32_COUNTS: f32 = 4_294_967_040.0;
-const I32_COUNTS: f32 = 2_147_483_520.0;
+/// `a b` for `a`, `b` below 2^24, exact: four 12-bit products, so that a core
+/// without a long multiply (a Cortex-M0) calls no 64-bit multiplication routine.
+#[inline(always)]
+fn mul24(a: u32, b: u32) -> u64 {
+    let (a1, a0, b1, b0) = (a >> 12, a & 0xfff, b >> 12, b & 0xfff);
+    // Each product is below 2^24 and `mid` below 2^25: no overflow in u32.
+    let mid = a1 * b0 + a0 * b1;
+    (u64::from(a1 * b1) << 24) + (u64::from(mid) << 12) + u64::from(a0 * b0)
+}
+
+/// `|x| scale` rounded to the nearest integer (halves up), for a finite `x` and a
+/// positive normal `scale` given as [`split`] gives it; `None` above `max`. Exact in
+/// integers: one rounding, where `x * scale + 0.5` in f32 rounds twice, and no
+/// soft-float call on a core without an FPU (a Cortex-M0 pays some 160 instructions
+/// for that multiply and add, this some 40; the benchmark's `monitor` row).
+#[inline(always)]
+fn counts_of(x: f32, (significand, exponent): (u32, i32), max: u32) -> Option<u32> {
+    let (m, e) = split(x.to_bits() & 0x7fff_ffff);
+    // |x| scale = p 2^-shift, p below 2^48.
+    let p = mul24(m, significand);
+    let shift = -(e + exponent);
+    if shift <= 0 {
+        // At least 2^47 counts: beyond every count range.
+        return None;
+    }
+    let counts = if shift >= 64 {
+        0
+    } else {
+        // p < 2^48: adding half a count cannot overflow.
+        (p + (1u64 << (shift - 1))) >> shift
+    };
+    u32::try_from(counts).ok().filter(|&c| c <= max)
+}
 
 impl Units {
     /// The units of LSBs already checked positive and finite.
@@ -200,8 +227,8 @@ impl Units {
             angle_lsb,
             // Reciprocals without a division (crate::recip, within 1 ulp): no
             // division routine in a node's flash.
-            per_load: crate::recip::recip(load_lsb),
-            per_angle: crate::recip::recip(angle_lsb),
+            per_load: split(crate::recip::recip(load_lsb).to_bits()),
+            per_angle: split(crate::recip::recip(angle_lsb).to_bits()),
         }
     }
 
@@ -230,15 +257,16 @@ impl Units {
         if phi.to_bits() & 0x7fff_ffff > f32::MAX.to_bits() {
             return Err(Error::Angle);
         }
-        let load = load * self.per_load + 0.5;
-        let angle = phi.abs() * self.per_angle + 0.5;
-        // Both positive (or +inf): their bits order them as their values.
-        if load.to_bits() > U32_COUNTS.to_bits() || angle.to_bits() > I32_COUNTS.to_bits() {
+        let (Some(load), Some(angle)) = (
+            counts_of(load, self.per_load, u32::MAX),
+            counts_of(phi, self.per_angle, i32::MAX as u32),
+        ) else {
             return Err(Error::OutOfRange);
-        }
-        let angle = truncate(angle) as i32; // in [0, 2^31): fits, and so does its negation
+        };
+        // angle <= i32::MAX: fits, and so does its negation.
+        let angle = angle as i32;
         Ok((
-            truncate(load),
+            load,
             if phi.is_sign_negative() {
                 angle.wrapping_neg()
             } else {
@@ -397,14 +425,27 @@ fn log2_result(x: i64) -> Result<Log2, Error> {
 
 #[cfg(test)]
 mod tests {
+    /// The integer conversion against the exact product in f64 (exact for two f32
+    /// significands) rounded half up, over the exponents that matter and a spread of
+    /// significands, at three scales.
     #[test]
-    fn truncate_is_the_cast() {
-        // Every exponent from below 1 to 2^32, a spread of mantissas each.
-        for bits in (0..0x4f80_0000u32).step_by(997) {
-            let x = f32::from_bits(bits);
-            assert_eq!(super::truncate(x), x as u32, "{x:e}");
+    fn counts_are_the_rounded_product() {
+        for scale in [1e2f32, 1.0 / 3e-9, 7.3e9, 3e38] {
+            let split_scale = super::split(scale.to_bits());
+            for bits in (0..0x5f00_0000u32).step_by(4099) {
+                let x = f32::from_bits(bits);
+                let exact = f64::from(x) * f64::from(scale);
+                let want = (exact + 0.5).floor();
+                let got = super::counts_of(x, split_scale, u32::MAX);
+                if want > f64::from(u32::MAX) {
+                    assert_eq!(got, None, "{x:e} {scale:e}");
+                } else {
+                    assert_eq!(got, Some(want as u32), "{x:e} {scale:e}");
+                    assert_eq!(super::counts_of(-x, split_scale, u32::MAX), got);
+                }
+            }
+            assert_eq!(super::counts_of(0.0, split_scale, 7), Some(0));
         }
-        let top = super::U32_COUNTS;
-        assert_eq!(super::truncate(top), top as u32);
+        assert_eq!(super::mul24(0xff_ffff, 0xff_ffff), 0xff_ffffu64 * 0xff_ffff);
     }
 }
