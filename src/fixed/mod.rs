@@ -179,33 +179,56 @@ fn split(bits: u32) -> (u32, i32) {
 #[inline(always)]
 fn mul24(a: u32, b: u32) -> u64 {
     let (a1, a0, b1, b0) = (a >> 12, a & 0xfff, b >> 12, b & 0xfff);
-    // Each product is below 2^24 and `mid` below 2^25: no overflow in u32.
-    let mid = a1 * b0 + a0 * b1;
-    (u64::from(a1 * b1) << 24) + (u64::from(mid) << 12) + u64::from(a0 * b0)
+    // Each product is below 2^24 and `mid` below 2^25: no overflow in u32 (wrapping:
+    // the compiler cannot see the operands' range through a stored scale).
+    let mid = a1.wrapping_mul(b0).wrapping_add(a0.wrapping_mul(b1));
+    (u64::from(a1.wrapping_mul(b1)) << 24)
+        .wrapping_add(u64::from(mid) << 12)
+        .wrapping_add(u64::from(a0.wrapping_mul(b0)))
 }
 
 /// `|x| scale` rounded to the nearest integer (halves up), for a finite `x` and a
 /// positive normal `scale` given as [`split`] gives it; `None` above `max`. Exact in
 /// integers: one rounding, where `x * scale + 0.5` in f32 rounds twice, and no
 /// soft-float call on a core without an FPU (a Cortex-M0 pays some 160 instructions
-/// for that multiply and add, this some 40; the benchmark's `monitor` row).
-#[inline(always)]
+/// for that multiply and add, this some 40; the benchmark's `monitor` row). Out of
+/// line: one copy for load and angle in a node's 16 KiB of flash.
+#[inline(never)]
 fn counts_of(x: f32, (significand, exponent): (u32, i32), max: u32) -> Option<u32> {
     let (m, e) = split(x.to_bits() & 0x7fff_ffff);
     // |x| scale = p 2^-shift, p below 2^48.
     let p = mul24(m, significand);
-    let shift = -(e + exponent);
+    // Both exponents lie in -149..=104 (`split`): no overflow.
+    let shift = e.wrapping_add(exponent).wrapping_neg();
     if shift <= 0 {
-        // At least 2^47 counts: beyond every count range.
+        // At least 2^46 counts: beyond every count range.
         return None;
     }
-    let counts = if shift >= 64 {
-        0
+    // The shift on the two 32-bit halves: a 64-bit shift by a variable amount is a
+    // routine call on a Cortex-M0.
+    let (hi, lo, shift) = ((p >> 32) as u32, p as u32, shift as u32);
+    let (counts, half) = if shift < 32 {
+        if hi >> shift != 0 {
+            return None; // 2^32 counts or more
+        }
+        // 1 <= shift < 32.
+        let up = 32u32.wrapping_sub(shift);
+        (
+            (hi << up) | (lo >> shift),
+            (lo >> shift.wrapping_sub(1)) & 1,
+        )
+    } else if shift < 64 {
+        let s = shift.wrapping_sub(32);
+        let half = if s == 0 {
+            lo >> 31
+        } else {
+            (hi >> s.wrapping_sub(1)) & 1
+        };
+        (hi >> s, half)
     } else {
-        // p < 2^48: adding half a count cannot overflow.
-        (p + (1u64 << (shift - 1))) >> shift
+        (0, 0) // below 2^-16 counts
     };
-    u32::try_from(counts).ok().filter(|&c| c <= max)
+    counts.checked_add(half).filter(|&c| c <= max)
 }
 
 impl Units {

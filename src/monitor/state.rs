@@ -211,3 +211,20 @@ pub const STATE_BUDGET_BYTES: usize = 1024;
 const _: () = assert!(core::mem::size_of::<MonitorState>() <= STATE_BUDGET_BYTES);
 const _: () =
     assert!(core::mem::size_of::<Monitor<()>>() - super::CONFIGURATION_BYTES <= STATE_BUDGET_BYTES);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The two sizes the budget bounds, as the README gives them (`cargo test --lib
+    /// monitor::state -- --nocapture`).
+    #[test]
+    fn state_fits_its_budget() {
+        let snapshot = core::mem::size_of::<MonitorState>();
+        let live = core::mem::size_of::<Monitor<()>>() - super::super::CONFIGURATION_BYTES;
+        std::println!(
+            "snapshot {snapshot} bytes, live monitor {live} bytes besides its configuration"
+        );
+        assert!(snapshot <= STATE_BUDGET_BYTES && live <= STATE_BUDGET_BYTES);
+    }
+}

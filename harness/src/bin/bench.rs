@@ -98,7 +98,10 @@ mod run {
 
     /// The monitor's per-sample pipeline (`Monitor::process`) over the scenario's
     /// first samples, each generated outside the measured call, in order: the monitor
-    /// is the stream's, its state carried from sample to sample.
+    /// is the stream's, its state carried from sample to sample. Out of line, so that
+    /// the monitor's code does not share a function (and its registers) with the other
+    /// measurements.
+    #[inline(never)]
     fn monitor<E: Estimator>(c: &Counter, estimator: E, op: Operation) -> Stats {
         let mut s = Stats::new();
         let mut config = Config::default();
