@@ -16,6 +16,19 @@ pub const PANIC: i32 = 101;
 /// Exit status of a HardFault (a bad memory access, a stack overflow into a fault).
 pub const HARD_FAULT: i32 = 102;
 
+/// A decimal count as a compile-time setting gives it (`option_env!`), in a `const`:
+/// the images' sample counts. Digits only (anything else is not checked).
+pub const fn parse_count(s: &str) -> usize {
+    let b = s.as_bytes();
+    let mut i = 0;
+    let mut n = 0;
+    while i < b.len() {
+        n = n * 10 + (b[i] - b'0') as usize;
+        i += 1;
+    }
+    n
+}
+
 /// Ends the program: semihosting exit with `code` (0 success), after the log is out.
 pub fn exit(code: i32) -> ! {
     defmt::flush();
@@ -114,6 +127,31 @@ pub mod counter {
     pub use cortex_m::peripheral::syst::SystClkSource;
 
     const RELOAD: u32 = 0x00ff_ffff;
+
+    /// Instructions of a series of measurements: how many, their sum and maximum.
+    #[derive(Clone, Copy, Default)]
+    pub struct Stats {
+        /// Measurements.
+        pub n: u32,
+        /// Their instructions in all.
+        pub sum: u64,
+        /// The most of one.
+        pub max: u32,
+    }
+
+    impl Stats {
+        /// Counts one measurement.
+        pub fn add(&mut self, x: u32) {
+            self.n += 1;
+            self.sum += x as u64;
+            self.max = self.max.max(x);
+        }
+
+        /// The mean, rounded to the nearest (0 for none).
+        pub fn mean(&self) -> u64 {
+            (self.sum + self.n as u64 / 2) / (self.n as u64).max(1)
+        }
+    }
 
     /// A free-running SysTick and its ticks per instruction.
     pub struct Counter {

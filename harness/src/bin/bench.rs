@@ -24,25 +24,15 @@ mod run {
     use misalign::monitor::{Config, Monitor, model_for_range, scenario};
     use misalign::reference::ModelChoice;
     use misalign::{Estimator, Scene, reference};
-    use misalign_harness::support::counter::{Counter, SystClkSource};
+    use misalign_harness::support::counter::{Counter, Stats, SystClkSource};
+    use misalign_harness::support::parse_count;
     use misalign_workload::{Model, Operation, hamrock_brewe::HamrockBrewe, samples};
 
     /// Samples per operation (the reference, a thousand times slower, gets an eighth).
     const SAMPLES: usize = match option_env!("MISALIGN_BENCH_SAMPLES") {
-        Some(s) => parse(s),
+        Some(s) => parse_count(s),
         None => 256,
     };
-
-    const fn parse(s: &str) -> usize {
-        let b = s.as_bytes();
-        let mut i = 0;
-        let mut n = 0;
-        while i < b.len() {
-            n = n * 10 + (b[i] - b'0') as usize;
-            i += 1;
-        }
-        n
-    }
 
     /// Samples of the built-in scenario that the monitor processes: its first
     /// `16 * SAMPLES` seconds (4096 s in the full run: the start, the start-up inhibit,
@@ -52,33 +42,19 @@ mod run {
     /// The angle LSB of the fixed-point core in the benchmark (rad per count).
     const ANGLE_LSB: f64 = 1e-8;
 
-    struct Stats {
-        n: u32,
-        sum: u64,
-        max: u32,
+    /// One line for the host: `bench model=<m> op=<op> n=<calls> mean=<x> max=<y>`.
+    trait Print {
+        fn print(&self, model: Model, op: Operation);
     }
 
-    impl Stats {
-        fn new() -> Self {
-            Stats {
-                n: 0,
-                sum: 0,
-                max: 0,
-            }
-        }
-        fn add(&mut self, x: u32) {
-            self.n += 1;
-            self.sum += x as u64;
-            self.max = self.max.max(x);
-        }
+    impl Print for Stats {
         fn print(&self, model: Model, op: Operation) {
-            let mean = (self.sum + self.n as u64 / 2) / (self.n as u64).max(1);
             defmt::println!(
                 "bench model={=str} op={=str} n={=u32} mean={=u64} max={=u32}",
                 model.name(),
                 op.name(),
                 self.n,
-                mean,
+                self.mean(),
                 self.max
             );
         }
@@ -86,7 +62,7 @@ mod run {
 
     /// Measures `f(x)` for every x, black-boxing input and output.
     fn each<T: Copy, R>(c: &Counter, xs: impl Iterator<Item = T>, f: impl Fn(T) -> R) -> Stats {
-        let mut s = Stats::new();
+        let mut s = Stats::default();
         for x in xs {
             let x = black_box(x);
             let (r, n) = c.measure(|| f(x));
@@ -103,7 +79,7 @@ mod run {
     /// measurements.
     #[inline(never)]
     fn monitor<E: Estimator>(c: &Counter, estimator: E, op: Operation) -> Stats {
-        let mut s = Stats::new();
+        let mut s = Stats::default();
         let mut config = Config::default();
         // The profile: the same stream with stages off.
         if matches!(op, Operation::MonitorNoSpikes | Operation::MonitorBare) {

@@ -24,24 +24,13 @@ misalign_harness::log_panics_and_faults!();
 
 mod run {
     use core::hint::black_box;
-    use misalign_harness::support::counter::Counter;
+    use misalign_harness::support::counter::{Counter, Stats};
 
     /// Inputs per table (a const generic: no allocator).
     const SAMPLES: usize = match option_env!("MISALIGN_SHAPES_SAMPLES") {
-        Some(s) => parse(s),
+        Some(s) => misalign_harness::support::parse_count(s),
         None => 256,
     };
-
-    const fn parse(s: &str) -> usize {
-        let b = s.as_bytes();
-        let mut i = 0;
-        let mut n = 0;
-        while i < b.len() {
-            n = n * 10 + (b[i] - b'0') as usize;
-            i += 1;
-        }
-        n
-    }
 
     /// log2(pi/2) in Q8.24: where the fixed-point tables' domains end.
     #[cfg(not(target_abi = "eabihf"))]
@@ -54,23 +43,20 @@ mod run {
     /// counted region: one instruction either way).
     #[inline(never)]
     fn measure<X: Copy, R>(c: &Counter, table: &str, shape: &str, xs: &[X], f: impl Fn(X) -> R) {
-        let (mut n, mut sum, mut max) = (0u32, 0u64, 0u32);
+        let mut s = Stats::default();
         for &x in xs {
             let x = black_box(x);
             let (r, k) = c.measure(|| f(x));
             black_box(r);
-            n += 1;
-            sum += k as u64;
-            max = max.max(k);
+            s.add(k);
         }
-        let mean = (sum + n as u64 / 2) / (n as u64).max(1);
         defmt::println!(
             "shape table={=str} shape={=str} n={=u32} mean={=u64} max={=u32}",
             table,
             shape,
-            n,
-            mean,
-            max
+            s.n,
+            s.mean(),
+            s.max
         );
     }
 
