@@ -1,27 +1,43 @@
-//! Durable state on the node: a checkpoint, a reset, a restore, in
-//! QEMU, through `misalign::storage` exactly as a firmware uses it (a blocking flash
-//! driver, `BlockingFlash`, `block_on`, no executor).
+//! Durable state on the node: the condition monitor's whole state checkpointed to
+//! flash while it monitors, through resets and power cuts, in QEMU, through
+//! `misalign::storage` exactly as a firmware uses it (a blocking flash driver,
+//! `BlockingFlash`, `block_on`, no executor).
 //!
-//! The "flash" is 4 KiB of RAM in cortex-m-rt's `.uninit` section: not zeroed at start,
-//! not reloaded by QEMU's reset, so it survives the reset as flash would. A control
-//! block in `.uninit` carries the test's progress across resets. The image runs many
-//! times in one QEMU session:
+//! The node monitors the built-in scenario (`misalign::monitor::scenario`, one sample a
+//! second) over the demo scene prepared at build time, with the core the monitoring
+//! node uses on that target (f32 with an FPU, fixed point without), and checkpoints
+//! the monitor's whole state (`MonitorState`, an 812-byte record) once a minute of
+//! samples. The "flash" is 4 KiB of RAM in cortex-m-rt's `.uninit` section: not zeroed
+//! at start, not reloaded by QEMU's reset, so it survives the reset as flash would. A
+//! control block in `.uninit` carries the test's progress across resets. The image
+//! runs many times in one QEMU session:
 //!
-//! 1. cold boot: the region holds whatever RAM held (zeros in QEMU): the restore
-//!    must give nothing and, the region not being blank, a reported event; then two
-//!    checkpoints (at the interval, and one on demand) and a reset (SYSRESETREQ);
-//! 2. after the reset: the restore must give exactly the second checkpoint; one more
-//!    checkpoint, a reset;
-//! 3. then the power cut on the target: on boot `k` of this phase the flash driver
-//!    resets the core at the `k`-th byte written (or word erased) of a checkpoint, so
-//!    that the checkpoint is cut there; after each such reset the restore must give
-//!    exactly the last complete checkpoint or the cut one, whole. The phase ends when a
-//!    checkpoint completes before its cut point, i.e. when every byte of one has been
-//!    cut; it must have swept at least a whole record.
+//! 0. cold boot: the region holds whatever RAM held (zeros in QEMU): the restore must
+//!    give nothing and, the region not being blank, a reported event. The node runs
+//!    the first 1800 samples (30 min) without a break for the reference; then it
+//!    starts afresh with checkpoints (one on demand, one at the interval) and resets
+//!    between two checkpoints;
+//! 1. after the reset: the restore must give exactly the last checkpoint; the node
+//!    goes on from it (the samples after it are replayed, as the scenario stands for
+//!    the sensors), checkpoints on demand before a planned reset, and resets;
+//! 2. the power-cut phase: on boot `k` the node goes on from the restored state for
+//!    one sample and checkpoints, and the flash driver resets the core at the `k`-th
+//!    byte written (or word erased) of that checkpoint; after each such reset the
+//!    restore must give exactly the last complete checkpoint or the cut one, whole.
+//!    The phase ends when a checkpoint completes before its cut point, i.e. when every
+//!    point of one has been cut; it must have swept at least a whole record;
+//! 3. the node goes on from the last checkpoint to the 1800th sample: its state must
+//!    be the reference's, bit for bit, as if the power had never failed.
 //!
-//! Exit status (semihosting): 0 when every step holds; 10 + step on a wrong restore
-//! (step: 0 cold, 1 after the first reset, 2 in the power-cut phase), 20 + step on a
-//! storage error, 30 if the power-cut phase swept less than a record; 101 on a panic.
+//! The states are compared by the CRC-32 of their records. On a real node the samples
+//! after the last checkpoint are lost with the power (the monitor then sees a gap);
+//! here they are replayed, so that the run can be compared with the reference. The
+//! node reports the deepest stack use of its boots.
+//!
+//! Exit status (semihosting): 0 when every step holds; 10 + step on a wrong restore,
+//! 20 + step on a storage error (step: 0 to 3 as above), 30 if the power-cut phase
+//! swept less than a record, 31 if the monitor refused its configuration or the scene
+//! or the scenario ended, 32 if the final state is not the reference's; 101 on a panic.
 //!
 //! ```sh
 //! cargo run --release --target thumbv7em-none-eabihf \
@@ -35,6 +51,11 @@
 #![cfg_attr(target_os = "none", no_main)]
 
 #[cfg(target_os = "none")]
+use misalign_logger as _;
+#[cfg(target_os = "none")]
+misalign_harness::log_panics_and_faults!();
+
+#[cfg(target_os = "none")]
 mod node {
     use core::mem::MaybeUninit;
     use core::ptr::addr_of_mut;
@@ -43,14 +64,41 @@ mod node {
         ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash, check_erase,
         check_read, check_write,
     };
+    use misalign::Estimator;
+    #[cfg(not(target_abi = "eabihf"))]
+    use misalign::fixed::FixedEllipticScene;
+    #[cfg(target_abi = "eabihf")]
+    use misalign::float::EllipticScene;
+    use misalign::monitor::scenario::Scenario;
+    use misalign::monitor::{Config, Monitor, MonitorState};
+    use misalign::prepared::crc32;
     use misalign::storage::{
-        BlockingFlash, Checkpoint, CodecError, Reader, RestoreOutcome, Store, Writer, block_on,
+        BlockingFlash, Checkpoint, Restore, RestoreOutcome, Store, block_on, codec,
     };
+    use misalign_harness::prepared;
+    use misalign_harness::support::{exit, stack};
 
     const SECTOR: usize = 1024;
     const SIZE: usize = 4 * SECTOR;
     /// What the control block holds first, so that cold RAM is told apart.
-    const MAGIC: u32 = 0x4D53_4C42;
+    const MAGIC: u32 = 0x4D53_4C43;
+    /// Samples of the whole run (30 min: the start-up inhibit, six trend intervals,
+    /// the first spike).
+    const FINAL: usize = 1800;
+    /// The checkpoint interval (s).
+    const INTERVAL_S: u32 = 60;
+    /// The cold boot's on-demand checkpoint, after this many samples.
+    const ON_DEMAND_AT: usize = 30;
+    /// The first reset, after this many samples (14 s after the last checkpoint: an
+    /// unplanned one).
+    const FIRST_RESET_AT: usize = 75;
+    /// The second reset, after this many samples (planned: a checkpoint on demand
+    /// first).
+    const SECOND_RESET_AT: usize = 90;
+    /// Bytes of a monitor state's record.
+    const RECORD: usize = codec::record_len(MonitorState::SIZE);
+    /// The store's buffer for it.
+    const BUF: usize = Store::<BlockingFlash<RamFlash>, 0>::buffer_len::<MonitorState>();
 
     #[unsafe(link_section = ".uninit.misalign_flash")]
     static mut FLASH: MaybeUninit<[u8; SIZE]> = MaybeUninit::uninit();
@@ -62,12 +110,23 @@ mod node {
     #[repr(C)]
     struct Control {
         magic: u32,
-        /// 0: cold boot, 1: after the first reset, 2: the power-cut phase.
+        /// 0: cold boot, 1: after the first reset, 2: the power-cut phase, 3: after it.
         step: u32,
         /// The power-cut phase: where this boot's checkpoint is cut.
         cut: u32,
-        /// The newest checkpoint known complete.
+        /// The newest checkpoint known complete, and its state's CRC.
         committed: u32,
+        committed_crc: u32,
+        /// The CRC of the state of the checkpoint being written (committed + 1).
+        pending_crc: u32,
+        /// The CRC of the reference's state after [`FINAL`] samples.
+        reference_crc: u32,
+        /// Boots of the power-cut phase.
+        boots: u32,
+        /// The stack pointer where this boot painted the free stack, and the deepest
+        /// stack use of any boot (bytes).
+        sp: u32,
+        stack_max: u32,
     }
 
     /// NOR flash over the `.uninit` RAM: erase to 0xFF, writes only clear bits. With a
@@ -82,7 +141,9 @@ mod node {
     impl RamFlash {
         fn tick(&mut self) {
             if self.cut == Some(self.points) {
-                reset();
+                // The power fails: no stack use noted (the deepest is the completed
+                // checkpoint's, noted at the phase's end).
+                cortex_m::peripheral::SCB::sys_reset();
             }
             self.points += 1;
         }
@@ -139,44 +200,15 @@ mod node {
         }
     }
 
-    /// A monitor-like state: energies per state, counters.
-    #[derive(Debug, PartialEq)]
-    struct Wear {
-        energy_j: [f64; 3],
-        samples: u32,
+    /// Notes this boot's deepest stack use.
+    fn note_stack(control: &mut Control) {
+        let used = stack::used(control.sp as usize) as u32;
+        control.stack_max = control.stack_max.max(used);
     }
 
-    impl Checkpoint for Wear {
-        const KIND: u8 = misalign::storage::kind::MONITOR_STATE;
-        const VERSION: u16 = 1;
-        const SIZE: usize = 3 * 8 + 4;
-
-        fn encode(&self, w: &mut Writer<'_>) -> Result<(), CodecError> {
-            w.each(&self.energy_j, |w, e| w.f64(*e))?;
-            w.u32(self.samples)
-        }
-
-        fn decode(r: &mut Reader<'_>) -> Result<Self, CodecError> {
-            Ok(Wear {
-                energy_j: r.array_of(|r| r.f64())?,
-                samples: r.u32()?,
-            })
-        }
-    }
-
-    fn wear(n: u32) -> Wear {
-        let k = f64::from(n);
-        Wear {
-            energy_j: [k * 1.25, k * k, 1e3 / (k + 1.0)],
-            samples: n * 1000,
-        }
-    }
-
-    fn exit(code: i32) -> ! {
-        semihosting::process::exit(code)
-    }
-
-    fn reset() -> ! {
+    /// A reset (SYSRESETREQ), after noting this boot's stack use.
+    fn reset(control: &mut Control) -> ! {
+        note_stack(control);
         cortex_m::peripheral::SCB::sys_reset()
     }
 
@@ -184,15 +216,252 @@ mod node {
     fn open(
         bytes: &'static mut [u8; SIZE],
         cut: Option<u32>,
-    ) -> Store<BlockingFlash<RamFlash>, 64> {
+    ) -> Store<BlockingFlash<RamFlash>, BUF> {
         let flash = RamFlash {
             bytes,
             points: 0,
             cut,
         };
-        match Store::new(BlockingFlash(flash), 0..SIZE as u32, 60) {
+        match Store::new(BlockingFlash(flash), 0..SIZE as u32, INTERVAL_S) {
             Ok(store) => store,
             Err(_) => exit(20),
+        }
+    }
+
+    /// The CRC-32 of a state's record (numbered 0, so that equal states have equal
+    /// CRCs) without its own CRC at the end (over which the CRC is a constant).
+    #[inline(never)]
+    fn crc_of(state: &MonitorState) -> u32 {
+        let mut record = [0u8; RECORD];
+        match codec::encode(state, 0, &mut record) {
+            Ok(n) => crc32(record.get(..n.saturating_sub(4)).unwrap_or(&[])),
+            Err(_) => exit(20),
+        }
+    }
+
+    /// The scenario's samples from the `done`-th on.
+    fn samples_from(done: usize) -> impl Iterator<Item = misalign::monitor::Sample> {
+        Scenario::new().skip(done)
+    }
+
+    /// Samples a monitor has processed (each of the scenario's is processed once).
+    fn done<E: Estimator>(m: &Monitor<E>) -> usize {
+        m.statistics().samples as usize
+    }
+
+    /// Feeds samples to `m` until it has processed `until`, checkpointing at the
+    /// interval of scenario time (and on demand after [`ON_DEMAND_AT`] samples); each
+    /// checkpoint written is recorded as committed.
+    fn run_to<E: Estimator>(
+        m: &mut Monitor<E>,
+        until: usize,
+        store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        control: &mut Control,
+    ) {
+        let code = control.step as i32;
+        for sample in samples_from(done(m)) {
+            if done(m) >= until {
+                break;
+            }
+            m.process(sample);
+            let state = m.snapshot();
+            let written = if done(m) == ON_DEMAND_AT && control.step == 0 {
+                block_on(store.checkpoint(&state)).map(Some)
+            } else {
+                block_on(store.checkpoint_if_due(m.elapsed_ms() / 1000, &state))
+            };
+            match written {
+                Ok(Some(sequence)) => {
+                    control.committed = sequence;
+                    control.committed_crc = crc_of(&state);
+                }
+                Ok(None) => {}
+                Err(_) => exit(20 + code),
+            }
+        }
+        if done(m) != until {
+            exit(31)
+        }
+    }
+
+    /// The restored state of a boot after the cold one, if it is the committed
+    /// checkpoint or, in the power-cut phase, the cut one whole; else the exit.
+    fn check_restore<'a>(
+        restored: &'a Restore<MonitorState>,
+        control: &mut Control,
+    ) -> &'a MonitorState {
+        let code = control.step as i32;
+        let (RestoreOutcome::Restored { sequence }, Some(state)) =
+            (restored.outcome, &restored.value)
+        else {
+            exit(10 + code)
+        };
+        let crc = crc_of(state);
+        let committed = sequence == control.committed && crc == control.committed_crc;
+        let pending = control.step == 2
+            && sequence == control.committed.wrapping_add(1)
+            && crc == control.pending_crc;
+        if !(committed || pending) {
+            exit(10 + code);
+        }
+        (control.committed, control.committed_crc) = (sequence, crc);
+        state
+    }
+
+    /// The CRC of the state of `m` after the first [`FINAL`] samples without a break.
+    #[inline(never)]
+    fn reference<E: Estimator>(mut m: Monitor<E>) -> u32 {
+        for sample in samples_from(0).take(FINAL) {
+            m.process(sample);
+        }
+        crc_of(&m.snapshot())
+    }
+
+    /// A monitor over the core `core` builds, fresh or going on from `state`.
+    fn monitor<E: Estimator>(
+        core: &impl Fn() -> Option<E>,
+        state: Option<&MonitorState>,
+    ) -> Monitor<E> {
+        let Some(core) = core() else { exit(31) };
+        let m = match state {
+            None => Monitor::new(core, Config::default()),
+            Some(s) => Monitor::restore(core, Config::default(), s),
+        };
+        m.unwrap_or_else(|_| exit(31))
+    }
+
+    /// A checkpoint of the state of `m` now, on demand; its CRC is noted as pending
+    /// while it is written, and as committed once it is complete.
+    fn checkpoint_now<E: Estimator>(
+        m: &Monitor<E>,
+        store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        control: &mut Control,
+    ) {
+        let state = m.snapshot();
+        control.pending_crc = crc_of(&state);
+        let Ok(sequence) = block_on(store.checkpoint(&state)) else {
+            exit(20 + control.step as i32)
+        };
+        (control.committed, control.committed_crc) = (sequence, control.pending_crc);
+    }
+
+    /// The cold boot: the reference, then the monitor from scratch with checkpoints
+    /// until the first reset.
+    #[inline(never)]
+    fn cold<E: Estimator>(
+        core: &impl Fn() -> Option<E>,
+        store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        control: &mut Control,
+    ) -> ! {
+        control.reference_crc = reference(monitor(core, None));
+        let mut m = monitor(core, None);
+        run_to(&mut m, FIRST_RESET_AT, store, control);
+        control.step = 1;
+        reset(control)
+    }
+
+    /// After the first reset: on from the restored state, with checkpoints, and one on
+    /// demand before the (planned) reset to the power-cut phase.
+    #[inline(never)]
+    fn after_reset<E: Estimator>(
+        core: &impl Fn() -> Option<E>,
+        state: &MonitorState,
+        store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        control: &mut Control,
+    ) -> ! {
+        let mut m = monitor(core, Some(state));
+        run_to(&mut m, SECOND_RESET_AT, store, control);
+        checkpoint_now(&m, store, control);
+        (control.step, control.cut, control.boots) = (2, 0, 0);
+        reset(control)
+    }
+
+    /// A boot of the power-cut phase: on from the restored state for one sample and a
+    /// checkpoint, cut at this boot's point (a reset). A checkpoint that completes
+    /// before its cut point ends the phase: every point of one has been cut.
+    #[inline(never)]
+    fn power_cut<E: Estimator>(
+        core: &impl Fn() -> Option<E>,
+        state: &MonitorState,
+        store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        control: &mut Control,
+    ) -> ! {
+        let mut m = monitor(core, Some(state));
+        let Some(sample) = samples_from(done(&m)).next() else {
+            exit(31)
+        };
+        m.process(sample);
+        checkpoint_now(&m, store, control);
+        // This boot's cut point was `control.cut - 1`.
+        if (control.cut as usize) <= RECORD {
+            exit(30);
+        }
+        control.step = 3;
+        reset(control)
+    }
+
+    /// After the power cuts: on from the last checkpoint to the end, which must be the
+    /// reference's state.
+    #[inline(never)]
+    fn finish<E: Estimator>(
+        core: &impl Fn() -> Option<E>,
+        state: &MonitorState,
+        store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        control: &mut Control,
+    ) -> ! {
+        let mut m = monitor(core, Some(state));
+        run_to(&mut m, FINAL, store, control);
+        if crc_of(&m.snapshot()) != control.reference_crc {
+            exit(32);
+        }
+        note_stack(control);
+        defmt::println!(
+            "storage node: {=usize} samples monitored through 3 resets and {=u32} power cuts (one at every point of a checkpoint of the {=usize}-byte record), {=u32} checkpoints; the state is the uninterrupted run's; deepest stack {=u32} bytes",
+            FINAL,
+            control.boots - 1,
+            RECORD,
+            control.committed,
+            control.stack_max
+        );
+        // Cold start next time QEMU runs this image.
+        control.magic = 0;
+        exit(0)
+    }
+
+    /// The node's whole test with the core `core` builds: one step per boot.
+    fn node<E: Estimator>(
+        core: impl Fn() -> Option<E>,
+        flash: &'static mut [u8; SIZE],
+        control: &mut Control,
+    ) -> ! {
+        let step = control.step;
+        let code = step as i32;
+        // In the power-cut phase this boot's checkpoint is cut at the next point (the
+        // restore before it only reads).
+        let cut = control.cut;
+        if step == 2 {
+            control.cut = cut + 1;
+            control.boots += 1;
+        }
+        let mut store = open(flash, (step == 2).then_some(cut));
+        let Ok(restored) = block_on(store.restore::<MonitorState>()) else {
+            exit(20 + code)
+        };
+        if step == 0 {
+            // Cold RAM is not a blank flash: nothing restored, an event reported.
+            if restored.value.is_some()
+                || !matches!(restored.outcome, RestoreOutcome::Rejected(_))
+                || store.stats().rejected != 1
+            {
+                exit(10 + code);
+            }
+            cold(&core, &mut store, control)
+        }
+        let state = check_restore(&restored, control);
+        match step {
+            1 => after_reset(&core, state, &mut store, control),
+            2 => power_cut(&core, state, &mut store, control),
+            _ => finish(&core, state, &mut store, control),
         }
     }
 
@@ -207,97 +476,29 @@ mod node {
                 &mut *addr_of_mut!(CONTROL).cast::<Control>(),
             )
         };
+        let sp = stack::paint();
         if control.magic != MAGIC {
             *control = Control {
                 magic: MAGIC,
                 step: 0,
                 cut: 0,
                 committed: 0,
+                committed_crc: 0,
+                pending_crc: 0,
+                reference_crc: 0,
+                boots: 0,
+                sp: 0,
+                stack_max: 0,
             };
         }
-        let step = control.step;
-        let code = step as i32;
-        // In the power-cut phase this boot's checkpoint is cut at the next point (the
-        // restore before it only reads).
-        let cut = control.cut;
-        if step == 2 {
-            control.cut = cut + 1;
-        }
-        let mut store = open(flash, (step == 2).then_some(cut));
-        let Ok(restored) = block_on(store.restore::<Wear>()) else {
-            exit(20 + code)
-        };
-        match step {
-            0 => {
-                // Cold RAM is not a blank flash: nothing restored, an event reported.
-                if restored.value.is_some()
-                    || !matches!(restored.outcome, RestoreOutcome::Rejected(_))
-                    || store.stats().rejected != 1
-                {
-                    exit(10 + code);
-                }
-                // At the interval (the first call starts it), then on demand.
-                let due = block_on(store.checkpoint_if_due(0, &wear(1)))
-                    .and_then(|_| block_on(store.checkpoint_if_due(60, &wear(1))));
-                if due != Ok(Some(1)) || block_on(store.checkpoint(&wear(2))) != Ok(2) {
-                    exit(20 + code);
-                }
-                control.step = 1;
-                reset()
-            }
-            1 => {
-                if restored.value != Some(wear(2))
-                    || restored.outcome != (RestoreOutcome::Restored { sequence: 2 })
-                {
-                    exit(10 + code);
-                }
-                if block_on(store.checkpoint(&wear(3))) != Ok(3) {
-                    exit(20 + code);
-                }
-                *control = Control {
-                    step: 2,
-                    cut: 0,
-                    committed: 3,
-                    ..*control
-                };
-                reset()
-            }
-            _ => {
-                // After a cut: the last complete checkpoint or the cut one, whole.
-                let RestoreOutcome::Restored { sequence } = restored.outcome else {
-                    exit(10 + code)
-                };
-                let committed = control.committed;
-                if !(sequence == committed || sequence == committed + 1)
-                    || restored.value != Some(wear(sequence))
-                {
-                    exit(10 + code);
-                }
-                control.committed = sequence;
-                if block_on(store.checkpoint(&wear(sequence + 1))) != Ok(sequence + 1) {
-                    exit(20 + code);
-                }
-                // It completed before its cut point: every byte has been cut.
-                let mut store = open(store.into_flash().0.bytes, None);
-                let Ok(last) = block_on(store.restore::<Wear>()) else {
-                    exit(20 + code)
-                };
-                if last.value != Some(wear(sequence + 1)) {
-                    exit(10 + code);
-                }
-                if (cut as usize) < misalign::storage::codec::record_len(Wear::SIZE) {
-                    exit(30);
-                }
-                // Cold start next time QEMU runs this image.
-                control.magic = 0;
-                exit(0)
-            }
-        }
-    }
-
-    #[panic_handler]
-    fn panic(_: &core::panic::PanicInfo) -> ! {
-        exit(101)
+        control.sp = sp as u32;
+        // The demo scene prepared at build time (the monitor's model for the
+        // scenario's range, the ellipse), loaded as the monitoring node loads it.
+        #[cfg(target_abi = "eabihf")]
+        let core = || EllipticScene::from_bytes(&prepared::ELLIPTIC).ok();
+        #[cfg(not(target_abi = "eabihf"))]
+        let core = || FixedEllipticScene::from_bytes(&prepared::FIXED_ELLIPTIC).ok();
+        node(core, flash, control)
     }
 }
 
