@@ -362,6 +362,56 @@ fn state_configuration_and_calibration_through_the_mock_flash() {
     assert_eq!(again.snapshot(), m.snapshot());
 }
 
+/// A restore in place, as a node with little RAM does it: the state decoded into one
+/// value (`restore_into`) and a monitor that resumes from it. The same state as
+/// `restore` and `Monitor::restore` give, also over a monitor that had run (resume
+/// replaces everything it held), and a fresh state is the default one.
+#[test]
+fn a_state_restored_in_place_is_the_same() {
+    assert_eq!(
+        MonitorState::default(),
+        Monitor::new(core(0.3), Config::default())
+            .unwrap()
+            .snapshot()
+    );
+    let (mut m, rest) = mid_scenario();
+    let mut store = Store::<_, BUF>::new(BlockingFlash(Flash::new()), 0..4 * 4096, 3600).unwrap();
+    let saved = m.snapshot();
+    let sequence = block_on(store.checkpoint(&saved)).unwrap();
+    let mut store = Store::<_, BUF>::new(store.into_flash(), 0..4 * 4096, 3600).unwrap();
+    let mut state = MonitorState::default();
+    let outcome = block_on(store.restore_into(&mut state)).unwrap();
+    assert_eq!(outcome, RestoreOutcome::Restored { sequence });
+    assert_eq!(state, saved);
+    // Over a fresh monitor and over one that ran on, then was reset to the state.
+    let mut fresh = Monitor::new(core(0.3), Config::default()).unwrap();
+    fresh.resume(&state);
+    let mut ran = Monitor::new(core(0.3), Config::default()).unwrap();
+    for s in Scenario::new().skip(9000).take(400) {
+        ran.process(s);
+    }
+    ran.resume(&state);
+    for resumed in [&mut fresh, &mut ran] {
+        assert_eq!(resumed.snapshot(), saved);
+    }
+    for s in rest.iter().take(3600) {
+        let want = m.process_with_friction(*s);
+        assert_eq!(fresh.process_with_friction(*s), want);
+        assert_eq!(ran.process_with_friction(*s), want);
+        let event = m.pop_event();
+        assert_eq!(fresh.pop_event(), event);
+        assert_eq!(ran.pop_event(), event);
+    }
+    assert_eq!(fresh.snapshot(), m.snapshot());
+    assert_eq!(ran.snapshot(), m.snapshot());
+    // A region that holds no state: the outcome says so, and the state is not used.
+    let mut blank = Store::<_, BUF>::new(BlockingFlash(Flash::new()), 0..4 * 4096, 3600).unwrap();
+    let mut untouched = MonitorState::default();
+    let outcome = block_on(blank.restore_into(&mut untouched)).unwrap();
+    assert_eq!(outcome, RestoreOutcome::Blank);
+    assert_eq!(untouched, MonitorState::default());
+}
+
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
 

@@ -191,8 +191,17 @@ fn open(flash: Flash) -> S {
 
 /// A start-up: a store on the flash and its restore of `State`.
 fn boot(flash: Flash) -> (S, Restore<State>) {
+    // `restore_into` on a copy of the flash must find the same and count the same.
+    let mut twin = open(flash.clone());
     let mut store = open(flash);
     let restored = block_on(store.restore::<State>()).unwrap();
+    let mut value = state(0);
+    let outcome = block_on(twin.restore_into(&mut value)).unwrap();
+    assert_eq!(outcome, restored.outcome);
+    if let Some(v) = &restored.value {
+        assert_eq!(&value, v);
+    }
+    assert_eq!(twin.stats(), store.stats());
     (store, restored)
 }
 

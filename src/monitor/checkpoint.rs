@@ -271,17 +271,17 @@ fn put_saved<T: Copy, const N: usize>(
     w.u8(s.len)
 }
 
+/// Reads what [`put_saved`] wrote into `saved`, item by item in place.
 fn get_saved<T: Copy, const N: usize>(
     r: &mut Reader<'_>,
-    fill: T,
+    saved: &mut Saved<T, N>,
     get: impl Fn(&mut Reader<'_>) -> Result<T, CodecError>,
-) -> Result<Saved<T, N>, CodecError> {
-    let mut items = [fill; N];
-    for slot in &mut items {
+) -> Result<(), CodecError> {
+    for slot in &mut saved.items {
         *slot = get(r)?;
     }
-    let len = r.u8()?;
-    require(usize::from(len) <= N, Saved { items, len })
+    saved.len = r.u8()?;
+    require(usize::from(saved.len) <= N, ())
 }
 
 const CLOCK_SIZE: usize = 5 + 8;
@@ -487,18 +487,23 @@ impl Checkpoint for MonitorState {
     }
 
     fn decode(r: &mut Reader<'_>) -> Result<Self, CodecError> {
-        Ok(MonitorState {
-            status: get_status(r)?,
-            load_window: get_saved(r, 0.0, finite)?,
-            angle_window: get_saved(r, 0.0, finite)?,
-            trend: get_saved(r, TrendPoint::default(), |r| {
-                Ok(TrendPoint {
-                    time_ms: r.u32()?,
-                    margin: finite(r)?,
-                })
-            })?,
-            events: get_saved(r, super::state::NO_EVENT, get_event)?,
-        })
+        let mut state = MonitorState::default();
+        state.decode_into(r)?;
+        Ok(state)
+    }
+
+    /// Field by field into `self`: a restore holds one state, not three.
+    fn decode_into(&mut self, r: &mut Reader<'_>) -> Result<(), CodecError> {
+        self.status = get_status(r)?;
+        get_saved(r, &mut self.load_window, finite)?;
+        get_saved(r, &mut self.angle_window, finite)?;
+        get_saved(r, &mut self.trend, |r| {
+            Ok(TrendPoint {
+                time_ms: r.u32()?,
+                margin: finite(r)?,
+            })
+        })?;
+        get_saved(r, &mut self.events, get_event)
     }
 }
 

@@ -102,6 +102,13 @@ pub struct Saved<T, const N: usize> {
 }
 
 impl<T: Copy, const N: usize> Saved<T, N> {
+    fn empty(fill: T) -> Self {
+        Saved {
+            items: [fill; N],
+            len: 0,
+        }
+    }
+
     fn from_iter(fill: T, it: impl Iterator<Item = T>) -> Self {
         let mut items = [fill; N];
         let mut len = 0u8;
@@ -179,27 +186,54 @@ impl<E: Estimator> Monitor<E> {
         state: &MonitorState,
     ) -> Result<Self, ConfigError> {
         let mut m = Monitor::new(estimator, config)?;
-        m.status = state.status;
+        m.resume(state);
+        Ok(m)
+    }
+
+    /// Goes on from `state` (a snapshot of a monitor with this configuration) in
+    /// place of whatever this monitor held: [`restore`](Self::restore) without a
+    /// second monitor on the stack. With `storage::Store::restore_into` (feature
+    /// `sequential-storage`) a node restores its state at start-up holding one monitor
+    /// and one state.
+    pub fn resume(&mut self, state: &MonitorState) {
+        self.status = state.status;
         // The buffers were filled from at most their own capacity: the pushes fit.
-        let n = config
+        let n = self
+            .config
             .spikes
             .map_or(SPIKE_WINDOW_CAPACITY, |s| usize::from(s.window));
-        for (window, saved) in m
+        for (window, saved) in self
             .windows
             .iter_mut()
             .zip([&state.load_window, &state.angle_window])
         {
+            window.clear();
             for x in saved.iter() {
                 window.push_back(x, n);
             }
         }
+        self.trend.clear();
         for p in state.trend.iter() {
-            let _ = m.trend.push_back(p);
+            let _ = self.trend.push_back(p);
         }
+        self.events.clear();
         for e in state.events.iter() {
-            let _ = m.events.push_back(e);
+            let _ = self.events.push_back(e);
         }
-        Ok(m)
+    }
+}
+
+/// The state of a monitor that has seen no sample (what [`Monitor::new`] starts
+/// from): a place to restore a checkpoint into.
+impl Default for MonitorState {
+    fn default() -> Self {
+        MonitorState {
+            status: Status::new(),
+            load_window: Saved::empty(0.0),
+            angle_window: Saved::empty(0.0),
+            trend: Saved::empty(TrendPoint::default()),
+            events: Saved::empty(NO_EVENT),
+        }
     }
 }
 

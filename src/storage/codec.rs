@@ -332,6 +332,38 @@ pub fn encode<T: Checkpoint>(
 /// [`Checkpoint::migrate`]). Every check comes before the payload is read: a damaged,
 /// foreign or unknown record is an error, never a value.
 pub fn decode<T: Checkpoint>(record: &[u8]) -> Result<Decoded<T>, CodecError> {
+    let (mut r, header) = payload::<T>(record)?;
+    let value = if header.version == T::VERSION {
+        T::decode(&mut r)?
+    } else {
+        T::migrate(header.version, &mut r)?
+    };
+    r.finish()?;
+    Ok(Decoded {
+        value,
+        sequence: header.sequence,
+        version: header.version,
+    })
+}
+
+/// [`decode`] into `value` in place ([`Checkpoint::decode_into`]; an older version
+/// through [`Checkpoint::migrate`]): the same checks and errors, and no second value
+/// on the stack. Returns the record's number and version. On an error from the
+/// payload `value` may hold part of it: start afresh.
+pub fn decode_into<T: Checkpoint>(record: &[u8], value: &mut T) -> Result<Decoded<()>, CodecError> {
+    let (mut r, header) = payload::<T>(record)?;
+    if header.version == T::VERSION {
+        value.decode_into(&mut r)?;
+    } else {
+        *value = T::migrate(header.version, &mut r)?;
+    }
+    r.finish()?;
+    Ok(header)
+}
+
+/// The checks of a record of `T` before its payload is read: a reader over the
+/// payload, and the record's number and version (a version `T` reads).
+fn payload<T: Checkpoint>(record: &[u8]) -> Result<(Reader<'_>, Decoded<()>), CodecError> {
     let mut r = Reader::new(record);
     if r.array::<4>().map_err(|_| CodecError::Foreign)? != MAGIC {
         return Err(CodecError::Foreign);
@@ -359,22 +391,17 @@ pub fn decode<T: Checkpoint>(record: &[u8]) -> Result<Decoded<T>, CodecError> {
     if kind != T::KIND {
         return Err(CodecError::WrongKind { found: kind });
     }
-    let payload = body.get(HEADER_LEN..).ok_or(CodecError::Length)?;
-    let mut r = Reader::new(payload);
-    let value = if version == T::VERSION {
-        if payload_len != T::SIZE {
-            return Err(CodecError::Length);
-        }
-        T::decode(&mut r)?
-    } else if version < T::VERSION {
-        T::migrate(version, &mut r)?
-    } else {
+    if version > T::VERSION {
         return Err(CodecError::UnsupportedVersion { version });
-    };
-    r.finish()?;
-    Ok(Decoded {
-        value,
+    }
+    if version == T::VERSION && payload_len != T::SIZE {
+        return Err(CodecError::Length);
+    }
+    let payload = body.get(HEADER_LEN..).ok_or(CodecError::Length)?;
+    let header = Decoded {
+        value: (),
         sequence,
         version,
-    })
+    };
+    Ok((Reader::new(payload), header))
 }

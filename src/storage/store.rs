@@ -11,7 +11,7 @@ use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapConfigError, MapStorage, SerializationError, Value};
 
 use super::Checkpoint;
-use super::codec::{self, CodecError};
+use super::codec::{self, CodecError, Decoded};
 
 /// The map's cache: none. A few reads more per operation, no RAM that could disagree
 /// with the flash after a reset.
@@ -370,18 +370,55 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
     /// read) gives `value: None` and [`RestoreOutcome::Rejected`], never a wrong value;
     /// a damaged or foreign region is erased so that checkpoints can go on. `Err` only
     /// for a flash driver error or a store buffer too small for `T`.
+    ///
+    /// A state of most of a kilobyte (the monitor's) is better restored with
+    /// [`Store::restore_into`], which does not hold it on the stack.
     pub async fn restore<T: Checkpoint>(&mut self) -> Result<Restore<T>, StorageError<F::Error>> {
+        let mut value = None;
+        let outcome = self
+            .restore_with::<T>(|record| {
+                codec::decode::<T>(record).map(|d| {
+                    value = Some(d.value);
+                    Decoded {
+                        value: (),
+                        sequence: d.sequence,
+                        version: d.version,
+                    }
+                })
+            })
+            .await?;
+        Ok(Restore { value, outcome })
+    }
+
+    /// [`Store::restore`] into `value`, decoded in place
+    /// ([`Checkpoint::decode_into`]): the same outcomes, and no copy of the value on
+    /// the stack. `value` holds the restored checkpoint when the outcome is
+    /// [`RestoreOutcome::Restored`] or [`RestoreOutcome::Migrated`]; after any other
+    /// outcome it may hold part of a refused record: start afresh.
+    pub async fn restore_into<T: Checkpoint>(
+        &mut self,
+        value: &mut T,
+    ) -> Result<RestoreOutcome, StorageError<F::Error>> {
+        self.restore_with::<T>(|record| codec::decode_into(record, value))
+            .await
+    }
+
+    /// The restore of the newest record of `T`, decoded by `decode`.
+    async fn restore_with<T: Checkpoint>(
+        &mut self,
+        mut decode: impl FnMut(&[u8]) -> Result<Decoded<()>, CodecError>,
+    ) -> Result<RestoreOutcome, StorageError<F::Error>> {
         self.check_buffer::<T>()?;
         let found = self
             .map
             .fetch_item::<&[u8]>(&mut self.buf.0, &T::KIND)
             .await;
         let event = match found {
-            Ok(Some(bytes)) => match codec::decode::<T>(bytes) {
+            Ok(Some(bytes)) => match decode(bytes) {
                 Ok(d) => {
                     self.sequence = self.sequence.max(d.sequence);
                     self.stats.restores = self.stats.restores.saturating_add(1);
-                    let outcome = if d.version == T::VERSION {
+                    return Ok(if d.version == T::VERSION {
                         RestoreOutcome::Restored {
                             sequence: d.sequence,
                         }
@@ -390,10 +427,6 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
                             sequence: d.sequence,
                             from_version: d.version,
                         }
-                    };
-                    return Ok(Restore {
-                        value: Some(d.value),
-                        outcome,
                     });
                 }
                 Err(e) => StorageEvent::from_codec(e, T::VERSION),
@@ -410,12 +443,7 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
                         self.erase_region().await?;
                         return Ok(self.rejected(StorageEvent::CorruptRegion));
                     }
-                    Ok(Held { ours: true, .. }) => {
-                        return Ok(Restore {
-                            value: None,
-                            outcome: RestoreOutcome::Blank,
-                        });
-                    }
+                    Ok(Held { ours: true, .. }) => return Ok(RestoreOutcome::Blank),
                     Ok(_) => {}
                     Err(e) => {
                         let event = unusable(e)?;
@@ -424,10 +452,7 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
                     }
                 }
                 if self.region_is_blank().await? {
-                    return Ok(Restore {
-                        value: None,
-                        outcome: RestoreOutcome::Blank,
-                    });
+                    return Ok(RestoreOutcome::Blank);
                 }
                 self.erase_region().await?;
                 StorageEvent::ForeignRegion
@@ -441,12 +466,9 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
         Ok(self.rejected(event))
     }
 
-    fn rejected<T>(&mut self, event: StorageEvent) -> Restore<T> {
+    fn rejected(&mut self, event: StorageEvent) -> RestoreOutcome {
         self.stats.rejected = self.stats.rejected.saturating_add(1);
-        Restore {
-            value: None,
-            outcome: RestoreOutcome::Rejected(event),
-        }
+        RestoreOutcome::Rejected(event)
     }
 
     /// What records the map lists (every item it can read, old ones included).
