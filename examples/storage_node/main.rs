@@ -72,9 +72,7 @@ mod node {
     use misalign::monitor::scenario::Scenario;
     use misalign::monitor::{Config, Monitor, MonitorState};
     use misalign::prepared::crc32;
-    use misalign::storage::{
-        BlockingFlash, Checkpoint, Restore, RestoreOutcome, Store, block_on, codec,
-    };
+    use misalign::storage::{BlockingFlash, Checkpoint, RestoreOutcome, Store, block_on, codec};
     use misalign_harness::prepared;
     use misalign_harness::support::{exit, stack};
 
@@ -284,16 +282,11 @@ mod node {
         }
     }
 
-    /// The restored state of a boot after the cold one, if it is the committed
-    /// checkpoint or, in the power-cut phase, the cut one whole; else the exit.
-    fn check_restore<'a>(
-        restored: &'a Restore<MonitorState>,
-        control: &mut Control,
-    ) -> &'a MonitorState {
+    /// Exits unless the restore of a boot after the cold one gave the committed
+    /// checkpoint or, in the power-cut phase, the cut one whole, into `state`.
+    fn check_restore(outcome: RestoreOutcome, state: &MonitorState, control: &mut Control) {
         let code = control.step as i32;
-        let (RestoreOutcome::Restored { sequence }, Some(state)) =
-            (restored.outcome, &restored.value)
-        else {
+        let RestoreOutcome::Restored { sequence } = outcome else {
             exit(10 + code)
         };
         let crc = crc_of(state);
@@ -305,7 +298,6 @@ mod node {
             exit(10 + code);
         }
         (control.committed, control.committed_crc) = (sequence, crc);
-        state
     }
 
     /// The CRC of the state of `m` after the first [`FINAL`] samples without a break.
@@ -317,17 +309,10 @@ mod node {
         crc_of(&m.snapshot())
     }
 
-    /// A monitor over the core `core` builds, fresh or going on from `state`.
-    fn monitor<E: Estimator>(
-        core: &impl Fn() -> Option<E>,
-        state: Option<&MonitorState>,
-    ) -> Monitor<E> {
+    /// A fresh monitor over the core `core` builds.
+    fn monitor<E: Estimator>(core: &impl Fn() -> Option<E>) -> Monitor<E> {
         let Some(core) = core() else { exit(31) };
-        let m = match state {
-            None => Monitor::new(core, Config::default()),
-            Some(s) => Monitor::restore(core, Config::default(), s),
-        };
-        m.unwrap_or_else(|_| exit(31))
+        Monitor::new(core, Config::default()).unwrap_or_else(|_| exit(31))
     }
 
     /// A checkpoint of the state of `m` now, on demand; its CRC is noted as pending
@@ -350,12 +335,12 @@ mod node {
     #[inline(never)]
     fn cold<E: Estimator>(
         core: &impl Fn() -> Option<E>,
+        m: &mut Monitor<E>,
         store: &mut Store<BlockingFlash<RamFlash>, BUF>,
         control: &mut Control,
     ) -> ! {
-        control.reference_crc = reference(monitor(core, None));
-        let mut m = monitor(core, None);
-        run_to(&mut m, FIRST_RESET_AT, store, control);
+        control.reference_crc = reference(monitor(core));
+        run_to(m, FIRST_RESET_AT, store, control);
         control.step = 1;
         reset(control)
     }
@@ -364,14 +349,12 @@ mod node {
     /// demand before the (planned) reset to the power-cut phase.
     #[inline(never)]
     fn after_reset<E: Estimator>(
-        core: &impl Fn() -> Option<E>,
-        state: &MonitorState,
+        m: &mut Monitor<E>,
         store: &mut Store<BlockingFlash<RamFlash>, BUF>,
         control: &mut Control,
     ) -> ! {
-        let mut m = monitor(core, Some(state));
-        run_to(&mut m, SECOND_RESET_AT, store, control);
-        checkpoint_now(&m, store, control);
+        run_to(m, SECOND_RESET_AT, store, control);
+        checkpoint_now(m, store, control);
         (control.step, control.cut, control.boots) = (2, 0, 0);
         reset(control)
     }
@@ -381,17 +364,15 @@ mod node {
     /// before its cut point ends the phase: every point of one has been cut.
     #[inline(never)]
     fn power_cut<E: Estimator>(
-        core: &impl Fn() -> Option<E>,
-        state: &MonitorState,
+        m: &mut Monitor<E>,
         store: &mut Store<BlockingFlash<RamFlash>, BUF>,
         control: &mut Control,
     ) -> ! {
-        let mut m = monitor(core, Some(state));
-        let Some(sample) = samples_from(done(&m)).next() else {
+        let Some(sample) = samples_from(done(m)).next() else {
             exit(31)
         };
         m.process(sample);
-        checkpoint_now(&m, store, control);
+        checkpoint_now(m, store, control);
         // This boot's cut point was `control.cut - 1`.
         if (control.cut as usize) <= RECORD {
             exit(30);
@@ -404,13 +385,11 @@ mod node {
     /// reference's state.
     #[inline(never)]
     fn finish<E: Estimator>(
-        core: &impl Fn() -> Option<E>,
-        state: &MonitorState,
+        m: &mut Monitor<E>,
         store: &mut Store<BlockingFlash<RamFlash>, BUF>,
         control: &mut Control,
     ) -> ! {
-        let mut m = monitor(core, Some(state));
-        run_to(&mut m, FINAL, store, control);
+        run_to(m, FINAL, store, control);
         if crc_of(&m.snapshot()) != control.reference_crc {
             exit(32);
         }
@@ -444,24 +423,25 @@ mod node {
             control.boots += 1;
         }
         let mut store = open(flash, (step == 2).then_some(cut));
-        let Ok(restored) = block_on(store.restore::<MonitorState>()) else {
+        // As a node restores: one monitor and one state, decoded in place.
+        let mut m = monitor(&core);
+        let mut state = MonitorState::default();
+        let Ok(outcome) = block_on(store.restore_into(&mut state)) else {
             exit(20 + code)
         };
         if step == 0 {
             // Cold RAM is not a blank flash: nothing restored, an event reported.
-            if restored.value.is_some()
-                || !matches!(restored.outcome, RestoreOutcome::Rejected(_))
-                || store.stats().rejected != 1
-            {
+            if !matches!(outcome, RestoreOutcome::Rejected(_)) || store.stats().rejected != 1 {
                 exit(10 + code);
             }
-            cold(&core, &mut store, control)
+            cold(&core, &mut m, &mut store, control)
         }
-        let state = check_restore(&restored, control);
+        check_restore(outcome, &state, control);
+        m.resume(&state);
         match step {
-            1 => after_reset(&core, state, &mut store, control),
-            2 => power_cut(&core, state, &mut store, control),
-            _ => finish(&core, state, &mut store, control),
+            1 => after_reset(&mut m, &mut store, control),
+            2 => power_cut(&mut m, &mut store, control),
+            _ => finish(&mut m, &mut store, control),
         }
     }
 
