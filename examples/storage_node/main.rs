@@ -29,7 +29,7 @@
 //! 3. the node goes on from the last checkpoint to the 1800th sample: its state must
 //!    be the reference's, bit for bit, as if the power had never failed.
 //!
-//! The states are compared by the CRC-32 of their records. On a real node the samples
+//! The states are compared by the CRC-32 their records carry. On a real node the samples
 //! after the last checkpoint are lost with the power (the monitor then sees a gap);
 //! here they are replayed, so that the run can be compared with the reference. The
 //! node reports the deepest stack use of its boots.
@@ -71,7 +71,6 @@ mod node {
     use misalign::float::EllipticScene;
     use misalign::monitor::scenario::Scenario;
     use misalign::monitor::{Config, Monitor, MonitorState};
-    use misalign::prepared::crc32;
     use misalign::storage::{BlockingFlash, Checkpoint, RestoreOutcome, Store, block_on, codec};
     use misalign_harness::prepared;
     use misalign_harness::support::{exit, stack};
@@ -226,15 +225,18 @@ mod node {
         }
     }
 
-    /// The CRC-32 of a state's record (numbered 0, so that equal states have equal
-    /// CRCs) without its own CRC at the end (over which the CRC is a constant).
+    /// The CRC-32 that a state's record carries (the record numbered 0, so that equal
+    /// states have equal CRCs).
     #[inline(never)]
     fn crc_of(state: &MonitorState) -> u32 {
         let mut record = [0u8; RECORD];
-        match codec::encode(state, 0, &mut record) {
-            Ok(n) => crc32(record.get(..n.saturating_sub(4)).unwrap_or(&[])),
-            Err(_) => exit(20),
-        }
+        let Ok(n) = codec::encode(state, 0, &mut record) else {
+            exit(20)
+        };
+        let crc = record
+            .get(n.wrapping_sub(4)..n)
+            .and_then(|b| b.try_into().ok());
+        crc.map_or(0, u32::from_le_bytes)
     }
 
     /// The scenario's samples from the `done`-th on.
@@ -262,16 +264,14 @@ mod node {
                 break;
             }
             m.process(sample);
+            if done(m) == ON_DEMAND_AT && control.step == 0 {
+                checkpoint_now(m, store, control);
+                continue;
+            }
             let state = m.snapshot();
-            let written = if done(m) == ON_DEMAND_AT && control.step == 0 {
-                block_on(store.checkpoint(&state)).map(Some)
-            } else {
-                block_on(store.checkpoint_if_due(m.elapsed_ms() / 1000, &state))
-            };
-            match written {
+            match block_on(store.checkpoint_if_due(m.elapsed_ms() / 1000, &state)) {
                 Ok(Some(sequence)) => {
-                    control.committed = sequence;
-                    control.committed_crc = crc_of(&state);
+                    (control.committed, control.committed_crc) = (sequence, crc_of(&state));
                 }
                 Ok(None) => {}
                 Err(_) => exit(20 + code),

@@ -102,13 +102,6 @@ pub struct Saved<T, const N: usize> {
 }
 
 impl<T: Copy, const N: usize> Saved<T, N> {
-    fn empty(fill: T) -> Self {
-        Saved {
-            items: [fill; N],
-            len: 0,
-        }
-    }
-
     fn from_iter(fill: T, it: impl Iterator<Item = T>) -> Self {
         let mut items = [fill; N];
         let mut len = 0u8;
@@ -229,10 +222,10 @@ impl Default for MonitorState {
     fn default() -> Self {
         MonitorState {
             status: Status::new(),
-            load_window: Saved::empty(0.0),
-            angle_window: Saved::empty(0.0),
-            trend: Saved::empty(TrendPoint::default()),
-            events: Saved::empty(NO_EVENT),
+            load_window: Saved::from_iter(0.0, core::iter::empty()),
+            angle_window: Saved::from_iter(0.0, core::iter::empty()),
+            trend: Saved::from_iter(TrendPoint::default(), core::iter::empty()),
+            events: Saved::from_iter(NO_EVENT, core::iter::empty()),
         }
     }
 }

@@ -103,18 +103,6 @@ mod run {
         }
     }
 
-    fn sort(keys: &mut [i32; N]) {
-        for j in 1..N {
-            let k = keys[j];
-            let mut i = j;
-            while i > 0 && keys[i - 1] > k {
-                keys[i] = keys[i - 1];
-                i -= 1;
-            }
-            keys[i] = k;
-        }
-    }
-
     /// The Hampel window: a ring of keys and loose bounds on them.
     struct Window {
         ring: [i32; N],
@@ -173,14 +161,14 @@ mod run {
         #[inline(never)]
         fn exact<D: Domain>(&mut self, k: i32, floor: D::Floor) -> Option<i32> {
             let mut s = self.ring;
-            sort(&mut s);
+            s.sort_unstable();
             (self.lo, self.hi, self.fresh) = (s[0], s[N - 1], false);
             let med = s[N / 2];
             let mut d = [0; N];
             for (d, &x) in d.iter_mut().zip(&s) {
                 *d = D::dev(x, med);
             }
-            sort(&mut d);
+            d.sort_unstable();
             D::exceeds(D::dev(k, med), d[N / 2], floor).then_some(med)
         }
     }
