@@ -40,3 +40,8 @@ pub mod storage;
 pub use error::Error;
 pub use estimator::{Estimate, Estimator, FrictionInverse};
 pub use scene::{Scene, ThetaRelation};
+
+/// The firmware guide's examples run as doctests, as the README's do.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/firmware.md")]
+struct FirmwareGuideDoctests;
