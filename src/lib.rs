@@ -1,30 +1,4 @@
-//! `misalign`: microslip, critical misalignment angle and axial force of two
-//! misaligned rolling cylinders, after "The rolling contact of misaligned elastic
-//! cylinders" (Hertz ellipse, Kalker's line integrals), for condition-monitoring
-//! firmware.
-//!
-//! ```
-//! use misalign::{reference, Scene};
-//!
-//! // Two steel rollers of 50 mm radius, mu = 0.3.
-//! let scene = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3)?;
-//! // 1 kN load, 0.2 mrad misalignment: part of the contact still sticks.
-//! let e = reference::elliptic(&scene, 1e3, 2e-4)?;
-//! assert!(e.slip_ratio > 0.0 && e.axial_force > 0.0 && e.axial_force < 0.3 * 1e3);
-//! let phi0 = e.critical_angle.expect("a critical angle exists at this load");
-//! assert_eq!(e.regime, reference::Regime::Partial);
-//! assert!(2e-4 < phi0); // phi0 = 0.41 mrad at this load
-//! # Ok::<(), misalign::Error>(())
-//! ```
-//!
-//! Layers: [`scene`] (one installation, validated), [`reference`](mod@reference) (the
-//! whole paper in f64), [`float`] (the f32 core), [`fixed`] (the fixed-point core),
-//! [`estimator`] (the contract both cores implement). Each core keeps its kernels and
-//! generated tables inside it. See ARCHITECTURE.md for which module owns what.
-//!
-//! The hidden feature `_internals` makes the cores' kernels and tables public for the
-//! workspace's own tooling (table generator, sweeps, benchmark, fuzzing). It is not
-//! part of the API: no semver promise, not for users.
+#![doc = include_str!("../README.md")]
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -65,9 +39,9 @@ pub mod storage;
 
 pub use error::Error;
 pub use estimator::{Estimate, Estimator, FrictionInverse};
-
-/// The README's examples run as doctests.
-#[cfg(doctest)]
-#[doc = include_str!("../README.md")]
-struct ReadmeDoctests;
 pub use scene::{Scene, ThetaRelation};
+
+/// The firmware guide's examples run as doctests, as the README's do.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/firmware.md")]
+struct FirmwareGuideDoctests;
