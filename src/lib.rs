@@ -20,7 +20,9 @@
 //! Layers: [`scene`] (one installation, validated), [`reference`](mod@reference) (the
 //! whole paper in f64), [`float`] (the f32 core), [`fixed`] (the fixed-point core),
 //! [`estimator`] (the contract both cores implement). Each core keeps its kernels and
-//! generated tables inside it. See ARCHITECTURE.md for which module owns what.
+//! generated tables inside it. Every byte format (the prepared scenes of [`prepared`],
+//! the checkpoint records of `storage`) reads and writes its fields through [`bytes`].
+//! See ARCHITECTURE.md for which module owns what.
 //!
 //! The hidden feature `_internals` makes the cores' kernels and tables public for the
 //! workspace's own tooling (table generator, sweeps, benchmark, fuzzing). It is not
@@ -48,6 +50,7 @@ macro_rules! internal {
     };
 }
 
+pub mod bytes;
 mod error;
 pub mod estimator;
 pub mod fixed;

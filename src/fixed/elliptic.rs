@@ -397,8 +397,8 @@ impl FixedEllipticScene {
         Self::read(&mut Reader::open(bytes, Kind::FixedElliptic, Self::BYTES)?)
     }
 
-    pub(super) fn write(&self, w: &mut Writer<'_>) {
-        for x in [
+    pub(super) fn write(&self, w: &mut Writer<'_>) -> Result<(), PreparedError> {
+        let constants = [
             self.log_theta_lsb,
             self.log_slip,
             self.log_critical,
@@ -407,12 +407,11 @@ impl FixedEllipticScene {
             self.log_risk,
             self.log_hertz,
             self.log_pressure,
-        ] {
-            w.i32(x);
-        }
-        w.u32(self.range.load_min);
-        w.u32(self.range.angle_max);
-        self.units.write(w);
+        ];
+        w.each(&constants, |w, x| w.i32(*x))?;
+        w.u32(self.range.load_min)?;
+        w.u32(self.range.angle_max)?;
+        self.units.write(w)
     }
 
     pub(super) fn read(r: &mut Reader<'_>) -> Result<Self, PreparedError> {
@@ -430,8 +429,8 @@ impl FixedEllipticScene {
             log_hertz: c[6],
             log_pressure: c[7],
             range: InputRange {
-                load_min: r.u32(),
-                angle_max: r.u32(),
+                load_min: r.u32()?,
+                angle_max: r.u32()?,
             },
             units: Units::read(r)?,
         };

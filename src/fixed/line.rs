@@ -228,8 +228,8 @@ impl FixedLineScene {
         Self::read(&mut Reader::open(bytes, Kind::FixedLine, Self::BYTES)?)
     }
 
-    pub(super) fn write(&self, w: &mut Writer<'_>) {
-        for x in [
+    pub(super) fn write(&self, w: &mut Writer<'_>) -> Result<(), PreparedError> {
+        let constants = [
             self.log_slip,
             self.log_critical,
             self.log_angle_lsb,
@@ -237,12 +237,11 @@ impl FixedLineScene {
             self.log_risk,
             self.log_width,
             self.log_pressure,
-        ] {
-            w.i32(x);
-        }
-        w.u32(self.range.load_min);
-        w.u32(self.range.angle_max);
-        self.units.write(w);
+        ];
+        w.each(&constants, |w, x| w.i32(*x))?;
+        w.u32(self.range.load_min)?;
+        w.u32(self.range.angle_max)?;
+        self.units.write(w)
     }
 
     pub(super) fn read(r: &mut Reader<'_>) -> Result<Self, PreparedError> {
@@ -259,8 +258,8 @@ impl FixedLineScene {
             log_width: c[5],
             log_pressure: c[6],
             range: InputRange {
-                load_min: r.u32(),
-                angle_max: r.u32(),
+                load_min: r.u32()?,
+                angle_max: r.u32()?,
             },
             units: Units::read(r)?,
         };
