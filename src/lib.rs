@@ -31,8 +31,8 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
-#[cfg(any(test, feature = "std"))]
-#[cfg_attr(test, macro_use)]
+#[cfg(test)]
+#[macro_use]
 extern crate std;
 
 /// A module that only the workspace's tooling reaches into: public (and hidden from

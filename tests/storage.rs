@@ -240,6 +240,29 @@ fn crc32_is_zlibs() {
     assert_eq!(codec::crc32(b""), 0);
 }
 
+/// A storage error says what failed and chains the record's or the configuration's
+/// error as its source, with no feature (`core::error::Error`).
+#[test]
+fn storage_errors_chain_their_cause() {
+    use std::error::Error as _;
+    let codec = StorageError::<MockError>::Codec(CodecError::Checksum);
+    let source = codec.source().expect("a record error is the source");
+    assert_eq!(source.downcast_ref(), Some(&CodecError::Checksum));
+    assert_eq!(codec.to_string(), "record: record checksum mismatch");
+    let config = StorageError::<MockError>::Config(ConfigError::TooSmall);
+    assert_eq!(
+        config.source().and_then(|e| e.downcast_ref()),
+        Some(&ConfigError::TooSmall)
+    );
+    let flash = StorageError::Flash(MockError::PowerLoss);
+    assert!(flash.source().is_none());
+    assert_eq!(
+        flash.to_string(),
+        "flash error: PowerLoss",
+        "the driver's error by its Debug form"
+    );
+}
+
 #[test]
 fn records_round_trip_bit_for_bit() {
     for n in [0, 1, 2, 17, u32::MAX] {

@@ -102,6 +102,18 @@ pub enum AdcError<E> {
     Bus(E),
 }
 
+impl<E: fmt::Debug> fmt::Display for AdcError<E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AdcError::Timeout => f.write_str("no conversion ready within the timeout"),
+            AdcError::Bus(e) => write!(f, "bus or pin error: {e:?}"),
+        }
+    }
+}
+
+/// The bus's error `E` need only be `Debug` (as embedded-hal's error traits ask).
+impl<E: fmt::Debug> core::error::Error for AdcError<E> {}
+
 /// The lowest and the highest raw code of an ADC: a code at either is saturated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

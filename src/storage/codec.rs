@@ -90,8 +90,7 @@ impl fmt::Display for CodecError {
     }
 }
 
-#[cfg(feature = "std")]
-impl std::error::Error for CodecError {}
+impl core::error::Error for CodecError {}
 
 impl From<FieldError> for CodecError {
     fn from(e: FieldError) -> Self {

@@ -48,6 +48,8 @@ impl fmt::Display for ConfigError {
     }
 }
 
+impl core::error::Error for ConfigError {}
+
 /// Why a storage operation failed. `E` is the flash driver's error.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -90,8 +92,18 @@ impl<E: fmt::Debug> fmt::Display for StorageError<E> {
     }
 }
 
-#[cfg(feature = "std")]
-impl<E: fmt::Debug> std::error::Error for StorageError<E> {}
+/// The flash driver's error `E` need only be `Debug` (as `NorFlashError` asks), so it
+/// is not a [`source`](core::error::Error::source); a record's or the configuration's
+/// error is.
+impl<E: fmt::Debug> core::error::Error for StorageError<E> {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            StorageError::Codec(e) => Some(e),
+            StorageError::Config(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
 impl<E> StorageError<E> {
     fn from_ss(e: SsError<E>) -> Self {
