@@ -99,7 +99,7 @@ const _: () = {
     #[cfg(feature = "sequential-storage")]
     every_error!(
         crate::storage::CodecError,
-        crate::storage::ConfigError,
+        crate::storage::StoreConfigError,
         crate::storage::StorageError<u8>,
     );
     #[cfg(feature = "_mock-flash")]
