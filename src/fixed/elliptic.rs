@@ -113,6 +113,10 @@ impl FixedEllipticScene {
     /// [`super::LOG2_RESULT_LIMIT`]; the other sums (z, y, theta0 - theta LSB, phi0) add
     /// table values (|log2| < 42) to constants (|log2| < 100) and counts (< 32) and stay
     /// inside i32 by construction.
+    // Inlined into `from_bytes`, so that a node loading a scene never builds it in
+    // memory for this check and the reciprocals of its units, which a counts-only
+    // node does not use, are not computed (soft-float on a Cortex-M0: 1.4 KiB).
+    #[inline(always)]
     fn check_sums(&self) -> Result<(), Error> {
         // In i64 and times 3 (the thirds of log2 P exact): integers only, so that
         // scenes loaded from bytes are checked without floating point.

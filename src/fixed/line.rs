@@ -90,6 +90,10 @@ impl FixedLineScene {
 
     /// Bounds every per-sample sum of [`FixedLineScene::estimate`] over the declared
     /// range (loads of 1 to 2^32 counts, angles of 1 to `angle_max` counts), in i64.
+    // Inlined into `from_bytes`, so that a node loading a scene never builds it in
+    // memory for this check and the reciprocals of its units, which a counts-only
+    // node does not use, are not computed (soft-float on a Cortex-M0: 1.4 KiB).
+    #[inline(always)]
     fn check_sums(&self) -> Result<(), Error> {
         // In i64 (exact, integers only: scenes loaded from bytes are checked alike),
         // times 3 for `output_range_thirds`.
