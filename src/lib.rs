@@ -3,8 +3,8 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
-#[cfg(any(test, feature = "std"))]
-#[cfg_attr(test, macro_use)]
+#[cfg(test)]
+#[macro_use]
 extern crate std;
 
 /// A module that only the workspace's tooling reaches into: public (and hidden from
@@ -22,6 +22,7 @@ macro_rules! internal {
     };
 }
 
+pub mod bytes;
 mod error;
 pub mod estimator;
 pub mod fixed;
@@ -39,6 +40,7 @@ pub mod storage;
 
 pub use error::Error;
 pub use estimator::{Estimate, Estimator, FrictionInverse};
+
 pub use scene::{Scene, ThetaRelation};
 
 /// The firmware guide's examples run as doctests, as the README's do.

@@ -26,6 +26,8 @@
 
 use core::fmt;
 
+use crate::bytes::FieldError;
+
 /// The format version that `to_bytes` writes and `from_bytes` accepts.
 pub const FORMAT_VERSION: u8 = 1;
 /// The first two bytes of every prepared scene.
@@ -86,173 +88,81 @@ impl fmt::Display for PreparedError {
 
 impl core::error::Error for PreparedError {}
 
-/// CRC-32 (IEEE 802.3, reflected, as zlib's `crc32`), bit by bit: no table in flash.
-pub fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = !0u32;
-    for &byte in bytes {
-        crc ^= u32::from(byte);
-        for _ in 0..8 {
-            let mask = (crc & 1).wrapping_neg();
-            crc = (crc >> 1) ^ (0xEDB8_8320 & mask);
-        }
-    }
-    !crc
-}
-
-/// Writes one scene's bytes: the header on creation, the constants in order, the
-/// CRC-32 on [`Writer::finish`]. Writes past the end are dropped (the lengths are
-/// constants, held by the tests).
-pub(crate) struct Writer<'a> {
-    buf: &'a mut [u8],
-    at: usize,
-}
-
-impl<'a> Writer<'a> {
-    pub(crate) fn new(buf: &'a mut [u8], kind: Kind) -> Self {
-        let mut w = Writer { buf, at: 0 };
-        w.bytes(&[MAGIC[0], MAGIC[1], kind as u8, FORMAT_VERSION]);
-        w
-    }
-
-    fn bytes(&mut self, b: &[u8]) {
-        let end = self.at.saturating_add(b.len());
-        if let Some(out) = self.buf.get_mut(self.at..end) {
-            // (zip, not copy_from_slice: no length check to panic on.)
-            for (o, &x) in out.iter_mut().zip(b) {
-                *o = x;
-            }
-        }
-        self.at = end;
-    }
-
-    pub(crate) fn u8(&mut self, x: u8) {
-        self.bytes(&[x]);
-    }
-    pub(crate) fn u32(&mut self, x: u32) {
-        self.bytes(&x.to_le_bytes());
-    }
-    pub(crate) fn i32(&mut self, x: i32) {
-        self.bytes(&x.to_le_bytes());
-    }
-    pub(crate) fn f32(&mut self, x: f32) {
-        self.u32(x.to_bits());
-    }
-    /// `n` zero bytes: an absent optional part.
-    pub(crate) fn zeros(&mut self, n: usize) {
-        for _ in 0..n {
-            self.u8(0);
-        }
-    }
-
-    /// An optional part: a flag byte, then `write`'s `n` bytes, or `n` zeros.
-    pub(crate) fn option<T>(&mut self, x: Option<&T>, n: usize, write: impl FnOnce(&T, &mut Self)) {
-        self.u8(x.is_some() as u8);
-        match x {
-            Some(x) => write(x, self),
-            None => self.zeros(n),
-        }
-    }
-
-    /// Writes the CRC-32 of everything before it into the last four bytes.
-    pub(crate) fn finish(self) {
-        let n = self.buf.len().saturating_sub(4);
-        let (body, tail) = self.buf.split_at_mut(n);
-        let crc = crc32(body).to_le_bytes();
-        for (o, &x) in tail.iter_mut().zip(&crc) {
-            *o = x;
+impl From<FieldError> for PreparedError {
+    fn from(e: FieldError) -> Self {
+        match e {
+            FieldError::InvalidValue => PreparedError::Value,
+            FieldError::Truncated | FieldError::TrailingBytes => PreparedError::Length,
         }
     }
 }
 
-/// A scene's bytes: the header, what `write` writes, the CRC-32.
-pub(crate) fn seal<const N: usize>(kind: Kind, write: impl FnOnce(&mut Writer<'_>)) -> [u8; N] {
+/// CRC-32 of the scenes (the checkpoint records' too).
+pub use crate::bytes::crc32;
+
+/// Writes one scene's constants, in order.
+pub(crate) type Writer<'a> = crate::bytes::Writer<'a, PreparedError>;
+
+/// Reads one scene's constants, after [`Reader::open`] checked the frame.
+pub(crate) type Reader<'a> = crate::bytes::Reader<'a, PreparedError>;
+
+/// A scene's bytes: the header, what `write` writes, the CRC-32. Should `write` fail
+/// or not fill the bytes (the lengths are constants, held by the tests), every byte is
+/// zero, which `from_bytes` refuses ([`PreparedError::Magic`]): never a scene that
+/// loads wrong.
+pub(crate) fn seal<const N: usize>(
+    kind: Kind,
+    write: impl FnOnce(&mut Writer<'_>) -> Result<(), PreparedError>,
+) -> [u8; N] {
     let mut out = [0; N];
-    let mut w = Writer::new(&mut out, kind);
-    write(&mut w);
-    w.finish();
+    if seal_into(&mut out, kind, write).is_err() {
+        out = [0; N];
+    }
     out
 }
 
-/// Reads one scene's constants after [`Reader::open`] checked the frame. Reads past
-/// the end give 0 (not reached: the length is checked first).
-pub(crate) struct Reader<'a> {
-    bytes: &'a [u8],
-    at: usize,
+fn seal_into(
+    out: &mut [u8],
+    kind: Kind,
+    write: impl FnOnce(&mut Writer<'_>) -> Result<(), PreparedError>,
+) -> Result<(), PreparedError> {
+    let n = out.len().checked_sub(4).ok_or(PreparedError::Length)?;
+    let (body, crc) = out.split_at_mut_checked(n).ok_or(PreparedError::Length)?;
+    let mut w = Writer::new(body);
+    w.bytes(&MAGIC)?;
+    w.u8(kind as u8)?;
+    w.u8(FORMAT_VERSION)?;
+    write(&mut w)?;
+    if w.written() != body.len() {
+        return Err(PreparedError::Length);
+    }
+    Writer::new(crc).u32(crc32(body))
 }
 
 impl<'a> Reader<'a> {
     /// Checks length, magic, kind, version and checksum of `bytes`, which must be
-    /// `len` long.
+    /// `len` long; the reader is then at the first constant.
     pub(crate) fn open(bytes: &'a [u8], kind: Kind, len: usize) -> Result<Self, PreparedError> {
         if bytes.len() != len || len < OVERHEAD {
             return Err(PreparedError::Length);
         }
-        let (body, crc) = bytes.split_at(len - 4);
-        match body {
-            [m0, m1, ..] if [*m0, *m1] != MAGIC => return Err(PreparedError::Magic),
-            [_, _, k, ..] if *k != kind as u8 => return Err(PreparedError::Kind),
-            [_, _, _, v, ..] if *v != FORMAT_VERSION => return Err(PreparedError::Version),
-            _ => {}
+        let (body, crc) = bytes
+            .split_at_checked(len - 4)
+            .ok_or(PreparedError::Length)?;
+        let mut r = Reader::new(body);
+        if r.array::<2>()? != MAGIC {
+            return Err(PreparedError::Magic);
+        }
+        if r.u8()? != kind as u8 {
+            return Err(PreparedError::Kind);
+        }
+        if r.u8()? != FORMAT_VERSION {
+            return Err(PreparedError::Version);
         }
         if crc32(body).to_le_bytes() != crc {
             return Err(PreparedError::Checksum);
         }
-        Ok(Reader { bytes: body, at: 4 })
-    }
-
-    fn array<const N: usize>(&mut self) -> [u8; N] {
-        let end = self.at.saturating_add(N);
-        let out = self
-            .bytes
-            .get(self.at..end)
-            .and_then(|b| b.try_into().ok())
-            .unwrap_or([0; N]);
-        self.at = end;
-        out
-    }
-
-    pub(crate) fn u8(&mut self) -> u8 {
-        self.array::<1>()[0]
-    }
-    pub(crate) fn u32(&mut self) -> u32 {
-        u32::from_le_bytes(self.array())
-    }
-    pub(crate) fn i32(&mut self) -> i32 {
-        i32::from_le_bytes(self.array())
-    }
-    /// An f32 by its bits (checked by the caller, e.g. [`positive_normal`]).
-    pub(crate) fn f32(&mut self) -> f32 {
-        f32::from_bits(self.u32())
-    }
-    /// A flag byte: 0 or 1.
-    pub(crate) fn flag(&mut self) -> Result<bool, PreparedError> {
-        match self.u8() {
-            0 => Ok(false),
-            1 => Ok(true),
-            _ => Err(PreparedError::Value),
-        }
-    }
-    /// An optional part that [`Writer::option`] wrote.
-    pub(crate) fn option<T>(
-        &mut self,
-        n: usize,
-        read: impl FnOnce(&mut Self) -> Result<T, PreparedError>,
-    ) -> Result<Option<T>, PreparedError> {
-        if self.flag()? {
-            read(self).map(Some)
-        } else {
-            self.zeros(n).map(|()| None)
-        }
-    }
-
-    /// Skips `n` bytes, which must be zero (an absent optional part).
-    pub(crate) fn zeros(&mut self, n: usize) -> Result<(), PreparedError> {
-        for _ in 0..n {
-            if self.u8() != 0 {
-                return Err(PreparedError::Value);
-            }
-        }
-        Ok(())
+        Ok(r)
     }
 }
 
@@ -300,7 +210,7 @@ pub(crate) fn read_choice(
     r: &mut Reader<'_>,
 ) -> Result<crate::reference::ModelChoice, PreparedError> {
     use crate::reference::ModelChoice;
-    match r.u8() {
+    match r.u8()? {
         0 => Ok(ModelChoice::Section9),
         1 => Ok(ModelChoice::Elliptic),
         2 => Ok(ModelChoice::Line),

@@ -69,7 +69,7 @@ pub enum FaultKind {
 }
 
 impl FaultKind {
-    /// Every kind, in the order of the sensors' fault counters (`sensors::FaultCounts`).
+    /// Every kind, in the order of the sensors' fault counters (`sensors::SensorFaultCounts`).
     pub const ALL: [FaultKind; 6] = [
         FaultKind::Disconnected,
         FaultKind::Bus,

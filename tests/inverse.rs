@@ -187,8 +187,8 @@ fn model_choice_round_trips() {
         let answer = inverse::angle_estimate(&scene, load, force).unwrap();
         let saturated = est.slip_ratio() >= 1.0
             || match est {
-                reference::Estimate::Elliptic(_) => force.abs() == mu * load,
-                reference::Estimate::Line(_) => force.abs() == mu * (load / length) * length,
+                reference::Solution::Elliptic(_) => force.abs() == mu * load,
+                reference::Solution::Line(_) => force.abs() == mu * (load / length) * length,
             };
         match answer {
             Inverse::AtLeast { value } => {

@@ -5,7 +5,7 @@
 
 use misalign::fixed::{FixedAuto, FixedContactDetails, FixedLineScene, exact_lsb};
 use misalign::float::{Auto, ContactDetails, EllipticScene, LineScene};
-use misalign::reference::{self, ContactModel, Estimate, MODEL_SWITCH_BAND, ModelChoice};
+use misalign::reference::{self, ContactModel, MODEL_SWITCH_BAND, ModelChoice, Solution};
 use misalign::{Error, Scene};
 
 fn rel(got: f64, want: f64) -> f64 {
@@ -135,7 +135,7 @@ fn forced_line_contact_reads_the_total_load_in_every_model() {
         .unwrap();
     let (load, phi) = (2000.0, 3e-4);
     let per_length = reference::line(&scene, load / 0.4, phi).unwrap();
-    let Estimate::Line(r) = reference::estimate_with(&scene, load, phi, ModelChoice::Line).unwrap()
+    let Solution::Line(r) = reference::estimate_with(&scene, load, phi, ModelChoice::Line).unwrap()
     else {
         panic!("forced line contact answered with the ellipse");
     };
@@ -207,7 +207,7 @@ fn the_jump_at_the_switch_is_the_documented_one() {
         let p_switch = (length / (2.0 * a1)).powi(3);
         let below = reference::estimate(&scene, p_switch * (1.0 - 1e-9), phi).unwrap();
         let above = reference::estimate(&scene, p_switch * (1.0 + 1e-9), phi).unwrap();
-        let (Estimate::Elliptic(e), Estimate::Line(l)) = (below, above) else {
+        let (Solution::Elliptic(e), Solution::Line(l)) = (below, above) else {
             panic!("no switch at 2a = length");
         };
         let k = (1.0 - e.shape.kprime * e.shape.kprime).sqrt();
@@ -324,7 +324,7 @@ fn rolling_resistance_and_power_in_line_contact() {
     assert!(l.rolling_resistance() > 0.0); // F has the sign of phi
     let est = reference::estimate(&scene, load, 1e-6).unwrap();
     assert_eq!(est.model(), ContactModel::Line);
-    let Estimate::Line(per_length) = est else {
+    let Solution::Line(per_length) = est else {
         unreachable!()
     };
     assert!(

@@ -277,7 +277,7 @@ fn the_configuration_round_trips_and_is_validated_on_decode() {
     assert_eq!(Config::KIND, kind::MONITOR_CONFIG);
     // The docs' wear figures are those of the monitor's real record.
     assert_eq!(
-        misalign::storage::wear::REFERENCE.payload,
+        misalign::storage::endurance::REFERENCE.payload,
         MonitorState::SIZE
     );
     assert_eq!(MonitorState::KIND, kind::MONITOR_STATE);

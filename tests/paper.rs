@@ -240,7 +240,7 @@ fn model_choice_switches_to_line_contact() {
     assert_eq!(short.model(), reference::ContactModel::Elliptic);
     assert_eq!(long.model(), reference::ContactModel::Line);
     match long {
-        reference::Estimate::Line(l) => assert_eq!(l.load, 2e3 / 0.1),
+        reference::Solution::Line(l) => assert_eq!(l.load, 2e3 / 0.1),
         _ => unreachable!(),
     }
     assert!(

@@ -10,11 +10,11 @@
 //! chosen ones (about 25 s; the default takes well under a second).
 
 use misalign::storage::codec::{self, CodecError, Decoded};
+use misalign::storage::endurance::{self, Geometry};
 use misalign::storage::kind;
-use misalign::storage::wear::{self, Geometry};
 use misalign::storage::{
-    BlockingFlash, Checkpoint, ConfigError, MockError, MockFlash, Reader, Restore, RestoreOutcome,
-    StorageError, StorageEvent, Store, Writer, block_on,
+    BlockingFlash, Checkpoint, MockError, MockFlash, Reader, Restore, RestoreOutcome, StorageError,
+    StorageEvent, Store, StoreConfigError, Writer, block_on,
 };
 
 // ---------------------------------------------------------------------------------
@@ -240,6 +240,29 @@ fn crc32_is_zlibs() {
     assert_eq!(codec::crc32(b""), 0);
 }
 
+/// A storage error says what failed and chains the record's or the configuration's
+/// error as its source, with no feature (`core::error::Error`).
+#[test]
+fn storage_errors_chain_their_cause() {
+    use std::error::Error as _;
+    let codec = StorageError::<MockError>::Codec(CodecError::Checksum);
+    let source = codec.source().expect("a record error is the source");
+    assert_eq!(source.downcast_ref(), Some(&CodecError::Checksum));
+    assert_eq!(codec.to_string(), "record: record checksum mismatch");
+    let config = StorageError::<MockError>::Config(StoreConfigError::TooSmall);
+    assert_eq!(
+        config.source().and_then(|e| e.downcast_ref()),
+        Some(&StoreConfigError::TooSmall)
+    );
+    let flash = StorageError::Flash(MockError::PowerLoss);
+    assert!(flash.source().is_none());
+    assert_eq!(
+        flash.to_string(),
+        "flash error: PowerLoss",
+        "the driver's error by its Debug form"
+    );
+}
+
 #[test]
 fn records_round_trip_bit_for_bit() {
     for n in [0, 1, 2, 17, u32::MAX] {
@@ -446,10 +469,10 @@ fn bad_configurations_are_typed_errors() {
     let bad = |range: core::ops::Range<u32>, interval| {
         Store::<_, BUF>::new(BlockingFlash(Flash::new()), range, interval).err()
     };
-    assert_eq!(bad(0..4096, 0), Some(ConfigError::ZeroInterval));
-    assert_eq!(bad(100..4096, 60), Some(ConfigError::Unaligned));
-    assert_eq!(bad(0..1024, 60), Some(ConfigError::TooSmall));
-    assert_eq!(bad(0..8192, 60), Some(ConfigError::OutOfBounds));
+    assert_eq!(bad(0..4096, 0), Some(StoreConfigError::ZeroInterval));
+    assert_eq!(bad(100..4096, 60), Some(StoreConfigError::Unaligned));
+    assert_eq!(bad(0..1024, 60), Some(StoreConfigError::TooSmall));
+    assert_eq!(bad(0..8192, 60), Some(StoreConfigError::OutOfBounds));
     assert_eq!(bad(0..4096, 60), None);
 
     // A buffer too small for the record: a typed error, on restore and on checkpoint.
@@ -498,7 +521,7 @@ fn checkpoints_follow_the_interval_and_on_demand() {
     // The numbering goes on after a restart.
     assert_eq!(store.next_sequence(), 4);
     // A new interval applies to the interval under way; zero is refused.
-    assert_eq!(store.set_interval_s(0), Err(ConfigError::ZeroInterval));
+    assert_eq!(store.set_interval_s(0), Err(StoreConfigError::ZeroInterval));
     assert_eq!(store.interval_s(), INTERVAL_S);
     store.set_interval_s(10).unwrap();
     assert_eq!(block_on(store.checkpoint_if_due(5000, &state(4))), Ok(None));
@@ -946,7 +969,7 @@ fn a_full_region_is_a_typed_error_and_keeps_what_it_holds() {
 }
 
 /// Many checkpoints through the small flash: the ring wraps around many times, every
-/// restart restores the newest, and the sectors wear evenly, as `wear` computes.
+/// restart restores the newest, and the sectors wear evenly, as `endurance` computes.
 #[test]
 fn wrap_around_and_wear_matches_the_mock_flash() {
     let geometry = Geometry {
@@ -996,10 +1019,10 @@ fn grouped(n: u64) -> String {
 
 #[test]
 fn the_docs_wear_figures_are_the_computed_ones() {
-    let g = wear::REFERENCE;
+    let g = endurance::REFERENCE;
     assert_eq!(g.checkpoints_per_sector(), 4);
     let rows = [
-        ("1 h (default)", wear::DEFAULT_INTERVAL_S),
+        ("1 h (default)", endurance::DEFAULT_INTERVAL_S),
         ("15 min", 900),
         ("5 min", 300),
     ];
@@ -1009,21 +1032,21 @@ fn the_docs_wear_figures_are_the_computed_ones() {
     for (name, interval) in rows {
         let row = format!(
             "| {name} | {} | {} | {} |",
-            grouped(wear::SECONDS_PER_YEAR / u64::from(interval)),
+            grouped(endurance::SECONDS_PER_YEAR / u64::from(interval)),
             grouped(g.cycles_per_year(interval)),
-            g.years_to(wear::RATED_CYCLES, interval)
+            g.years_to(endurance::RATED_CYCLES, interval)
         );
         assert!(module.contains(&row), "module docs lack {row}");
     }
-    let ten_years = g.min_interval_s(wear::RATED_CYCLES, 10);
+    let ten_years = g.min_interval_s(endurance::RATED_CYCLES, 10);
     assert!(module.contains(&format!("{ten_years} s for ten years")));
     // The shortest interval for ten years is just that: the erases of ten years at
     // it fit the rating, one second less does not.
     let erases_in_ten_years = |interval: u32| {
-        10 * wear::SECONDS_PER_YEAR / u64::from(interval) / g.checkpoints_per_cycle()
+        10 * endurance::SECONDS_PER_YEAR / u64::from(interval) / g.checkpoints_per_cycle()
     };
-    assert!(erases_in_ten_years(ten_years) <= u64::from(wear::RATED_CYCLES));
-    assert!(erases_in_ten_years(ten_years - 1) >= u64::from(wear::RATED_CYCLES));
+    assert!(erases_in_ten_years(ten_years) <= u64::from(endurance::RATED_CYCLES));
+    assert!(erases_in_ten_years(ten_years - 1) >= u64::from(endurance::RATED_CYCLES));
 
     let guide =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/firmware.md")).unwrap();
@@ -1031,13 +1054,13 @@ fn the_docs_wear_figures_are_the_computed_ones() {
     let sentences = [
         format!(
             "{} erase cycles per sector a year, {} years to 10 000 cycles",
-            g.cycles_per_year(wear::DEFAULT_INTERVAL_S),
-            g.years_to(wear::RATED_CYCLES, wear::DEFAULT_INTERVAL_S)
+            g.cycles_per_year(endurance::DEFAULT_INTERVAL_S),
+            g.years_to(endurance::RATED_CYCLES, endurance::DEFAULT_INTERVAL_S)
         ),
         format!(
             "every 15 minutes it would take {}, {} years",
             grouped(g.cycles_per_year(900)),
-            g.years_to(wear::RATED_CYCLES, 900)
+            g.years_to(endurance::RATED_CYCLES, 900)
         ),
         format!("({ten_years} s for ten years here)"),
     ];

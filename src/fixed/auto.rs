@@ -251,16 +251,16 @@ impl FixedAuto {
             w.option(
                 self.elliptic.as_ref(),
                 FixedEllipticScene::PAYLOAD,
-                |e, w| e.write(w),
-            );
-            w.option(self.line.as_ref(), FixedLineScene::PAYLOAD, |l, w| {
+                |w, e| e.write(w),
+            )?;
+            w.option(self.line.as_ref(), FixedLineScene::PAYLOAD, |w, l| {
                 l.write(w)
-            });
-            w.option(self.log_half_length.as_ref(), 4, |l, w| w.i32(*l));
-            w.i32(self.log_band);
-            w.u8(choice_byte(self.choice));
-            w.i32(self.log_risk);
-            self.units.write(w);
+            })?;
+            w.option(self.log_half_length.as_ref(), 4, |w, l| w.i32(*l))?;
+            w.i32(self.log_band)?;
+            w.u8(choice_byte(self.choice))?;
+            w.i32(self.log_risk)?;
+            self.units.write(w)
         })
     }
 

@@ -113,6 +113,10 @@ impl FixedEllipticScene {
     /// [`super::LOG2_RESULT_LIMIT`]; the other sums (z, y, theta0 - theta LSB, phi0) add
     /// table values (|log2| < 42) to constants (|log2| < 100) and counts (< 32) and stay
     /// inside i32 by construction.
+    // Inlined into `from_bytes`, so that a node loading a scene never builds it in
+    // memory for this check and the reciprocals of its units, which a counts-only
+    // node does not use, are not computed (soft-float on a Cortex-M0: 1.4 KiB).
+    #[inline(always)]
     fn check_sums(&self) -> Result<(), Error> {
         // In i64 and times 3 (the thirds of log2 P exact): integers only, so that
         // scenes loaded from bytes are checked without floating point.
@@ -397,8 +401,8 @@ impl FixedEllipticScene {
         Self::read(&mut Reader::open(bytes, Kind::FixedElliptic, Self::BYTES)?)
     }
 
-    pub(super) fn write(&self, w: &mut Writer<'_>) {
-        for x in [
+    pub(super) fn write(&self, w: &mut Writer<'_>) -> Result<(), PreparedError> {
+        let constants = [
             self.log_theta_lsb,
             self.log_slip,
             self.log_critical,
@@ -407,12 +411,11 @@ impl FixedEllipticScene {
             self.log_risk,
             self.log_hertz,
             self.log_pressure,
-        ] {
-            w.i32(x);
-        }
-        w.u32(self.range.load_min);
-        w.u32(self.range.angle_max);
-        self.units.write(w);
+        ];
+        w.each(&constants, |w, x| w.i32(*x))?;
+        w.u32(self.range.load_min)?;
+        w.u32(self.range.angle_max)?;
+        self.units.write(w)
     }
 
     pub(super) fn read(r: &mut Reader<'_>) -> Result<Self, PreparedError> {
@@ -430,8 +433,8 @@ impl FixedEllipticScene {
             log_hertz: c[6],
             log_pressure: c[7],
             range: InputRange {
-                load_min: r.u32(),
-                angle_max: r.u32(),
+                load_min: r.u32()?,
+                angle_max: r.u32()?,
             },
             units: Units::read(r)?,
         };

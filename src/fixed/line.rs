@@ -90,6 +90,10 @@ impl FixedLineScene {
 
     /// Bounds every per-sample sum of [`FixedLineScene::estimate`] over the declared
     /// range (loads of 1 to 2^32 counts, angles of 1 to `angle_max` counts), in i64.
+    // Inlined into `from_bytes`, so that a node loading a scene never builds it in
+    // memory for this check and the reciprocals of its units, which a counts-only
+    // node does not use, are not computed (soft-float on a Cortex-M0: 1.4 KiB).
+    #[inline(always)]
     fn check_sums(&self) -> Result<(), Error> {
         // In i64 (exact, integers only: scenes loaded from bytes are checked alike),
         // times 3 for `output_range_thirds`.
@@ -228,8 +232,8 @@ impl FixedLineScene {
         Self::read(&mut Reader::open(bytes, Kind::FixedLine, Self::BYTES)?)
     }
 
-    pub(super) fn write(&self, w: &mut Writer<'_>) {
-        for x in [
+    pub(super) fn write(&self, w: &mut Writer<'_>) -> Result<(), PreparedError> {
+        let constants = [
             self.log_slip,
             self.log_critical,
             self.log_angle_lsb,
@@ -237,12 +241,11 @@ impl FixedLineScene {
             self.log_risk,
             self.log_width,
             self.log_pressure,
-        ] {
-            w.i32(x);
-        }
-        w.u32(self.range.load_min);
-        w.u32(self.range.angle_max);
-        self.units.write(w);
+        ];
+        w.each(&constants, |w, x| w.i32(*x))?;
+        w.u32(self.range.load_min)?;
+        w.u32(self.range.angle_max)?;
+        self.units.write(w)
     }
 
     pub(super) fn read(r: &mut Reader<'_>) -> Result<Self, PreparedError> {
@@ -259,8 +262,8 @@ impl FixedLineScene {
             log_width: c[5],
             log_pressure: c[6],
             range: InputRange {
-                load_min: r.u32(),
-                angle_max: r.u32(),
+                load_min: r.u32()?,
+                angle_max: r.u32()?,
             },
             units: Units::read(r)?,
         };

@@ -255,15 +255,15 @@ impl Units {
         }
     }
 
-    pub(crate) fn write(&self, w: &mut Writer<'_>) {
-        w.f32(self.load_lsb);
-        w.f32(self.angle_lsb);
+    pub(crate) fn write(&self, w: &mut Writer<'_>) -> Result<(), PreparedError> {
+        w.f32(self.load_lsb)?;
+        w.f32(self.angle_lsb)
     }
 
     /// Units from prepared bytes: both positive normal f32, as [`Units::new`] makes them.
     pub(crate) fn read(r: &mut Reader<'_>) -> Result<Self, PreparedError> {
-        let load_lsb = crate::prepared::positive_normal(r.f32())?;
-        let angle_lsb = crate::prepared::positive_normal(r.f32())?;
+        let load_lsb = crate::prepared::positive_normal(r.f32()?)?;
+        let angle_lsb = crate::prepared::positive_normal(r.f32()?)?;
         Ok(Units::of(load_lsb, angle_lsb))
     }
 
@@ -431,7 +431,7 @@ fn output_range_thirds(lo: i64, hi: i64) -> Result<(), Error> {
 
 /// A Q8.24 scene constant from prepared bytes: within +-100, as [`constant`] makes it.
 fn read_constant(r: &mut Reader<'_>) -> Result<i32, PreparedError> {
-    let l = r.i32();
+    let l = r.i32()?;
     crate::prepared::value(l.unsigned_abs() < 100 << 24)?;
     Ok(l)
 }

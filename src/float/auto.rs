@@ -232,13 +232,13 @@ impl Auto {
     /// choice and the risk threshold. The ellipse loads with the full tables.
     pub fn to_bytes(&self) -> [u8; Self::BYTES] {
         seal(Kind::Auto, |w| {
-            w.option(self.elliptic.as_ref(), EllipticScene::PAYLOAD, |e, w| {
+            w.option(self.elliptic.as_ref(), EllipticScene::PAYLOAD, |w, e| {
                 e.write(w)
-            });
-            w.option(self.line.as_ref(), LineScene::PAYLOAD, |l, w| l.write(w));
-            w.f32(self.two_over_length);
-            w.u8(choice_byte(self.choice));
-            w.f32(self.risk_slip_ratio);
+            })?;
+            w.option(self.line.as_ref(), LineScene::PAYLOAD, |w, l| l.write(w))?;
+            w.f32(self.two_over_length)?;
+            w.u8(choice_byte(self.choice))?;
+            w.f32(self.risk_slip_ratio)
         })
     }
 
@@ -254,12 +254,12 @@ impl Auto {
             EllipticScene::read(r, super::Tables::FULL)
         })?;
         let line = r.option(LineScene::PAYLOAD, LineScene::read)?;
-        let two_over_length = r.f32();
+        let two_over_length = r.f32()?;
         if two_over_length.to_bits() != 0 {
             positive_normal(two_over_length)?;
         }
         let choice = read_choice(r)?;
-        let risk_slip_ratio = positive_finite(r.f32())?;
+        let risk_slip_ratio = positive_finite(r.f32()?)?;
         models_present(choice, elliptic.is_some(), line.is_some())?;
         Ok(Auto {
             elliptic,

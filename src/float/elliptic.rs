@@ -509,8 +509,8 @@ impl<'t> EllipticScene<'t> {
         )
     }
 
-    pub(super) fn write(&self, w: &mut Writer<'_>) {
-        for x in [
+    pub(super) fn write(&self, w: &mut Writer<'_>) -> Result<(), PreparedError> {
+        let constants = [
             self.radius_factor,
             self.inv_radius_factor,
             self.slip_gain,
@@ -519,18 +519,17 @@ impl<'t> EllipticScene<'t> {
             self.hertz_gain,
             self.risk_slip_ratio,
             self.cubed_critical_gain,
-        ] {
-            w.f32(x);
-        }
+        ];
+        w.each(&constants, |w, x| w.f32(*x))
     }
 
     pub(super) fn read(r: &mut Reader<'_>, tables: Tables<'t>) -> Result<Self, PreparedError> {
         let mut c = [0.0f32; 6];
         for x in &mut c {
-            *x = positive_normal(r.f32())?;
+            *x = positive_normal(r.f32()?)?;
         }
-        let risk_slip_ratio = positive_finite(r.f32())?;
-        let cubed_critical_gain = r.f32();
+        let risk_slip_ratio = positive_finite(r.f32()?)?;
+        let cubed_critical_gain = r.f32()?;
         // On the bits (positive f32 order as their bits): 2^-40 <= c <= 1, A within
         // `SLIP_GAIN_LIMIT`, mu at most 128 (the f32 of a mu below 128), B^3 0 or in
         // the hot path's [2^-120, 2^39] (whether it is B's cube takes floating point:

@@ -261,28 +261,27 @@ impl LineScene {
         Self::read(&mut Reader::open(bytes, Kind::Line, Self::BYTES)?)
     }
 
-    pub(super) fn write(&self, w: &mut Writer<'_>) {
-        for x in [
+    pub(super) fn write(&self, w: &mut Writer<'_>) -> Result<(), PreparedError> {
+        let constants = [
             self.slip_gain,
             self.critical_gain,
             self.friction,
             self.width_gain,
             self.pressure_gain,
             self.risk_slip_ratio,
-        ] {
-            w.f32(x);
-        }
-        w.u32(self.load_min_bits);
-        w.u32(self.load_span_bits);
+        ];
+        w.each(&constants, |w, x| w.f32(*x))?;
+        w.u32(self.load_min_bits)?;
+        w.u32(self.load_span_bits)
     }
 
     pub(super) fn read(r: &mut Reader<'_>) -> Result<Self, PreparedError> {
         let mut c = [0.0f32; 5];
         for x in &mut c {
-            *x = positive_normal(r.f32())?;
+            *x = positive_normal(r.f32()?)?;
         }
-        let risk_slip_ratio = positive_finite(r.f32())?;
-        let (load_min_bits, load_span_bits) = (r.u32(), r.u32());
+        let risk_slip_ratio = positive_finite(r.f32()?)?;
+        let (load_min_bits, load_span_bits) = (r.u32()?, r.u32()?);
         // The load range: positive f32 from the lightest up to at most f32::MAX.
         value(
             load_min_bits != 0

@@ -204,26 +204,26 @@ pub struct Line {
 /// A result of either model, as chosen by [`estimate`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Estimate {
+pub enum Solution {
     /// The ellipse fits on the rollers (or no length was given).
     Elliptic(Elliptic),
     /// The ellipse would be longer than the rollers: line contact with P / length.
     Line(Line),
 }
 
-impl Estimate {
+impl Solution {
     /// Which model produced it.
     pub fn model(&self) -> ContactModel {
         match self {
-            Estimate::Elliptic(_) => ContactModel::Elliptic,
-            Estimate::Line(_) => ContactModel::Line,
+            Solution::Elliptic(_) => ContactModel::Elliptic,
+            Solution::Line(_) => ContactModel::Line,
         }
     }
     /// Slip ratio d/b.
     pub fn slip_ratio(&self) -> f64 {
         match self {
-            Estimate::Elliptic(e) => e.slip_ratio,
-            Estimate::Line(l) => l.slip_ratio,
+            Solution::Elliptic(e) => e.slip_ratio,
+            Solution::Line(l) => l.slip_ratio,
         }
     }
     /// Regime.
@@ -234,38 +234,38 @@ impl Estimate {
     /// (N/m for line contact without a length).
     pub fn axial_force(&self, scene: &Scene) -> f64 {
         match self {
-            Estimate::Elliptic(e) => e.axial_force,
-            Estimate::Line(l) => l.axial_force * scene.length().unwrap_or(1.0),
+            Solution::Elliptic(e) => e.axial_force,
+            Solution::Line(l) => l.axial_force * scene.length().unwrap_or(1.0),
         }
     }
     /// Rolling resistance `F phi / 2` (N) on each cylinder (section 7): the line
     /// model's per unit length times the length (section 9), or N/m without a length.
     pub fn rolling_resistance(&self, scene: &Scene) -> f64 {
         match self {
-            Estimate::Elliptic(e) => e.rolling_resistance(),
-            Estimate::Line(l) => l.rolling_resistance() * scene.length().unwrap_or(1.0),
+            Solution::Elliptic(e) => e.rolling_resistance(),
+            Solution::Line(l) => l.rolling_resistance() * scene.length().unwrap_or(1.0),
         }
     }
     /// Power `F phi V` (W) dissipated by microslip at rolling speed `speed` (m/s),
     /// section 7; for line contact per unit length times the length (W/m without one).
     pub fn dissipated_power(&self, scene: &Scene, speed: f64) -> f64 {
         match self {
-            Estimate::Elliptic(e) => e.dissipated_power(speed),
-            Estimate::Line(l) => l.dissipated_power(speed) * scene.length().unwrap_or(1.0),
+            Solution::Elliptic(e) => e.dissipated_power(speed),
+            Solution::Line(l) => l.dissipated_power(speed) * scene.length().unwrap_or(1.0),
         }
     }
     /// Critical angle phi0 (rad), if any.
     pub fn critical_angle(&self) -> Option<f64> {
         match self {
-            Estimate::Elliptic(e) => e.critical_angle,
-            Estimate::Line(l) => Some(l.critical_angle),
+            Solution::Elliptic(e) => e.critical_angle,
+            Solution::Line(l) => Some(l.critical_angle),
         }
     }
     /// Validity flags.
     pub fn validity(&self) -> Validity {
         match self {
-            Estimate::Elliptic(e) => e.validity,
-            Estimate::Line(l) => l.validity,
+            Solution::Elliptic(e) => e.validity,
+            Solution::Line(l) => l.validity,
         }
     }
 }
@@ -592,7 +592,7 @@ impl Line {
 ///
 /// # Errors
 /// As [`elliptic`] and [`line()`].
-pub fn estimate(scene: &Scene, load: f64, phi: f64) -> Result<Estimate, Error> {
+pub fn estimate(scene: &Scene, load: f64, phi: f64) -> Result<Solution, Error> {
     estimate_with(scene, load, phi, ModelChoice::Section9)
 }
 
@@ -608,10 +608,10 @@ pub fn estimate_with(
     load: f64,
     phi: f64,
     choice: ModelChoice,
-) -> Result<Estimate, Error> {
+) -> Result<Solution, Error> {
     check_sample(load, phi)?;
     if choice == ModelChoice::Elliptic {
-        return elliptic(scene, load, phi).map(Estimate::Elliptic);
+        return elliptic(scene, load, phi).map(Solution::Elliptic);
     }
     // A plane, or radii so unequal that c underflows, has a strip for every phi (no
     // ellipse); forced line contact without a length needs no ellipse either.
@@ -624,10 +624,10 @@ pub fn estimate_with(
         && choice == ModelChoice::Section9
         && !e.validity.longer_than_rollers
     {
-        return Ok(Estimate::Elliptic(e));
+        return Ok(Solution::Elliptic(e));
     }
     let per_length = load / scene.length().unwrap_or(1.0);
     let mut l = line(scene, per_length, phi)?;
     l.validity.near_model_switch = ellipse.is_some_and(|e| e.validity.near_model_switch);
-    Ok(Estimate::Line(l))
+    Ok(Solution::Line(l))
 }

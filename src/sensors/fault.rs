@@ -9,7 +9,7 @@ pub use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 /// How many faults of each kind one sensor has had (saturating counters).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct FaultCounts {
+pub struct SensorFaultCounts {
     /// [`FaultKind::Disconnected`].
     pub disconnected: u32,
     /// [`FaultKind::Bus`].
@@ -24,7 +24,7 @@ pub struct FaultCounts {
     pub out_of_range: u32,
 }
 
-impl FaultCounts {
+impl SensorFaultCounts {
     fn slot(&mut self, kind: FaultKind) -> &mut u32 {
         match kind {
             FaultKind::Disconnected => &mut self.disconnected,
@@ -96,7 +96,7 @@ pub struct FaultDetector {
     limits: RawLimits,
     last: Option<i32>,
     repeats: u16,
-    counts: FaultCounts,
+    counts: SensorFaultCounts,
 }
 
 impl FaultDetector {
@@ -107,7 +107,7 @@ impl FaultDetector {
             limits,
             last: None,
             repeats: 0,
-            counts: FaultCounts {
+            counts: SensorFaultCounts {
                 disconnected: 0,
                 bus: 0,
                 saturated: 0,
@@ -129,7 +129,7 @@ impl FaultDetector {
     }
 
     /// The faults counted so far.
-    pub const fn counts(&self) -> FaultCounts {
+    pub const fn counts(&self) -> SensorFaultCounts {
         self.counts
     }
 
@@ -206,7 +206,7 @@ mod tests {
 
     #[test]
     fn counts_every_kind_in_its_own_field() {
-        let mut counts = FaultCounts::default();
+        let mut counts = SensorFaultCounts::default();
         for (i, &kind) in FaultKind::ALL.iter().enumerate() {
             for _ in 0..=i {
                 counts.record(kind);
@@ -216,9 +216,9 @@ mod tests {
             assert_eq!(counts.get(kind), i as u32 + 1, "{kind:?}");
         }
         assert_eq!(counts.total(), 21);
-        let mut full = FaultCounts {
+        let mut full = SensorFaultCounts {
             stuck: u32::MAX,
-            ..FaultCounts::default()
+            ..SensorFaultCounts::default()
         };
         full.record(FaultKind::Stuck);
         assert_eq!(full.stuck, u32::MAX);

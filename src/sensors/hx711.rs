@@ -7,6 +7,8 @@
 //! more pulses select the channel and gain of the *next* conversion; PD_SCK held high
 //! for more than 60 µs powers the chip down, and it wakes up on channel A, gain 128.
 
+use core::fmt;
+
 use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::{InputPin, OutputPin};
 
@@ -46,6 +48,17 @@ pub enum PinError<EIn, EOut> {
     /// Driving PD_SCK failed.
     Sck(EOut),
 }
+
+impl<EIn: fmt::Debug, EOut: fmt::Debug> fmt::Display for PinError<EIn, EOut> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PinError::Dout(e) => write!(f, "HX711 DOUT read failed: {e:?}"),
+            PinError::Sck(e) => write!(f, "HX711 PD_SCK drive failed: {e:?}"),
+        }
+    }
+}
+
+impl<EIn: fmt::Debug, EOut: fmt::Debug> core::error::Error for PinError<EIn, EOut> {}
 
 /// The HX711 on two GPIO pins: DOUT (input) and PD_SCK (output), with a delay.
 ///

@@ -16,7 +16,7 @@
 //! (identical raw codes where noise is expected), a jump (a raw step larger than a
 //! physical signal can make between two readings, e.g. the full scale) and out of the
 //! calibrated physical range. Each sensor counts its faults per kind
-//! ([`FaultCounts`]). Nothing here panics or waits without bound, whatever the pins and
+//! ([`SensorFaultCounts`]). Nothing here panics or waits without bound, whatever the pins and
 //! the bus return. [`SensorSample`] gathers one sample for a condition monitor: load,
 //! angle, optional speed and the first fault, if any (a faulty sample is a sensor fault,
 //! never a measurement).
@@ -62,7 +62,7 @@ mod probes;
 pub mod sim;
 mod speed;
 
-pub use fault::{FaultCounts, FaultDetector, FaultKind, RawLimits, SensorFault, SensorId};
+pub use fault::{FaultDetector, FaultKind, RawLimits, SensorFault, SensorFaultCounts, SensorId};
 pub use hx711::{Hx711, Hx711Channel, PinError};
 pub use load::{LoadCalibration, LoadCell, STANDARD_GRAVITY, weight_newtons};
 pub use probes::{
@@ -101,6 +101,18 @@ pub enum AdcError<E> {
     /// The bus or a pin reported an error.
     Bus(E),
 }
+
+impl<E: fmt::Debug> fmt::Display for AdcError<E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AdcError::Timeout => f.write_str("no conversion ready within the timeout"),
+            AdcError::Bus(e) => write!(f, "bus or pin error: {e:?}"),
+        }
+    }
+}
+
+/// The bus's error `E` need only be `Debug` (as embedded-hal's error traits ask).
+impl<E: fmt::Debug> core::error::Error for AdcError<E> {}
 
 /// The lowest and the highest raw code of an ADC: a code at either is saturated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -19,6 +19,7 @@
 //! for a stuck sensor.
 
 use core::cell::{Cell, RefCell};
+use core::fmt;
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::{self, ErrorType, InputPin, OutputPin};
@@ -73,6 +74,14 @@ impl DelayNs for SimDelay<'_> {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SimError;
+
+impl fmt::Display for SimError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("injected pin or bus error")
+    }
+}
+
+impl core::error::Error for SimError {}
 
 impl digital::Error for SimError {
     fn kind(&self) -> digital::ErrorKind {

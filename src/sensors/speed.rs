@@ -2,7 +2,7 @@
 
 use core::f32::consts::PI;
 
-use super::{CalibrationError, FaultCounts, FaultKind, SensorFault, SensorId, require};
+use super::{CalibrationError, FaultKind, SensorFault, SensorFaultCounts, SensorId, require};
 
 /// `V = 2 pi r pulses / (pulses_per_rev * dt)`: the surface speed, m/s, of a roller of
 /// radius `radius_m` m that gave `pulses` pulses of a `pulses_per_rev` encoder in
@@ -53,7 +53,7 @@ impl SpeedCalibration {
 pub struct Tachometer {
     calibration: SpeedCalibration,
     last: Option<(u32, u32)>,
-    counts: FaultCounts,
+    counts: SensorFaultCounts,
 }
 
 impl Tachometer {
@@ -63,7 +63,7 @@ impl Tachometer {
         Ok(Tachometer {
             calibration,
             last: None,
-            counts: FaultCounts::default(),
+            counts: SensorFaultCounts::default(),
         })
     }
 
@@ -107,7 +107,7 @@ impl Tachometer {
     }
 
     /// The faults counted so far.
-    pub fn counts(&self) -> FaultCounts {
+    pub fn counts(&self) -> SensorFaultCounts {
         self.counts
     }
 }

@@ -11,10 +11,10 @@
 //!   end from ordinary blocking firmware code:
 //!
 //! ```ignore
-//! use misalign::storage::{block_on, wear, BlockingFlash, Store};
+//! use misalign::storage::{block_on, endurance, BlockingFlash, Store};
 //! let region = 0x3_0000..0x3_8000; // eight 4 KiB sectors
 //! let flash = BlockingFlash(hal_flash);
-//! let mut store = Store::<_, 1024>::new(flash, region, wear::DEFAULT_INTERVAL_S)?;
+//! let mut store = Store::<_, 1024>::new(flash, region, endurance::DEFAULT_INTERVAL_S)?;
 //! let restored = block_on(store.restore::<MonitorState>())?;
 //! // ... in the sampling loop:
 //! block_on(store.checkpoint_if_due(now_s, &state))?;

@@ -16,6 +16,7 @@
 use core::fmt;
 
 use super::Checkpoint;
+use crate::bytes::FieldError;
 
 /// The magic bytes at the start of every record: a record of another program fails here.
 pub const MAGIC: [u8; 4] = *b"MSLG";
@@ -89,195 +90,29 @@ impl fmt::Display for CodecError {
     }
 }
 
-#[cfg(feature = "std")]
-impl std::error::Error for CodecError {}
+impl core::error::Error for CodecError {}
+
+impl From<FieldError> for CodecError {
+    fn from(e: FieldError) -> Self {
+        match e {
+            FieldError::Truncated => CodecError::Truncated,
+            FieldError::InvalidValue => CodecError::InvalidValue,
+            FieldError::TrailingBytes => CodecError::TrailingBytes,
+        }
+    }
+}
 
 /// CRC-32 of the records: the prepared scenes' own (IEEE 802.3, reflected, as
 /// zlib's `crc32`), one routine in the image for both.
-pub use crate::prepared::crc32;
+pub use crate::bytes::crc32;
 
-/// Writes little-endian fields into a payload, never past its end.
-#[derive(Debug)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Writer<'a> {
-    out: &'a mut [u8],
-    at: usize,
-}
+/// Writes little-endian fields into a payload, never past its end: the crate's one
+/// byte writer ([`crate::bytes::Writer`]), failing with a [`CodecError`].
+pub type Writer<'a> = crate::bytes::Writer<'a, CodecError>;
 
-impl<'a> Writer<'a> {
-    /// A writer filling `out` from its start.
-    pub fn new(out: &'a mut [u8]) -> Self {
-        Writer { out, at: 0 }
-    }
-
-    /// Bytes written so far.
-    #[must_use]
-    pub fn written(&self) -> usize {
-        self.at
-    }
-
-    /// Writes raw bytes.
-    pub fn bytes(&mut self, bytes: &[u8]) -> Result<(), CodecError> {
-        let end = self
-            .at
-            .checked_add(bytes.len())
-            .ok_or(CodecError::Truncated)?;
-        let dst = self
-            .out
-            .get_mut(self.at..end)
-            .ok_or(CodecError::Truncated)?;
-        dst.copy_from_slice(bytes);
-        self.at = end;
-        Ok(())
-    }
-
-    /// Writes a `u8`.
-    pub fn u8(&mut self, v: u8) -> Result<(), CodecError> {
-        self.bytes(&[v])
-    }
-
-    /// Writes a `u16`, little-endian.
-    pub fn u16(&mut self, v: u16) -> Result<(), CodecError> {
-        self.bytes(&v.to_le_bytes())
-    }
-
-    /// Writes a `u32`, little-endian.
-    pub fn u32(&mut self, v: u32) -> Result<(), CodecError> {
-        self.bytes(&v.to_le_bytes())
-    }
-
-    /// Writes a `u64`, little-endian.
-    pub fn u64(&mut self, v: u64) -> Result<(), CodecError> {
-        self.bytes(&v.to_le_bytes())
-    }
-
-    /// Writes an `i32`, little-endian.
-    pub fn i32(&mut self, v: i32) -> Result<(), CodecError> {
-        self.bytes(&v.to_le_bytes())
-    }
-
-    /// Writes an `f32` (its IEEE bits), little-endian: restored bit for bit.
-    pub fn f32(&mut self, v: f32) -> Result<(), CodecError> {
-        self.u32(v.to_bits())
-    }
-
-    /// Writes an `f64` (its IEEE bits), little-endian: restored bit for bit.
-    pub fn f64(&mut self, v: f64) -> Result<(), CodecError> {
-        self.u64(v.to_bits())
-    }
-
-    /// Writes a `bool` as one byte, 0 or 1.
-    pub fn bool(&mut self, v: bool) -> Result<(), CodecError> {
-        self.u8(u8::from(v))
-    }
-
-    /// Writes every item of `items` with `field` (e.g. `w.each(&energies, |w, e| w.f64(*e))`).
-    pub fn each<T>(
-        &mut self,
-        items: &[T],
-        mut field: impl FnMut(&mut Self, &T) -> Result<(), CodecError>,
-    ) -> Result<(), CodecError> {
-        items.iter().try_for_each(|item| field(self, item))
-    }
-}
-
-/// Reads little-endian fields from a payload, never past its end.
-#[derive(Debug)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Reader<'a> {
-    bytes: &'a [u8],
-    at: usize,
-}
-
-impl<'a> Reader<'a> {
-    /// A reader of `bytes` from their start.
-    #[must_use]
-    pub fn new(bytes: &'a [u8]) -> Self {
-        Reader { bytes, at: 0 }
-    }
-
-    /// Bytes not read yet.
-    #[must_use]
-    pub fn remaining(&self) -> usize {
-        self.bytes.len().saturating_sub(self.at)
-    }
-
-    /// Reads `N` raw bytes.
-    pub fn array<const N: usize>(&mut self) -> Result<[u8; N], CodecError> {
-        let end = self.at.checked_add(N).ok_or(CodecError::Truncated)?;
-        let src = self.bytes.get(self.at..end).ok_or(CodecError::Truncated)?;
-        let mut out = [0u8; N];
-        out.copy_from_slice(src);
-        self.at = end;
-        Ok(out)
-    }
-
-    /// Reads a `u8`.
-    pub fn u8(&mut self) -> Result<u8, CodecError> {
-        self.array::<1>().map(|[b]| b)
-    }
-
-    /// Reads a little-endian `u16`.
-    pub fn u16(&mut self) -> Result<u16, CodecError> {
-        self.array().map(u16::from_le_bytes)
-    }
-
-    /// Reads a little-endian `u32`.
-    pub fn u32(&mut self) -> Result<u32, CodecError> {
-        self.array().map(u32::from_le_bytes)
-    }
-
-    /// Reads a little-endian `u64`.
-    pub fn u64(&mut self) -> Result<u64, CodecError> {
-        self.array().map(u64::from_le_bytes)
-    }
-
-    /// Reads a little-endian `i32`.
-    pub fn i32(&mut self) -> Result<i32, CodecError> {
-        self.array().map(i32::from_le_bytes)
-    }
-
-    /// Reads an `f32` from its little-endian IEEE bits (any bits, NaN included:
-    /// the type's `decode` refuses what it must).
-    pub fn f32(&mut self) -> Result<f32, CodecError> {
-        self.u32().map(f32::from_bits)
-    }
-
-    /// Reads an `f64` from its little-endian IEEE bits (any bits, NaN included).
-    pub fn f64(&mut self) -> Result<f64, CodecError> {
-        self.u64().map(f64::from_bits)
-    }
-
-    /// Reads a `bool`: 0 or 1, anything else is [`CodecError::InvalidValue`].
-    pub fn bool(&mut self) -> Result<bool, CodecError> {
-        match self.u8()? {
-            0 => Ok(false),
-            1 => Ok(true),
-            _ => Err(CodecError::InvalidValue),
-        }
-    }
-
-    /// Reads `N` items with `field`, into an array (e.g. `r.array_of(|r| r.f64())`).
-    pub fn array_of<T: Copy + Default, const N: usize>(
-        &mut self,
-        mut field: impl FnMut(&mut Self) -> Result<T, CodecError>,
-    ) -> Result<[T; N], CodecError> {
-        let mut out = [T::default(); N];
-        for item in &mut out {
-            *item = field(self)?;
-        }
-        Ok(out)
-    }
-
-    /// Succeeds if every byte was read: a payload of another size is refused.
-    pub fn finish(&self) -> Result<(), CodecError> {
-        if self.remaining() == 0 {
-            Ok(())
-        } else {
-            Err(CodecError::TrailingBytes)
-        }
-    }
-}
+/// Reads little-endian fields from a payload, never past its end: the crate's one
+/// byte reader ([`crate::bytes::Reader`]), failing with a [`CodecError`].
+pub type Reader<'a> = crate::bytes::Reader<'a, CodecError>;
 
 /// A record decoded: the value, its checkpoint number and the format version it was
 /// stored in (older than [`Checkpoint::VERSION`] when it was migrated).
@@ -323,8 +158,7 @@ pub fn encode<T: Checkpoint>(
     if w.written() != T::SIZE {
         return Err(CodecError::TrailingBytes);
     }
-    let crc = crc32(body);
-    crc_bytes.copy_from_slice(&crc.to_le_bytes());
+    Writer::new(crc_bytes).u32(crc32(body))?;
     Ok(len)
 }
 

@@ -17,6 +17,8 @@
 //! point an operation consumes visits every way the power can fail during it, as
 //! littlefs's test runner does.
 
+use core::fmt;
+
 use embedded_storage::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash, check_erase, check_read,
     check_write,
@@ -41,6 +43,22 @@ pub enum MockError {
     /// The power failed earlier; [`MockFlash::restart`] first.
     PoweredOff,
 }
+
+impl fmt::Display for MockError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MockError::OutOfBounds => f.write_str("outside the flash"),
+            MockError::NotAligned => f.write_str("not on the word or sector grid"),
+            MockError::ZeroToOne { offset } => {
+                write!(f, "write to a word not erased (0 bit to 1 at {offset:#x})")
+            }
+            MockError::PowerLoss => f.write_str("power lost during the operation"),
+            MockError::PoweredOff => f.write_str("powered off: restart first"),
+        }
+    }
+}
+
+impl core::error::Error for MockError {}
 
 impl NorFlashError for MockError {
     fn kind(&self) -> NorFlashErrorKind {

@@ -41,10 +41,10 @@
 //! # Flash wear
 //!
 //! Each sector is erased once every `k * s` checkpoints (`k` checkpoints per sector,
-//! `s` sectors; the arithmetic is in [`wear`]). For the [`wear::REFERENCE`] geometry
+//! `s` sectors; the arithmetic is in [`endurance`]). For the [`endurance::REFERENCE`] geometry
 //! (a 792-byte payload, the monitor's whole state, `MonitorState`, version 1; eight
 //! 4 KiB sectors; 4-byte words: 4 checkpoints per sector) at the default interval of
-//! one hour ([`wear::DEFAULT_INTERVAL_S`]):
+//! one hour ([`endurance::DEFAULT_INTERVAL_S`]):
 //!
 //! | interval | checkpoints a year | erase cycles per sector a year | years to 10 000 cycles |
 //! | --- | --- | --- | --- |
@@ -55,10 +55,10 @@
 //! To choose the interval: pick the longest loss of accumulation (energy, time per
 //! state, counters) you accept on a power failure, and checkpoint on demand at the rare
 //! moments that must not be lost (a risk-state change, before a planned reset or a
-//! firmware update); compute [`wear::Geometry::cycles_per_year`] for your record
+//! firmware update); compute [`endurance::Geometry::cycles_per_year`] for your record
 //! ([`Checkpoint::SIZE`]) and region; if the part's rated cycles (10 000 for typical
 //! MCU internal flash) last fewer years than the product's life, lengthen the interval
-//! or give the region more sectors ([`wear::Geometry::min_interval_s`] gives the
+//! or give the region more sectors ([`endurance::Geometry::min_interval_s`] gives the
 //! shortest interval for a life: 987 s for ten years at the reference geometry).
 //! Doubling the sectors halves the wear; so does halving the record.
 
@@ -66,10 +66,10 @@ pub mod blocking;
 #[cfg(feature = "sensors")]
 mod calibration;
 pub mod codec;
+pub mod endurance;
 #[cfg(feature = "_mock-flash")]
 mod mock_flash;
 mod store;
-pub mod wear;
 
 pub use blocking::{BlockingFlash, block_on};
 #[cfg(feature = "sensors")]
@@ -78,7 +78,7 @@ pub use codec::{CodecError, Reader, Writer};
 #[cfg(feature = "_mock-flash")]
 pub use mock_flash::{MockError, MockFlash};
 pub use store::{
-    ConfigError, Restore, RestoreOutcome, StorageError, StorageEvent, StorageStats, Store,
+    Restore, RestoreOutcome, StorageError, StorageEvent, StorageStats, Store, StoreConfigError,
 };
 
 /// The record kinds ([`Checkpoint::KIND`]) of this crate's state types, fixed here so

@@ -21,7 +21,7 @@ type NoCache = Cache<Uncached, Uncached, Uncached, u8>;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
-pub enum ConfigError {
+pub enum StoreConfigError {
     /// The region does not start or end on a sector (erase-size) boundary.
     Unaligned,
     /// The region has fewer than two sectors: the map needs one to fill while it
@@ -36,17 +36,19 @@ pub enum ConfigError {
     ZeroInterval,
 }
 
-impl fmt::Display for ConfigError {
+impl fmt::Display for StoreConfigError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
-            ConfigError::Unaligned => "region not on sector boundaries",
-            ConfigError::TooSmall => "region needs at least two sectors",
-            ConfigError::Geometry => "flash sectors too small or word too large",
-            ConfigError::OutOfBounds => "region past the end of the flash",
-            ConfigError::ZeroInterval => "checkpoint interval must be positive",
+            StoreConfigError::Unaligned => "region not on sector boundaries",
+            StoreConfigError::TooSmall => "region needs at least two sectors",
+            StoreConfigError::Geometry => "flash sectors too small or word too large",
+            StoreConfigError::OutOfBounds => "region past the end of the flash",
+            StoreConfigError::ZeroInterval => "checkpoint interval must be positive",
         })
     }
 }
+
+impl core::error::Error for StoreConfigError {}
 
 /// Why a storage operation failed. `E` is the flash driver's error.
 #[derive(Debug, Clone, PartialEq)]
@@ -69,7 +71,7 @@ pub enum StorageError<E> {
     /// A record could not be encoded (the type's `encode` broke its `SIZE`).
     Codec(CodecError),
     /// The store's configuration is unusable.
-    Config(ConfigError),
+    Config(StoreConfigError),
     /// `sequential-storage` reported an internal error it says should never happen.
     Internal,
 }
@@ -90,8 +92,18 @@ impl<E: fmt::Debug> fmt::Display for StorageError<E> {
     }
 }
 
-#[cfg(feature = "std")]
-impl<E: fmt::Debug> std::error::Error for StorageError<E> {}
+/// The flash driver's error `E` need only be `Debug` (as `NorFlashError` asks), so it
+/// is not a [`source`](core::error::Error::source); a record's or the configuration's
+/// error is.
+impl<E: fmt::Debug> core::error::Error for StorageError<E> {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            StorageError::Codec(e) => Some(e),
+            StorageError::Config(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
 impl<E> StorageError<E> {
     fn from_ss(e: SsError<E>) -> Self {
@@ -295,19 +307,19 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
     /// A store on `range` of `flash` (whole sectors, at least two), checkpointing every
     /// `interval_s` seconds through [`Store::checkpoint_if_due`]. Reads nothing yet:
     /// call [`Store::restore`] at start-up.
-    pub fn new(flash: F, range: Range<u32>, interval_s: u32) -> Result<Self, ConfigError> {
+    pub fn new(flash: F, range: Range<u32>, interval_s: u32) -> Result<Self, StoreConfigError> {
         if interval_s == 0 {
-            return Err(ConfigError::ZeroInterval);
+            return Err(StoreConfigError::ZeroInterval);
         }
         let capacity = u32::try_from(flash.capacity()).unwrap_or(u32::MAX);
         if range.end > capacity || range.start > range.end {
-            return Err(ConfigError::OutOfBounds);
+            return Err(StoreConfigError::OutOfBounds);
         }
         let config = MapConfig::<F>::try_new(range.clone()).map_err(|e| match e {
             MapConfigError::StartRangeNotAtPageBoundary
-            | MapConfigError::EndRangeNotAtPageBoundary => ConfigError::Unaligned,
-            MapConfigError::RangeTooSmall => ConfigError::TooSmall,
-            _ => ConfigError::Geometry,
+            | MapConfigError::EndRangeNotAtPageBoundary => StoreConfigError::Unaligned,
+            MapConfigError::RangeTooSmall => StoreConfigError::TooSmall,
+            _ => StoreConfigError::Geometry,
         })?;
         Ok(Store {
             map: MapStorage::new(flash, config, Cache::new_uncached()),
@@ -346,9 +358,9 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
 
     /// Changes the checkpoint interval (e.g. from a new configuration); the interval
     /// under way is measured against the new value.
-    pub fn set_interval_s(&mut self, interval_s: u32) -> Result<(), ConfigError> {
+    pub fn set_interval_s(&mut self, interval_s: u32) -> Result<(), StoreConfigError> {
         if interval_s == 0 {
-            return Err(ConfigError::ZeroInterval);
+            return Err(StoreConfigError::ZeroInterval);
         }
         self.interval_s = interval_s;
         Ok(())

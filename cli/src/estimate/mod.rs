@@ -13,7 +13,7 @@ use clap::{Parser, ValueEnum};
 use misalign::fixed::{FixedAuto, FixedContactDetails, FixedEllipticScene, Log2, exact_lsb};
 use misalign::float::{Auto, ContactDetails};
 use misalign::reference::{
-    self, ANGLE_LIMIT, ContactModel, Estimate, ModelChoice, PRESSURE_LIMIT, SLENDER_LIMIT, Validity,
+    self, ANGLE_LIMIT, ContactModel, ModelChoice, PRESSURE_LIMIT, SLENDER_LIMIT, Solution, Validity,
 };
 use misalign::{Error, Scene};
 use serde::Serialize;
@@ -325,7 +325,7 @@ fn reference_row(x: &Sample) -> Result<Answer, String> {
     let est = reference::estimate_with(scene, load, phi, choice).map_err(|e| e.to_string())?;
     let f = Some(Num::F64(est.axial_force(scene)));
     match est {
-        Estimate::Elliptic(e) => {
+        Solution::Elliptic(e) => {
             let opt = |x: Option<f64>| x.map(Num::F64);
             let row = OutRow {
                 theta: opt(Some(e.shape.theta)),
@@ -352,7 +352,7 @@ fn reference_row(x: &Sample) -> Result<Answer, String> {
                 no_critical_angle: e.critical_angle.is_none(),
             })
         }
-        Estimate::Line(l) => {
+        Solution::Line(l) => {
             let row = OutRow {
                 b: Some(Num::F64(l.b)),
                 p0: Some(Num::F64(l.p0)),
