@@ -48,6 +48,7 @@ macro_rules! internal {
     };
 }
 
+pub mod batch;
 mod error;
 pub mod estimator;
 pub mod fixed;
