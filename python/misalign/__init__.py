@@ -272,23 +272,15 @@ SCENE = tuple(_misalign.scenario_samples()["scene"])
 scenario.scene = SCENE  # type: ignore[attr-defined]
 
 
-def _round_half_away(x: np.ndarray) -> np.ndarray:
-    """Rounds half away from zero, as Rust's f64::round."""
-    a = np.abs(x)
-    r = np.floor(a)
-    r += (a - r) >= 0.5
-    return np.copysign(r, x)
-
-
-def _trace_column(name: str, x, n: int, dtype) -> np.ndarray:
+def _trace_column(name: str, x, n: int) -> np.ndarray:
     if x is None:
-        return np.full(n, np.nan, dtype=dtype)
+        return np.full(n, np.nan)
     a = _as_float(name, x)
     if a.ndim == 0:
         a = np.full(n, float(a))
     if a.ndim != 1 or a.shape[0] != n:
         raise ValueError(f"{name} has shape {a.shape}; the trace has {n} samples")
-    return np.ascontiguousarray(a.astype(dtype))
+    return np.ascontiguousarray(a)
 
 
 @dataclass
@@ -346,21 +338,21 @@ def replay(t, P, phi, *, V=None, F=None, scene=None, length=None, model: str = "
     bad = ~np.isfinite(tt)
     if bad.any():
         raise ValueError(f"t is not a finite number at sample {int(np.argmax(bad))}")
-    time_ms = np.mod(_round_half_away(tt * 1e3), 2.0**32).astype(np.uint32)
-    P32 = _trace_column("P", P, n, np.float32)
-    phi32 = _trace_column("phi", phi, n, np.float32)
-    V32 = _trace_column("V", V, n, np.float32)
-    F32 = _trace_column("F", F, n, np.float32)
+    tt = np.ascontiguousarray(tt)
+    P64 = _trace_column("P", P, n)
+    phi64 = _trace_column("phi", phi, n)
+    V64 = _trace_column("V", V, n)
+    F64 = _trace_column("F", F, n)
     scene = SCENE if scene is None else tuple(float(x) for x in scene)
     if len(scene) != 5:
         raise ValueError("scene must be (R1, R2, G, nu, mu)")
     r = _misalign.Replay(scene, None if length is None else float(length), model,
-                         _load_range(P32), config)
+                         _load_range(P64.astype(np.float32)), config)
     chunk = max(1, int(chunk))
     for start in range(0, n, chunk):
         end = min(n, start + chunk)
-        r.feed(time_ms[start:end], P32[start:end], phi32[start:end], V32[start:end],
-               F32[start:end])
+        r.feed(tt[start:end], P64[start:end], phi64[start:end], V64[start:end],
+               F64[start:end])
         if progress:
             done = end * 100 // max(n, 1)
             bar = "#" * (done // 4) + " " * (25 - done // 4)

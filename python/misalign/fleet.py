@@ -46,7 +46,11 @@ def roller_summary(pdf, *, scene=None, length=None, model: str = "f32",
     import pandas as pd
 
     rows = []
-    for roller, g in pdf.groupby("roller", sort=False):
+    names = pdf["roller"].to_numpy()
+    # One roller per partition (one Parquet file per roller): no grouping needed.
+    one = len(names) > 0 and bool((names == names[0]).all())
+    groups = [(names[0], pdf)] if one else pdf.groupby("roller", sort=False)
+    for roller, g in groups:
         get = lambda c: g[c].to_numpy() if c in g else None  # noqa: E731
         r = replay(get("t"), get("P"), get("phi"), V=get("V"), F=get("F"), scene=scene,
                    length=length, model=model, config=config)

@@ -649,18 +649,20 @@ impl Replay {
         })
     }
 
-    /// Feeds samples: time (ms, wrapping u32), P (N), phi (rad), V (m/s), F (N); NaN in
-    /// V or F is "not measured" for that sample.
+    /// Feeds samples: time (s, finite), P (N), phi (rad), V (m/s), F (N); NaN in V or
+    /// F is "not measured" for that sample. Each becomes what the monitor example's
+    /// trace reader makes of it: t the node's wrapping u32 ms counter (rounded half
+    /// away from zero), the others f32.
     fn feed(
         &mut self,
         py: Python<'_>,
-        time_ms: PyReadonlyArray1<'_, u32>,
-        load: PyReadonlyArray1<'_, f32>,
-        phi: PyReadonlyArray1<'_, f32>,
-        speed: PyReadonlyArray1<'_, f32>,
-        force: PyReadonlyArray1<'_, f32>,
+        time_s: PyReadonlyArray1<'_, f64>,
+        load: PyReadonlyArray1<'_, f64>,
+        phi: PyReadonlyArray1<'_, f64>,
+        speed: PyReadonlyArray1<'_, f64>,
+        force: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<()> {
-        let t = time_ms.as_slice().map_err(value_error)?;
+        let t = time_s.as_slice().map_err(value_error)?;
         let p = load.as_slice().map_err(value_error)?;
         let a = phi.as_slice().map_err(value_error)?;
         let v = speed.as_slice().map_err(value_error)?;
@@ -669,12 +671,18 @@ impl Replay {
         if [p.len(), a.len(), v.len(), f.len()].iter().any(|&m| m != n) {
             return Err(value_error("trace columns of different lengths"));
         }
+        if let Some(i) = t.iter().position(|x| !x.is_finite()) {
+            return Err(value_error(format!(
+                "t is not a finite number at sample {i}"
+            )));
+        }
         let Replay { core, events } = self;
         py.detach(|| {
             let samples = (0..n).map(|i| {
-                let mut s = Sample::new(t[i], p[i], a[i]);
-                s.speed = (!v[i].is_nan()).then_some(v[i]);
-                s.axial_force = (!f[i].is_nan()).then_some(f[i]);
+                let time_ms = ((t[i] * 1e3).round() as i64).rem_euclid(1 << 32) as u32;
+                let mut s = Sample::new(time_ms, p[i] as f32, a[i] as f32);
+                s.speed = (!v[i].is_nan()).then_some(v[i] as f32);
+                s.axial_force = (!f[i].is_nan()).then_some(f[i] as f32);
                 s
             });
             match core {
