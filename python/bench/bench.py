@@ -122,6 +122,8 @@ def main():
             (m, results[m]) for m in ["f32", "fixed"]]:
         err_rows[label] = {k: rel(got[k], ref[k]) for k in ["s", "F", "phi0"]}
     err_digits, digit_rows = accuracy_50_digit()
+    k = min(args.rows, 200_000)
+    cost = misalign._misalign.reference_cost(P[:k], phi[:k])
     samples, fleet_s, startup, summary = fleet_speed(args.fleet_rollers, args.fleet_hours,
                                                      max(1, args.repeat - 1))
     fleet_rate = samples / fleet_s
@@ -129,7 +131,7 @@ def main():
     failed = [f"{m}: {k} {e:.2e} > {BOUNDS[m]:.0e}" for m, errs in err_digits.items()
               for k, e in errs.items() if e > BOUNDS[m]]
     lines = page(args, load, speed, err_digits, digit_rows, err_rows, samples, fleet_s,
-                 startup, fleet_rate, len(summary))
+                 startup, fleet_rate, len(summary), cost, k)
     print("\n".join(lines))
     if failed:
         print("accuracy bound exceeded: " + "; ".join(failed), file=sys.stderr)
@@ -141,7 +143,7 @@ def main():
 
 
 def page(args, load, speed, err_digits, digit_rows, err_rows, samples, fleet_s, startup,
-         fleet_rate, rollers):
+         fleet_rate, rollers, cost, cost_rows):
     e3 = lambda e: "{:.1e} / {:.1e} / {:.1e}".format(e["s"], e["F"], e["phi0"])  # noqa: E731
     cmd = "python python/bench/bench.py" + (
         "" if args.rows == 1_000_000 else f" --rows {args.rows}")
@@ -176,6 +178,14 @@ def page(args, load, speed, err_digits, digit_rows, err_rows, samples, fleet_s, 
         vs_ref = e3(err_rows[label]) if label in err_rows else ("0 (itself)" if label == "reference" else "")
         out.append(f"| {label} | {speed[label]:,.0f} | {ratio:.1f} | {met} | {digits} | {vs_ref} |")
     out += [
+        "",
+        f"**Where the reference's time goes** (one thread, the first {cost_rows:,} of these "
+        "rows, ns per row, `misalign._misalign.reference_cost`): the ellipse's shape "
+        f"(k', m, n from theta, eqs 4-6) {cost['ellipse_shape']:.0f}, the critical angle "
+        f"(phi0 at the load, eqs 18, 30) {cost['critical_angle']:.0f}, the whole elliptic "
+        f"solution {cost['elliptic']:.0f}, the batch with its columns {cost['batch']:.0f}; "
+        f"the peer's whole row takes {1e9 / speed['peer']:.0f} ns on one core, the f32 "
+        f"core's {2e9 / speed['f32']:.0f} ns (two cores' wall clock times two).",
         "",
         f"**Fleet**: {rollers} rollers, {samples:,} samples (`misalign.fleet.synthetic"
         f"({args.fleet_rollers}, {args.fleet_hours:g})`, one Parquet file per roller), "

@@ -860,6 +860,81 @@ fn thresholds(
     }
 }
 
+/// Where the reference's time goes per row, on one thread, for the demo scene over
+/// the given loads (N) and angles (rad): ns per row of the ellipse's shape (k', m, n
+/// from theta, eqs 4-6), the critical angle (phi0 at the load, eqs 18, 30), the whole
+/// elliptic solution, and the batch (the same plus writing the columns).
+#[pyfunction]
+fn reference_cost<'py>(
+    py: Python<'py>,
+    load: PyReadonlyArray1<'py, f64>,
+    phi: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use misalign::reference;
+    use std::hint::black_box;
+    use std::time::Instant;
+    let (p, a) = (
+        load.as_slice().map_err(value_error)?,
+        phi.as_slice().map_err(value_error)?,
+    );
+    if p.len() != a.len() || p.is_empty() {
+        return Err(value_error("load and phi: one non-empty length"));
+    }
+    let scene = Scene::DEMO;
+    let n = p.len() as f64;
+    let per_row = |f: &dyn Fn()| {
+        let t = Instant::now();
+        f();
+        t.elapsed().as_secs_f64() * 1e9 / n
+    };
+    let figures = py.detach(|| {
+        let shape = per_row(&|| {
+            for &x in a {
+                black_box(reference::normal::ellipse_shape(scene.auxiliary_angle(x)));
+            }
+        });
+        let critical = per_row(&|| {
+            for &x in p {
+                black_box(reference::critical_angle(&scene, x));
+            }
+        });
+        let elliptic = per_row(&|| {
+            for (&x, &y) in p.iter().zip(a) {
+                let _ = black_box(reference::elliptic(&scene, x, y));
+            }
+        });
+        let m = p.len();
+        let (mut s, mut f, mut c) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+        let (mut r, mut mo, mut fl, mut st) =
+            (vec![0u8; m], vec![0u8; m], vec![0u8; m], vec![0u8; m]);
+        let t = Instant::now();
+        let _ = batch::estimate(
+            &Inputs::one_scene(&scene, Column::Each(p), Column::Each(a)),
+            &mut Outputs {
+                slip_ratio: &mut s,
+                axial_force: &mut f,
+                critical_angle: &mut c,
+                regime: &mut r,
+                model: &mut mo,
+                flags: &mut fl,
+                status: &mut st,
+                details: None,
+            },
+            Model::Reference,
+        );
+        let batch = t.elapsed().as_secs_f64() * 1e9 / n;
+        [shape, critical, elliptic, batch]
+    });
+    let d = PyDict::new(py);
+    for (name, x) in ["ellipse_shape", "critical_angle", "elliptic", "batch"]
+        .into_iter()
+        .zip(figures)
+    {
+        d.set_item(name, x)?;
+    }
+    Ok(d)
+}
+
 /// The compiled half of `misalign`.
 #[pymodule]
 fn _misalign(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -868,6 +943,7 @@ fn _misalign(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(scenario_samples, m)?)?;
     m.add_function(wrap_pyfunction!(thresholds, m)?)?;
+    m.add_function(wrap_pyfunction!(reference_cost, m)?)?;
     m.add_class::<Replay>()?;
     Ok(())
 }
