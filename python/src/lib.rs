@@ -923,12 +923,43 @@ fn reference_cost<'py>(
             Model::Reference,
         );
         let batch = t.elapsed().as_secs_f64() * 1e9 / n;
-        [shape, critical, elliptic, batch]
+        let core = Auto::new(&scene);
+        let f32_core = per_row(&|| {
+            if let Ok(core) = &core {
+                for (&x, &y) in p.iter().zip(a) {
+                    let _ = black_box(core.estimate(x as f32, y as f32));
+                }
+            }
+        });
+        let t = Instant::now();
+        let _ = batch::estimate(
+            &Inputs::one_scene(&scene, Column::Each(p), Column::Each(a)),
+            &mut Outputs {
+                slip_ratio: &mut s,
+                axial_force: &mut f,
+                critical_angle: &mut c,
+                regime: &mut r,
+                model: &mut mo,
+                flags: &mut fl,
+                status: &mut st,
+                details: None,
+            },
+            Model::F32,
+        );
+        let f32_batch = t.elapsed().as_secs_f64() * 1e9 / n;
+        [shape, critical, elliptic, batch, f32_core, f32_batch]
     });
     let d = PyDict::new(py);
-    for (name, x) in ["ellipse_shape", "critical_angle", "elliptic", "batch"]
-        .into_iter()
-        .zip(figures)
+    for (name, x) in [
+        "ellipse_shape",
+        "critical_angle",
+        "elliptic",
+        "batch",
+        "f32_core",
+        "f32_batch",
+    ]
+    .into_iter()
+    .zip(figures)
     {
         d.set_item(name, x)?;
     }

@@ -35,7 +35,7 @@ fn model_code(m: ContactModel) -> u8 {
 }
 
 /// Writes row `i`; returns 1 for a refused row, 0 otherwise.
-#[inline]
+#[inline(always)]
 fn put(out: &mut Outputs<'_>, i: usize, row: Result<Row, Error>, details: &[f64; 12]) -> usize {
     let (bad, values) = match row {
         Ok(r) => (
@@ -56,24 +56,18 @@ fn put(out: &mut Outputs<'_>, i: usize, row: Result<Row, Error>, details: &[f64;
         ),
     };
     // The lengths were checked by `rows`: `get_mut` never misses.
-    let set = |slice: &mut [f64], x: f64| {
-        if let Some(v) = slice.get_mut(i) {
-            *v = x;
-        }
-    };
-    set(out.slip_ratio, values.0);
-    set(out.axial_force, values.1);
-    set(out.critical_angle, values.2);
-    for (slice, x) in [
-        (&mut *out.regime, values.3),
-        (&mut *out.model, values.4),
-        (&mut *out.flags, values.5),
-        (&mut *out.status, values.6),
-    ] {
+    fn set<T>(slice: &mut [T], i: usize, x: T) {
         if let Some(v) = slice.get_mut(i) {
             *v = x;
         }
     }
+    set(out.slip_ratio, i, values.0);
+    set(out.axial_force, i, values.1);
+    set(out.critical_angle, i, values.2);
+    set(out.regime, i, values.3);
+    set(out.model, i, values.4);
+    set(out.flags, i, values.5);
+    set(out.status, i, values.6);
     if let Some(d) = &mut out.details {
         let values = if bad == 0 { details } else { &NO_DETAILS };
         for (slice, x) in d.slices().into_iter().zip(values) {
@@ -241,7 +235,7 @@ fn narrow(x: f64, error: Error) -> Result<f32, Error> {
     Ok(y)
 }
 
-#[inline]
+#[inline(always)]
 fn float_row(core: &Auto, load: f64, phi: f64) -> Result<Row, Error> {
     let e = core.estimate(narrow(load, Error::Load)?, narrow(phi, Error::Angle)?)?;
     let est = e.estimate;
