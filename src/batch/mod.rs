@@ -7,7 +7,7 @@
 //! for the batch when every scene column is [`Column::One`]): a prepared core scene
 //! costs far more than one estimate, and a historian's export holds long runs of one
 //! installation. Section 9's model choice is made per row, as
-//! [`reference::estimate_with`] makes it.
+//! [`reference::estimate_with`](crate::reference::estimate_with) makes it.
 //!
 //! A bad row (a refused scene or sample) gets its [`Error`] as a status code
 //! ([`status_of`], [`error_of`]), NaN in its numbers and [`NONE`] in its codes; the
