@@ -86,3 +86,20 @@ def test_fixed_core_near_the_reference():
     assert fix["s"].shape == (40, 30)
     for c in ["s", "F", "phi0"]:
         assert rel(fix[c], ref[c]).max() <= 1e-4, c
+
+
+def test_threads_give_the_numbers_of_one_thread():
+    # More rows than one chunk (8192), so that the rows are split over threads.
+    rng = np.random.default_rng(5)
+    n = 50_000
+    P = np.exp(rng.uniform(np.log(100.0), np.log(5e4), n))
+    phi = np.exp(rng.uniform(np.log(1e-6), np.log(3e-3), n)) * rng.choice([-1.0, 1.0], n)
+    P[::997] = np.nan  # bad rows among them
+    for model in ["reference", "f32", "fixed"]:
+        a = misalign.estimate(0.05, 0.05, 79.3e9, 0.3, 0.3, P, phi, length=0.3, model=model,
+                              details=True)
+        b = misalign.estimate(0.05, 0.05, 79.3e9, 0.3, 0.3, P, phi, length=0.3, model=model,
+                              details=True, threads=False)
+        for k in a:
+            np.testing.assert_array_equal(a[k], b[k], err_msg=f"{model} {k}")
+        assert (a["model"] == "line").any() and (a["error"] != "").sum() == len(P[::997])
