@@ -907,22 +907,26 @@ fn reference_cost<'py>(
         let (mut s, mut f, mut c) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
         let (mut r, mut mo, mut fl, mut st) =
             (vec![0u8; m], vec![0u8; m], vec![0u8; m], vec![0u8; m]);
-        let t = Instant::now();
-        let _ = batch::estimate(
-            &Inputs::one_scene(&scene, Column::Each(p), Column::Each(a)),
-            &mut Outputs {
-                slip_ratio: &mut s,
-                axial_force: &mut f,
-                critical_angle: &mut c,
-                regime: &mut r,
-                model: &mut mo,
-                flags: &mut fl,
-                status: &mut st,
-                details: None,
-            },
-            Model::Reference,
-        );
-        let batch = t.elapsed().as_secs_f64() * 1e9 / n;
+        let mut timed_batch = |model: Model| {
+            let t = Instant::now();
+            let _ = batch::estimate(
+                &Inputs::one_scene(&scene, Column::Each(p), Column::Each(a)),
+                &mut Outputs {
+                    slip_ratio: &mut s,
+                    axial_force: &mut f,
+                    critical_angle: &mut c,
+                    regime: &mut r,
+                    model: &mut mo,
+                    flags: &mut fl,
+                    status: &mut st,
+                    details: None,
+                },
+                model,
+            );
+            t.elapsed().as_secs_f64() * 1e9 / n
+        };
+        let batch = timed_batch(Model::Reference);
+        let f32_batch = timed_batch(Model::F32);
         let core = Auto::new(&scene);
         let f32_core = per_row(&|| {
             if let Ok(core) = &core {
@@ -931,22 +935,6 @@ fn reference_cost<'py>(
                 }
             }
         });
-        let t = Instant::now();
-        let _ = batch::estimate(
-            &Inputs::one_scene(&scene, Column::Each(p), Column::Each(a)),
-            &mut Outputs {
-                slip_ratio: &mut s,
-                axial_force: &mut f,
-                critical_angle: &mut c,
-                regime: &mut r,
-                model: &mut mo,
-                flags: &mut fl,
-                status: &mut st,
-                details: None,
-            },
-            Model::F32,
-        );
-        let f32_batch = t.elapsed().as_secs_f64() * 1e9 / n;
         [shape, critical, elliptic, batch, f32_core, f32_batch]
     });
     let d = PyDict::new(py);
