@@ -12,7 +12,7 @@ use misalign::monitor::{
 use misalign::reference::ModelChoice;
 use misalign::reference::inverse::{self, Inverse};
 use misalign::{Error, Estimator, Scene};
-use numpy::{IntoPyArray, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -107,20 +107,33 @@ fn estimate<'py>(
         phi: cols[7],
         choice,
     };
-    let mut s = vec![0.0; n];
-    let mut f = vec![0.0; n];
-    let mut phi0 = vec![0.0; n];
-    let mut regime = vec![0u8; n];
-    let mut model_code = vec![0u8; n];
-    let mut flags = vec![0u8; n];
-    let mut status = vec![0u8; n];
-    let mut extra: Vec<Vec<f64>> = if details {
-        vec![vec![0.0; n]; 12]
-    } else {
-        Vec::new()
-    };
+    // numpy's own arrays (its allocator asks the kernel for huge pages on large ones:
+    // fewer page faults while the rows are written than a fresh Vec's).
+    let floats: Vec<Bound<'py, PyArray1<f64>>> = (0..if details { 15 } else { 3 })
+        .map(|_| PyArray1::<f64>::zeros(py, n, false))
+        .collect();
+    let codes: Vec<Bound<'py, PyArray1<u8>>> = (0..4)
+        .map(|_| PyArray1::<u8>::zeros(py, n, false))
+        .collect();
+    let mut float_guards: Vec<_> = floats.iter().map(|a| a.readwrite()).collect();
+    let mut code_guards: Vec<_> = codes.iter().map(|a| a.readwrite()).collect();
+    let mut float_slices = float_guards
+        .iter_mut()
+        .map(|g| g.as_slice_mut().map_err(value_error))
+        .collect::<PyResult<Vec<&mut [f64]>>>()?;
+    let mut code_slices = code_guards
+        .iter_mut()
+        .map(|g| g.as_slice_mut().map_err(value_error))
+        .collect::<PyResult<Vec<&mut [u8]>>>()?;
     py.detach(|| {
-        let details = match extra.as_mut_slice() {
+        let [regime, model_code, flags, status] = code_slices.as_mut_slice() else {
+            return Ok(0); // not reached: four code columns were made above
+        };
+        let (main, extra) = float_slices.split_at_mut(3);
+        let [s, f, phi0] = main else {
+            return Ok(0); // not reached: three number columns were made above
+        };
+        let details = match extra {
             [
                 theta,
                 kprime,
@@ -151,13 +164,13 @@ fn estimate<'py>(
             _ => None,
         };
         let mut out = Outputs {
-            slip_ratio: &mut s,
-            axial_force: &mut f,
-            critical_angle: &mut phi0,
-            regime: &mut regime,
-            model: &mut model_code,
-            flags: &mut flags,
-            status: &mut status,
+            slip_ratio: s,
+            axial_force: f,
+            critical_angle: phi0,
+            regime,
+            model: model_code,
+            flags,
+            status,
             details,
         };
         if threads {
@@ -167,19 +180,23 @@ fn estimate<'py>(
         }
     })
     .map_err(value_error)?;
+    drop(float_slices);
+    drop(code_slices);
+    drop(float_guards);
+    drop(code_guards);
     let dict = PyDict::new(py);
-    dict.set_item("s", s.into_pyarray(py))?;
-    dict.set_item("F", f.into_pyarray(py))?;
-    dict.set_item("phi0", phi0.into_pyarray(py))?;
-    dict.set_item("regime_code", regime.into_pyarray(py))?;
-    dict.set_item("model_code", model_code.into_pyarray(py))?;
-    dict.set_item("flags", flags.into_pyarray(py))?;
-    dict.set_item("status", status.into_pyarray(py))?;
-    let detail_names = [
-        "theta", "kprime", "m", "n", "a", "b", "p0", "d", "Pstar", "P0star", "theta0", "R",
+    let names = [
+        "s", "F", "phi0", "theta", "kprime", "m", "n", "a", "b", "p0", "d", "Pstar", "P0star",
+        "theta0", "R",
     ];
-    for (name, col) in detail_names.into_iter().zip(extra) {
-        dict.set_item(name, col.into_pyarray(py))?;
+    for (name, col) in names.into_iter().zip(floats) {
+        dict.set_item(name, col)?;
+    }
+    for (name, col) in ["regime_code", "model_code", "flags", "status"]
+        .into_iter()
+        .zip(codes)
+    {
+        dict.set_item(name, col)?;
     }
     Ok(dict)
 }
