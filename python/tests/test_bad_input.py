@@ -128,3 +128,27 @@ def test_trace_time_backwards_and_repeated():
     # Bad samples are the monitor's counted faults, not an exception.
     r = misalign.replay(np.arange(5.0), [1e3, np.nan, -np.inf, 1e3, 1e3], [2e-4] * 5)
     assert r.summary["faults"]["non_finite"] >= 1
+
+
+def test_extreme_values_never_give_a_silent_nan():
+    special = np.array([0.0, -0.0, 1e-320, 5e-324, 1e-300, 1e300, 1.7e308, np.inf, -np.inf,
+                        np.nan, -1.0, 0.5, np.pi / 2, 2.0, 0.05, 79.3e9, 0.3, 1e3, 2e-4, 1e20,
+                        3.4e38, 1e-45])
+    rng = np.random.default_rng(0)
+    cols = [rng.choice(special, 20_000) for _ in range(8)]
+    for model in ["reference", "f32", "fixed"]:
+        for contact in ["auto", "elliptic", "line"]:
+            r = misalign.estimate(*cols[:7], length=cols[7], model=model, contact=contact)
+            ok = r["error"] == ""
+            assert ok.any() and (~ok).any()
+            assert not np.isnan(r["s"][ok]).any() and not np.isnan(r["F"][ok]).any()
+            # phi0 is NaN exactly where the flag says there is no critical angle.
+            none = np.array(["no_critical_angle" in f for f in r["flags"][ok]], dtype=bool)
+            assert (np.isnan(r["phi0"][ok]) == none).all(), (model, contact)
+    for model in ["reference", "f32"]:
+        for contact in ["auto", "elliptic", "line"]:
+            a = misalign.solve_mu(*cols[:4], cols[5], cols[6], cols[7], model=model,
+                                  contact=contact)
+            b = misalign.solve_phi(*cols[:5], cols[5], cols[7], model=model, contact=contact)
+            for r, k in [(a, "mu"), (b, "phi")]:
+                assert not (np.isnan(r[k]) & (r["error"] == "")).any(), (model, contact, k)
