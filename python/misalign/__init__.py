@@ -346,8 +346,10 @@ def replay(t, P, phi, *, V=None, F=None, scene=None, length=None, model: str = "
     scene = SCENE if scene is None else tuple(float(x) for x in scene)
     if len(scene) != 5:
         raise ValueError("scene must be (R1, R2, G, nu, mu)")
+    with np.errstate(over="ignore"):  # beyond f32: inf, as the node's f32 reads it
+        P32 = P64.astype(np.float32)
     r = _misalign.Replay(scene, None if length is None else float(length), model,
-                         _load_range(P64.astype(np.float32)), config)
+                         _load_range(P32), config)
     chunk = max(1, int(chunk))
     for start in range(0, n, chunk):
         end = min(n, start + chunk)
@@ -384,7 +386,8 @@ def thresholds(P=None, *, scene=None, length=None, model: str = "f32",
     _option("model", model, ("f32", "fixed"))
     scene = SCENE if scene is None else tuple(float(x) for x in scene)
     if P is not None:
-        P32 = _as_float("P", P).reshape(-1).astype(np.float32)
+        with np.errstate(over="ignore"):  # beyond f32: inf, as the node's f32 reads it
+            P32 = _as_float("P", P).reshape(-1).astype(np.float32)
         loads = np.sort(P32[np.isfinite(P32)])
         top = loads[len(loads) * 999 // 1000] if len(loads) else np.float32(0.0)
         top = float(np.float32(top) * np.float32(1.2))
