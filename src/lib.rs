@@ -22,6 +22,7 @@ macro_rules! internal {
     };
 }
 
+pub mod batch;
 pub mod bytes;
 mod error;
 pub mod estimator;

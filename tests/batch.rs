@@ -1,0 +1,371 @@
+//! `misalign::batch` against the independent 50-digit values of tests/data (the
+//! reference over slices, a scene per row), against the cores called row by row (one
+//! scene for all, a scene per row), and on bad rows and bad lengths.
+
+mod common;
+use common::{Worst, num, read_rows};
+use misalign::batch::{self, Column, Details, Inputs, Mismatch, Model, Outputs};
+use misalign::fixed::FixedAuto;
+use misalign::float::Auto;
+use misalign::reference::ModelChoice;
+use misalign::{Error, Scene};
+
+/// d/b, F and phi0 of the reference against the 50-digit values.
+const MAIN_BOUND: f64 = 4e-15;
+/// Every other column: the bound of tests/reference_vectors.rs.
+const BOUND: f64 = 1e-12;
+
+/// Owned output columns of `n` rows.
+struct Owned {
+    s: Vec<f64>,
+    f: Vec<f64>,
+    phi0: Vec<f64>,
+    regime: Vec<u8>,
+    model: Vec<u8>,
+    flags: Vec<u8>,
+    status: Vec<u8>,
+    details: Vec<Vec<f64>>,
+}
+
+impl Owned {
+    fn new(n: usize) -> Self {
+        Owned {
+            s: vec![0.0; n],
+            f: vec![0.0; n],
+            phi0: vec![0.0; n],
+            regime: vec![0; n],
+            model: vec![0; n],
+            flags: vec![0; n],
+            status: vec![0; n],
+            details: vec![vec![0.0; n]; 12],
+        }
+    }
+
+    fn outputs(&mut self, with_details: bool) -> Outputs<'_> {
+        let details = if with_details {
+            let [
+                theta,
+                kprime,
+                m,
+                n,
+                a,
+                b,
+                p0,
+                d,
+                pstar,
+                p0star,
+                theta0,
+                radius,
+            ] = <&mut [Vec<f64>; 12]>::try_from(self.details.as_mut_slice()).unwrap();
+            Some(Details {
+                theta,
+                kprime,
+                m,
+                n,
+                a,
+                b,
+                p0,
+                d,
+                pstar,
+                p0star,
+                theta0,
+                radius,
+            })
+        } else {
+            None
+        };
+        Outputs {
+            slip_ratio: &mut self.s,
+            axial_force: &mut self.f,
+            critical_angle: &mut self.phi0,
+            regime: &mut self.regime,
+            model: &mut self.model,
+            flags: &mut self.flags,
+            status: &mut self.status,
+            details,
+        }
+    }
+
+    fn detail(&self, name: &str) -> &[f64] {
+        let names = [
+            "theta", "kprime", "m", "n", "a", "b", "p0", "d", "Pstar", "P0star", "theta0", "R",
+        ];
+        &self.details[names.iter().position(|n| *n == name).unwrap()]
+    }
+}
+
+fn column(rows: &[common::Row], name: &str) -> Vec<f64> {
+    rows.iter().map(|r| num(r, name)).collect()
+}
+
+fn regime(code: u8) -> &'static str {
+    ["partial", "gross"][code as usize]
+}
+
+/// A scene per row, from the columns of a reference file.
+fn inputs<'a>(cols: &'a [Vec<f64>; 7], choice: ModelChoice) -> Inputs<'a> {
+    Inputs {
+        r1: Column::Each(&cols[0]),
+        r2: Column::Each(&cols[1]),
+        shear_modulus: Column::Each(&cols[2]),
+        poisson_ratio: Column::Each(&cols[3]),
+        friction: Column::Each(&cols[4]),
+        length: None,
+        load: Column::Each(&cols[5]),
+        phi: Column::Each(&cols[6]),
+        choice,
+    }
+}
+
+fn read_inputs(rows: &[common::Row]) -> [Vec<f64>; 7] {
+    ["R1", "R2", "G", "nu", "mu", "P", "phi"].map(|c| column(rows, c))
+}
+
+#[test]
+fn reference_batch_against_vectors_scene() {
+    let rows = read_rows("vectors_scene.csv");
+    let cols = read_inputs(&rows);
+    let mut out = Owned::new(rows.len());
+    let bad = batch::estimate(
+        &inputs(&cols, ModelChoice::Section9),
+        &mut out.outputs(true),
+        Model::Reference,
+    )
+    .unwrap();
+    assert_eq!(bad, 0);
+    let (mut main, mut rest) = (Worst::default(), Worst::default());
+    for (i, row) in rows.iter().enumerate() {
+        main.add("s", i, out.s[i], num(row, "s"));
+        main.add("F", i, out.f[i], num(row, "F"));
+        main.add("phi0", i, out.phi0[i], num(row, "phi0"));
+        for name in [
+            "theta", "kprime", "m", "n", "a", "b", "p0", "d", "Pstar", "P0star", "theta0",
+        ] {
+            rest.add(name, i, out.detail(name)[i], num(row, name));
+        }
+        assert!(out.detail("R")[i].is_nan(), "row {i}: R is line contact's");
+        assert_eq!(regime(out.regime[i]), row["regime"], "row {i}");
+        assert_eq!(out.model[i], 0, "row {i}: elliptic");
+        assert_eq!(out.status[i], batch::OK, "row {i}");
+    }
+    main.assert_below(MAIN_BOUND);
+    rest.assert_below(BOUND);
+}
+
+#[test]
+fn reference_batch_against_vectors_line() {
+    let rows = read_rows("vectors_line.csv");
+    let cols = read_inputs(&rows);
+    let mut out = Owned::new(rows.len());
+    let bad = batch::estimate(
+        &inputs(&cols, ModelChoice::Line),
+        &mut out.outputs(true),
+        Model::Reference,
+    )
+    .unwrap();
+    assert_eq!(bad, 0);
+    let (mut main, mut rest) = (Worst::default(), Worst::default());
+    for (i, row) in rows.iter().enumerate() {
+        main.add("s", i, out.s[i], num(row, "s"));
+        main.add("F", i, out.f[i], num(row, "F"));
+        main.add("phi0", i, out.phi0[i], num(row, "phi0"));
+        for name in ["R", "b", "p0", "d", "Pstar", "P0star"] {
+            rest.add(name, i, out.detail(name)[i], num(row, name));
+        }
+        assert_eq!(regime(out.regime[i]), row["regime"], "row {i}");
+        assert_eq!(out.model[i], 1, "row {i}: line");
+    }
+    main.assert_below(MAIN_BOUND);
+    rest.assert_below(BOUND);
+}
+
+/// Loads and angles over the demo scene's range, with a length so that section 9
+/// switches to line contact at the low angles.
+fn sweep() -> (Vec<f64>, Vec<f64>) {
+    let mut load = Vec::new();
+    let mut phi = Vec::new();
+    for i in 0..40 {
+        for j in 0..40 {
+            load.push(10.0 * 1.25f64.powi(i));
+            phi.push(if j % 2 == 0 { 1.0 } else { -1.0 } * 1e-6 * 1.3f64.powi(j));
+        }
+    }
+    (load, phi)
+}
+
+#[test]
+fn cores_in_a_batch_answer_as_row_by_row() {
+    let scene = Scene::DEMO.with_length(0.2).unwrap();
+    let (load, phi) = sweep();
+    let n = load.len();
+    let one = Inputs::one_scene(&scene, Column::Each(&load), Column::Each(&phi));
+    // The same scene given per row: prepared once per run of equal constants.
+    let per_row_cols = [
+        vec![scene.r1(); n],
+        vec![scene.r2(); n],
+        vec![scene.shear_modulus(); n],
+        vec![scene.poisson_ratio(); n],
+        vec![scene.friction(); n],
+        load.clone(),
+        phi.clone(),
+    ];
+    let lengths = vec![0.2; n];
+    let per_row = Inputs {
+        length: Some(Column::Each(&lengths)),
+        ..inputs(&per_row_cols, ModelChoice::Section9)
+    };
+    let f32_core = Auto::new(&scene).unwrap();
+    let fixed_core = FixedAuto::new(&scene, 1e-2, 1e-10).unwrap();
+    let fixed = Model::Fixed {
+        load_lsb: 1e-2,
+        angle_lsb: Some(1e-10),
+    };
+    let mut lines = 0;
+    for inputs in [&one, &per_row] {
+        let mut a = Owned::new(n);
+        assert_eq!(
+            batch::estimate(inputs, &mut a.outputs(true), Model::F32),
+            Ok(0)
+        );
+        let mut b = Owned::new(n);
+        assert_eq!(batch::estimate(inputs, &mut b.outputs(false), fixed), Ok(0));
+        for i in 0..n {
+            let e = f32_core.estimate(load[i] as f32, phi[i] as f32).unwrap();
+            assert_eq!(a.s[i], f64::from(e.estimate.slip_ratio), "row {i}");
+            assert_eq!(a.f[i], f64::from(e.estimate.axial_force), "row {i}");
+            let phi0 = e.estimate.critical_angle.map_or(f64::NAN, f64::from);
+            assert_eq!(a.phi0[i].to_bits(), phi0.to_bits(), "row {i}");
+            assert_eq!(a.model[i], e.model as u8, "row {i}");
+            lines += usize::from(a.model[i] == 1);
+            let counts = (
+                (load[i] / 1e-2).round() as u32,
+                (phi[i] / 1e-10).round() as i32,
+            );
+            let x = fixed_core.estimate(counts.0, counts.1).unwrap().estimate;
+            assert_eq!(b.s[i], x.slip_ratio.to_f64(), "row {i}");
+            let force = x.axial_force.to_f64();
+            let force = if x.axial_force_negative {
+                -force
+            } else {
+                force
+            };
+            assert_eq!(b.f[i], force, "row {i}");
+            assert_eq!(
+                b.phi0[i].to_bits(),
+                x.critical_angle.map_or(f64::NAN, |c| c.to_f64()).to_bits()
+            );
+        }
+        // Every detail stays NaN for the cores: they do not compute them.
+        assert!(a.details.iter().flatten().all(|x| x.is_nan()));
+    }
+    assert!(lines > 0, "the sweep reaches line contact");
+}
+
+#[test]
+fn bad_rows_get_their_error_and_the_others_their_values() {
+    let load = [1e3, f64::NAN, -1.0, 1e3, f64::INFINITY, 1e3, 1e3];
+    let phi = [2e-4, 2e-4, 2e-4, f64::NAN, 2e-4, 2.0, 2e-4];
+    let mu = [0.3, 0.3, 0.3, 0.3, 0.3, 0.3, -0.3];
+    let inputs = Inputs {
+        friction: Column::Each(&mu),
+        ..Inputs::one_scene(&Scene::DEMO, Column::Each(&load), Column::Each(&phi))
+    };
+    let want = [
+        None,
+        Some(Error::Load),
+        Some(Error::Load),
+        Some(Error::Angle),
+        Some(Error::Load),
+        Some(Error::Angle),
+        Some(Error::Friction),
+    ];
+    let fixed = Model::Fixed {
+        load_lsb: 1e-2,
+        angle_lsb: None,
+    };
+    for model in [Model::Reference, Model::F32, fixed] {
+        let mut out = Owned::new(load.len());
+        let bad = batch::estimate(&inputs, &mut out.outputs(true), model).unwrap();
+        assert_eq!(bad, 6, "{model:?}");
+        for (i, w) in want.iter().enumerate() {
+            assert_eq!(batch::error_of(out.status[i]), *w, "{model:?} row {i}");
+            if w.is_some() {
+                assert!(out.s[i].is_nan() && out.f[i].is_nan() && out.phi0[i].is_nan());
+                assert_eq!((out.regime[i], out.model[i]), (batch::NONE, batch::NONE));
+            } else {
+                assert!(out.s[i] > 0.0 && out.f[i] > 0.0 && out.phi0[i] > 0.0);
+            }
+        }
+    }
+}
+
+#[test]
+fn every_error_has_its_own_status() {
+    let errors = [
+        Error::Radius,
+        Error::ShearModulus,
+        Error::PoissonRatio,
+        Error::Friction,
+        Error::Length,
+        Error::Load,
+        Error::Angle,
+        Error::PlaneHasNoEllipse,
+        Error::Unsupported,
+        Error::Force,
+        Error::OutOfRange,
+    ];
+    for e in errors {
+        let code = batch::status_of(e);
+        assert_ne!(code, batch::OK);
+        assert_eq!(batch::error_of(code), Some(e));
+    }
+    assert_eq!(batch::error_of(batch::OK), None);
+}
+
+#[test]
+fn columns_of_another_length_are_refused_before_any_row() {
+    let load = [1e3; 3];
+    let phi = [2e-4; 4];
+    let inputs = Inputs::one_scene(&Scene::DEMO, Column::Each(&load), Column::Each(&phi));
+    let mut out = Owned::new(3);
+    assert_eq!(
+        batch::estimate(&inputs, &mut out.outputs(false), Model::Reference),
+        Err(Mismatch)
+    );
+    assert!(out.s.iter().all(|x| *x == 0.0), "nothing written");
+    let mut short = Owned::new(4);
+    short.f.pop();
+    let inputs = Inputs::one_scene(&Scene::DEMO, Column::One(1e3), Column::Each(&phi));
+    assert_eq!(
+        batch::estimate(&inputs, &mut short.outputs(false), Model::F32),
+        Err(Mismatch)
+    );
+    // Scalars only: the outputs' length.
+    let inputs = Inputs::one_scene(&Scene::DEMO, Column::One(1e3), Column::One(2e-4));
+    let mut out = Owned::new(2);
+    assert_eq!(
+        batch::estimate(&inputs, &mut out.outputs(false), Model::Reference),
+        Ok(0)
+    );
+    assert_eq!(out.s[0], out.s[1]);
+}
+
+#[cfg(feature = "rayon")]
+#[test]
+fn threads_give_the_same_numbers() {
+    let (load, phi) = sweep();
+    let load: Vec<f64> = load.iter().cycle().take(50_000).copied().collect();
+    let phi: Vec<f64> = phi.iter().cycle().take(50_000).copied().collect();
+    let scene = Scene::DEMO.with_length(0.2).unwrap();
+    let inputs = Inputs::one_scene(&scene, Column::Each(&load), Column::Each(&phi));
+    for model in [Model::Reference, Model::F32] {
+        let (mut a, mut b) = (Owned::new(load.len()), Owned::new(load.len()));
+        batch::estimate(&inputs, &mut a.outputs(true), model).unwrap();
+        batch::par_estimate(&inputs, &mut b.outputs(true), model).unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a.s), bits(&b.s));
+        assert_eq!(bits(&a.f), bits(&b.f));
+        assert_eq!(bits(&a.phi0), bits(&b.phi0));
+        assert_eq!(bits(&a.details[5]), bits(&b.details[5]));
+    }
+}
