@@ -1,0 +1,202 @@
+//! `cargo xtask measurements [--check]`: every table of docs/measurements.md, and the
+//! README's headline, drawn from the committed CSVs under `docs/` (each measuring
+//! command writes its CSV and then calls [`update`]). `--check` fails if a committed
+//! table differs from what the CSVs draw, as `cargo xtask figures --check` does for the
+//! SVGs; a unit test does the same under `cargo test`.
+//!
+//! Each table sits between `<!-- NAME:begin -->` and `<!-- NAME:end -->`; the prose
+//! around it is the page's own and carries no measured number.
+
+use crate::bench::{self, find};
+use crate::records::{self, BenchRow, NodeRow, ShapeRow, SizeRow, SweepRow};
+use crate::{firmware, shapes, sweep};
+use misalign_workload::{Model, Operation};
+use std::fmt::Write as _;
+use std::process::ExitCode;
+
+/// The measurements page, from the repository's root.
+pub const PAGE: &str = "docs/measurements.md";
+const README: &str = "README.md";
+
+/// One generated table: the file it is in, its markers' name, its text.
+struct Block {
+    file: &'static str,
+    name: &'static str,
+    text: String,
+}
+
+/// Every table, drawn from the committed CSVs.
+fn blocks() -> Result<Vec<Block>, String> {
+    let bench = records::read::<BenchRow>()?;
+    let shapes = records::read::<ShapeRow>()?;
+    let sweep = records::read::<SweepRow>()?;
+    let sizes = records::read::<SizeRow>()?;
+    let nodes = records::read::<NodeRow>()?;
+    let block = |file, name, text| Block { file, name, text };
+    Ok(vec![
+        block(README, "headline", headline(&bench)),
+        block(PAGE, "bench", bench::estimates(&bench)),
+        block(PAGE, "cost", bench::cost(&bench)),
+        block(PAGE, "stages", bench::stages(&bench)),
+        block(PAGE, "shapes", shapes::table(&shapes)),
+        block(PAGE, "sweep", sweep::markdown(&sweep, false)),
+        block(PAGE, "firmware", firmware::table(&sizes).0),
+        block(PAGE, "node", node(&nodes)),
+    ])
+}
+
+/// The README's headline: per core, the estimate's worst error and instructions on the
+/// Cortex-M0 and M4F, and the monitor's instructions per sample, from docs/bench.csv.
+fn headline(rows: &[BenchRow]) -> String {
+    let mut s = String::from(
+        "| core | max relative error of d/b, F, phi0 | instructions per estimate: Cortex-M0 / M4F | monitor per sample: Cortex-M0 / M4F |\n\
+         |---|--:|--:|--:|\n",
+    );
+    let mean =
+        |cpu, model, op| find(rows, cpu, model, op).map_or("-".into(), |r| r.mean.to_string());
+    for (model, name) in [
+        (Model::F32, "f32"),
+        (Model::Fixed, "fixed point"),
+        (Model::Reference, "f64 reference"),
+    ] {
+        let error = find(rows, "cortex-m0", model, Operation::Estimate)
+            .and_then(|r| r.error)
+            .map_or("-".into(), |e| format!("{e:.1e}"));
+        let both = |op| {
+            let (m0, m4f) = (mean("cortex-m0", model, op), mean("cortex-m4f", model, op));
+            if m0 == "-" && m4f == "-" {
+                "-".to_string()
+            } else {
+                format!("{m0} / {m4f}")
+            }
+        };
+        writeln!(
+            s,
+            "| {name} | {error} | {} | {} |",
+            both(Operation::Estimate),
+            both(Operation::Monitor)
+        )
+        .unwrap();
+    }
+    s.push_str(
+        "\nMeans in QEMU (`-icount`: instructions, not cycles); errors against \
+         independent reference data. How each is measured, and every other table: \
+         [docs/measurements.md](docs/measurements.md).\n",
+    );
+    s
+}
+
+/// The node table and the scenario's length it was measured over.
+fn node(rows: &[NodeRow]) -> String {
+    let (table, _) = firmware::node_table(rows);
+    let samples: Vec<u64> = rows.iter().map(|r| r.samples).collect();
+    match samples.first() {
+        Some(n) if samples.iter().all(|x| x == n) => {
+            format!("{table}\nEach run: the scenario's {n} samples.\n")
+        }
+        _ => table,
+    }
+}
+
+/// `text` with the block between the markers `<!-- NAME:begin -->` and
+/// `<!-- NAME:end -->` replaced by `block`.
+fn replace(text: &str, name: &str, block: &str) -> Result<String, String> {
+    let (begin, end) = (
+        format!("<!-- {name}:begin -->"),
+        format!("<!-- {name}:end -->"),
+    );
+    let (Some(a), Some(b)) = (text.find(&begin), text.find(&end)) else {
+        return Err(format!("no {name} markers"));
+    };
+    if b < a {
+        return Err(format!("the {name} markers are out of order"));
+    }
+    Ok(format!("{}{begin}\n{block}{}", &text[..a], &text[b..]))
+}
+
+/// Each file with its tables as the CSVs draw them: `(path, committed, drawn)`.
+fn drawn() -> Result<Vec<(&'static str, String, String)>, String> {
+    let blocks = blocks()?;
+    let mut out = Vec::new();
+    for file in [PAGE, README] {
+        let path = crate::root().join(file);
+        let committed = std::fs::read_to_string(&path).map_err(|e| format!("{file}: {e}"))?;
+        let mut text = committed.clone();
+        for b in blocks.iter().filter(|b| b.file == file) {
+            text = replace(&text, b.name, &b.text).map_err(|e| format!("{file}: {e}"))?;
+        }
+        out.push((file, committed, text));
+    }
+    Ok(out)
+}
+
+/// The files whose tables differ from what the committed CSVs draw.
+pub fn stale() -> Result<Vec<&'static str>, String> {
+    Ok(drawn()?
+        .into_iter()
+        .filter(|(_, committed, text)| committed != text)
+        .map(|(file, _, _)| file)
+        .collect())
+}
+
+/// Writes every table from the committed CSVs.
+pub fn update() -> Result<(), String> {
+    for (file, committed, text) in drawn()? {
+        if committed != text {
+            std::fs::write(crate::root().join(file), text).map_err(|e| format!("{file}: {e}"))?;
+            eprintln!("wrote the tables of {file}");
+        }
+    }
+    Ok(())
+}
+
+/// `cargo xtask measurements [--check]`.
+pub fn run(check: bool) -> ExitCode {
+    let result = if check {
+        stale().map(|files| {
+            for f in &files {
+                eprintln!("{f}: a table differs from its CSV: run `cargo xtask measurements`");
+            }
+            if files.is_empty() {
+                println!("every table of {PAGE} and {README} is what its CSV draws");
+            }
+            files.is_empty()
+        })
+    } else {
+        update().map(|()| true)
+    };
+    match result {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
+        Err(e) => {
+            eprintln!("xtask measurements: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The committed tables are what the committed CSVs draw.
+    #[test]
+    fn committed_tables_match_their_csvs() {
+        assert_eq!(
+            stale().unwrap(),
+            Vec::<&str>::new(),
+            "run `cargo xtask measurements`"
+        );
+    }
+
+    #[test]
+    fn a_block_is_replaced_between_its_markers() {
+        let text = "a\n<!-- t:begin -->\nold\n<!-- t:end -->\nb\n";
+        assert_eq!(
+            replace(text, "t", "new\n").unwrap(),
+            "a\n<!-- t:begin -->\nnew\n<!-- t:end -->\nb\n"
+        );
+        assert!(replace(text, "u", "x").is_err());
+        assert!(replace("<!-- t:end --><!-- t:begin -->", "t", "x").is_err());
+    }
+}
