@@ -29,7 +29,8 @@ use std::collections::HashMap;
 use std::fmt::Write;
 use std::process::ExitCode;
 
-fn rel(got: f64, want: f64) -> f64 {
+/// Relative error of `got` against `want`; equal values (zeros, infinities) give 0.
+pub fn rel(got: f64, want: f64) -> f64 {
     if got == want {
         0.0
     } else {
@@ -37,7 +38,8 @@ fn rel(got: f64, want: f64) -> f64 {
     }
 }
 
-fn read(name: &str) -> Result<Vec<Record>, String> {
+/// The rows of a reference file of tests/data/ (or `$MISALIGN_REFERENCE_DIR`).
+pub fn read(name: &str) -> Result<Vec<Record>, String> {
     let dir = std::env::var_os("MISALIGN_REFERENCE_DIR").map_or_else(
         || crate::root().join("tests/data"),
         std::path::PathBuf::from,
@@ -57,11 +59,11 @@ fn read(name: &str) -> Result<Vec<Record>, String> {
         .collect()
 }
 
-fn num(row: &Record, key: &str) -> f64 {
+pub fn num(row: &Record, key: &str) -> f64 {
     row[key].parse().unwrap_or(f64::NAN)
 }
 
-fn scene(row: &Record) -> Scene {
+pub fn scene(row: &Record) -> Scene {
     Scene::new(
         num(row, "R1"),
         num(row, "R2"),
@@ -80,7 +82,7 @@ fn worst3(got: (f64, f64, f64), row: &Record) -> f64 {
 }
 
 /// Angle counts with the sign of phi.
-fn signed(counts: u32, phi: f64) -> i32 {
+pub fn signed(counts: u32, phi: f64) -> i32 {
     if phi < 0.0 {
         -(counts as i32)
     } else {
@@ -89,7 +91,7 @@ fn signed(counts: u32, phi: f64) -> i32 {
 }
 
 /// d/b, F and phi0 of a fixed-point estimate, as f64.
-fn fixed3(x: &misalign::fixed::FixedEstimate) -> (f64, f64, f64) {
+pub fn fixed3(x: &misalign::fixed::FixedEstimate) -> (f64, f64, f64) {
     let force = x.axial_force.to_f64() * if x.axial_force_negative { -1.0 } else { 1.0 };
     (
         x.slip_ratio.to_f64(),
@@ -255,7 +257,8 @@ fn monitor_errors(e: &mut Errors) -> Result<(), String> {
     Ok(())
 }
 
-type Record = HashMap<String, String>;
+/// One row of a reference file: column name to text.
+pub type Record = HashMap<String, String>;
 
 /// The whole elliptic estimate of every model against one reference row.
 fn elliptic_errors(e: &mut Errors, row: &Record) -> Result<(), String> {
@@ -329,7 +332,7 @@ fn line_errors(e: &mut Errors, row: &Record) -> Result<(), String> {
 }
 
 /// d/b, F and phi0 of an f32 estimate, as f64.
-fn f32s(f: &misalign::Estimate) -> (f64, f64, f64) {
+pub fn f32s(f: &misalign::Estimate) -> (f64, f64, f64) {
     (
         f.slip_ratio as f64,
         f.axial_force as f64,

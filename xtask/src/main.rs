@@ -1,6 +1,7 @@
 //! Chores for people and CI alike: `cargo xtask <task>` (`cargo xtask help` lists
 //! them). A task is a variant of [`Task`] and its arm in [`main`].
 
+mod accuracy;
 mod bench;
 mod cross;
 mod figures;
@@ -100,6 +101,9 @@ enum Task {
         #[arg(long, alias = "readme")]
         write: bool,
     },
+    /// The worst relative error of every quantity of every model against the
+    /// reference data, on the host; writes docs/accuracy.csv and its table.
+    Accuracy,
     /// Prove the estimator and the monitor have no panic path (panic-never).
     Nopanic,
     /// Draw every table of docs/measurements.md and the README's headline from the
@@ -136,6 +140,7 @@ fn main() -> ExitCode {
         Task::Bench { csv, short, cpu } => bench::run(csv, short, cpu.as_deref()),
         Task::Shapes { short, csv } => shapes::run(short, csv),
         Task::Firmware { write } => firmware::run(write),
+        Task::Accuracy => accuracy::run(),
         Task::Nopanic => nopanic::run(),
         Task::Measurements { check } => measurements::run(check),
     }

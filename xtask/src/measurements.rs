@@ -8,8 +8,8 @@
 //! around it is the page's own and carries no measured number.
 
 use crate::bench::{self, find};
-use crate::records::{self, BenchRow, NodeRow, ShapeRow, SizeRow, SweepRow};
-use crate::{firmware, shapes, sweep};
+use crate::records::{self, AccuracyRow, BenchRow, NodeRow, ShapeRow, SizeRow, SweepRow};
+use crate::{accuracy, firmware, shapes, sweep};
 use misalign_workload::{Model, Operation};
 use std::fmt::Write as _;
 use std::process::ExitCode;
@@ -32,9 +32,11 @@ fn blocks() -> Result<Vec<Block>, String> {
     let sweep = records::read::<SweepRow>()?;
     let sizes = records::read::<SizeRow>()?;
     let nodes = records::read::<NodeRow>()?;
+    let accuracy = records::read::<AccuracyRow>()?;
     let block = |file, name, text| Block { file, name, text };
     Ok(vec![
-        block(README, "headline", headline(&bench)),
+        block(README, "headline", headline(&bench, &accuracy)),
+        block(PAGE, "accuracy", accuracy::table(&accuracy)),
         block(PAGE, "bench", bench::estimates(&bench)),
         block(PAGE, "cost", bench::cost(&bench)),
         block(PAGE, "stages", bench::stages(&bench)),
@@ -45,29 +47,29 @@ fn blocks() -> Result<Vec<Block>, String> {
     ])
 }
 
-/// The README's headline: per core, the estimate's worst error and instructions on the
-/// Cortex-M0 and M4F, and the monitor's instructions per sample, from docs/bench.csv.
-fn headline(rows: &[BenchRow]) -> String {
+/// The README's headline: per model, the worst error of d/b (docs/accuracy.csv), the
+/// instructions per estimate and the monitor's per sample on the Cortex-M0 and M4F
+/// (docs/bench.csv).
+fn headline(bench: &[BenchRow], accuracy: &[AccuracyRow]) -> String {
     let mut s = String::from(
-        "| core | max relative error of d/b, F, phi0 | instructions per estimate: Cortex-M0 / M4F | monitor per sample: Cortex-M0 / M4F |\n\
+        "| model | max relative error of d/b | instructions per estimate: Cortex-M0 / M4F | monitor per sample: Cortex-M0 / M4F |\n\
          |---|--:|--:|--:|\n",
     );
-    let mean =
-        |cpu, model, op| find(rows, cpu, model, op).map_or("-".into(), |r| r.mean.to_string());
+    let mean = |cpu, model, op| find(bench, cpu, model, op).map(|r| r.mean);
     for (model, name) in [
-        (Model::F32, "f32"),
-        (Model::Fixed, "fixed point"),
+        (Model::F32, "f32 core"),
+        (Model::Fixed, "fixed-point core"),
         (Model::Reference, "f64 reference"),
     ] {
-        let error = find(rows, "cortex-m0", model, Operation::Estimate)
-            .and_then(|r| r.error)
-            .map_or("-".into(), |e| format!("{e:.1e}"));
-        let both = |op| {
-            let (m0, m4f) = (mean("cortex-m0", model, op), mean("cortex-m4f", model, op));
-            if m0 == "-" && m4f == "-" {
-                "-".to_string()
-            } else {
-                format!("{m0} / {m4f}")
+        let error = accuracy
+            .iter()
+            .find(|r| r.model == model.name() && r.contact == "elliptic" && r.quantity == "s")
+            .map_or("-".into(), |r| format!("{:.1e}", r.max_rel));
+        let both = |op| match (mean("cortex-m0", model, op), mean("cortex-m4f", model, op)) {
+            (None, None) => "-".to_string(),
+            (m0, m4f) => {
+                let n = |x: Option<u64>| x.map_or("-".into(), |x| x.to_string());
+                format!("{} / {}", n(m0), n(m4f))
             }
         };
         writeln!(
@@ -79,9 +81,9 @@ fn headline(rows: &[BenchRow]) -> String {
         .unwrap();
     }
     s.push_str(
-        "\nMeans in QEMU (`-icount`: instructions, not cycles); errors against \
-         independent reference data. How each is measured, and every other table: \
-         [docs/measurements.md](docs/measurements.md).\n",
+        "\nElliptic contact; instructions are means in QEMU (`-icount`: instructions, not \
+         cycles); errors against independent reference data. How each is measured, and \
+         every other table: [docs/measurements.md](docs/measurements.md).\n",
     );
     s
 }

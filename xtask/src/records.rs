@@ -313,6 +313,22 @@ record! {
     }
 }
 
+record! {
+    /// docs/accuracy.csv (`cargo xtask accuracy`): the worst relative error of one
+    /// quantity of one model, over every row of the reference data for its contact.
+    AccuracyRow in "accuracy.csv" {
+        /// `f32`, `fixed`, `reference`.
+        model: String = "model",
+        /// `elliptic` or `line`.
+        contact: String = "contact",
+        /// The reference data's column: `s` (d/b), `F`, `phi0`, `m`, `n`, `a`, `b`, `p0`.
+        quantity: String = "quantity",
+        max_rel: f64 = "max_rel_error",
+        /// Rows compared.
+        rows: u64 = "rows",
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
