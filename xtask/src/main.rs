@@ -47,8 +47,10 @@ enum Task {
     /// Every fuzz target for N seconds each (default 60), or N inputs from a fixed seed
     /// (repeatable; CI); needs a nightly toolchain.
     Fuzz {
+        /// Wall-clock seconds per target (exploration; differs from run to run).
         #[arg(long, value_name = "N", conflicts_with = "runs")]
         seconds: Option<u32>,
+        /// Inputs per target from a fixed seed (the same inputs on every machine).
         #[arg(long, value_name = "N")]
         runs: Option<u64>,
     },
