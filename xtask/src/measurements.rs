@@ -42,7 +42,7 @@ fn blocks() -> Result<Vec<Block>, String> {
         block(PAGE, "stages", bench::stages(&bench)),
         block(PAGE, "shapes", shapes::table(&shapes)),
         block(PAGE, "sweep", sweep::markdown(&sweep, false)),
-        block(PAGE, "firmware", firmware::table(&sizes).0),
+        block(PAGE, "firmware", sizes_block(&sizes)),
         block(PAGE, "node", node(&nodes)),
     ])
 }
@@ -86,6 +86,17 @@ fn headline(bench: &[BenchRow], accuracy: &[AccuracyRow]) -> String {
          every other table: [docs/measurements.md](docs/measurements.md).\n",
     );
     s
+}
+
+/// The size table, with the budget and targets it is held to (`firmware.rs`).
+fn sizes_block(rows: &[SizeRow]) -> String {
+    use firmware::{FLASH_BUDGET, NODE_FLASH_TARGET, NODE_RAM_TARGET, STACK_BUDGET};
+    format!(
+        "{}\nBudget of the per-sample estimator (the command fails over it): {FLASH_BUDGET} B \
+         of flash and {STACK_BUDGET} B of stack. Targets of the node on the Cortex-M0 \
+         (marked when missed): {NODE_FLASH_TARGET} B of flash, {NODE_RAM_TARGET} B of RAM.\n",
+        firmware::table(rows).0
+    )
 }
 
 /// The node table and the scenario's length it was measured over.
