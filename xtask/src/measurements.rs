@@ -202,6 +202,47 @@ mod tests {
         );
     }
 
+    /// The headline takes the elliptic d/b error from the accuracy rows and the means
+    /// of the estimate and the monitor on the Cortex-M0 and M4F from the bench rows.
+    #[test]
+    fn the_headline_reads_its_figures_from_the_rows() {
+        let bench = |cpu: &str, model: &str, operation: &str, mean| BenchRow {
+            cpu: cpu.into(),
+            model: model.into(),
+            operation: operation.into(),
+            mean,
+            max: mean + 1,
+            error: Some(1.0),
+        };
+        let rows = [
+            bench("cortex-m0", "f32", "estimate", 11),
+            bench("cortex-m4f", "f32", "estimate", 12),
+            bench("cortex-m3", "f32", "estimate", 13),
+            bench("cortex-m0", "f32", "monitor", 21),
+            bench("cortex-m4f", "f32", "monitor", 22),
+            bench("cortex-m0", "fixed", "estimate", 31),
+        ];
+        let accuracy = |contact: &str, quantity: &str, max_rel| AccuracyRow {
+            model: "f32".into(),
+            contact: contact.into(),
+            quantity: quantity.into(),
+            max_rel,
+            rows: 1,
+        };
+        let errors = [
+            accuracy("line", "s", 5e-9),
+            accuracy("elliptic", "F", 6e-9),
+            accuracy("elliptic", "s", 7e-9),
+        ];
+        let h = headline(&rows, &errors);
+        assert!(
+            h.contains("| f32 core | 7.0e-9 | 11 / 12 | 21 / 22 |"),
+            "{h}"
+        );
+        assert!(h.contains("| fixed-point core | - | 31 / - | - |"), "{h}");
+        assert!(h.contains("| f64 reference | - | - | - |"), "{h}");
+    }
+
     #[test]
     fn a_block_is_replaced_between_its_markers() {
         let text = "a\n<!-- t:begin -->\nold\n<!-- t:end -->\nb\n";
