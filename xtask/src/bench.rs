@@ -5,13 +5,15 @@
 //! practical samples of `misalign_workload::samples`; the monitor's pipeline per sample over
 //! the built-in scenario, and its profile). Error: the same code on the host against the
 //! independent reference data (tests/data/vectors_scene.csv and
-//! vectors_line.csv, or `$MISALIGN_REFERENCE_DIR`). Writes docs/bench.csv, docs/speed-vs-error.svg and the README's
-//! "Accuracy and cost" table; `--csv` prints the CSV, else a readable table. `--cpu ID`
+//! vectors_line.csv, or `$MISALIGN_REFERENCE_DIR`). Writes docs/bench.csv,
+//! docs/speed-vs-error.svg and the tables drawn from them (docs/measurements.md, the
+//! README's headline); `--csv` prints the CSV, else a readable table. `--cpu ID`
 //! (`cortex-m4f`, ...) runs the image on that core only, for iterating on one core's
 //! code; such a partial run writes nothing.
 
 use crate::cross::{self, CPUS};
-use crate::figures::BenchRow;
+use crate::log::Fields;
+use crate::records::{self, BenchRow};
 use misalign::Scene;
 use misalign::fixed::logexp::{exp2_fixed, log2_u32};
 use misalign::fixed::tables::{LOG_G_HIGH, LOG_G_LOW};
@@ -27,32 +29,8 @@ use std::collections::HashMap;
 use std::fmt::Write;
 use std::process::ExitCode;
 
-/// One measured row.
-#[derive(Clone)]
-pub struct Row {
-    pub cpu: &'static str,
-    pub model: Model,
-    pub operation: Operation,
-    pub mean: u64,
-    pub max: u64,
-    pub error: f64,
-}
-
-impl Row {
-    /// The row as the figure takes it, its error as docs/bench.csv holds it (four
-    /// digits), so that `cargo xtask figures` redraws the same figure from the CSV.
-    fn plotted(&self) -> BenchRow {
-        BenchRow {
-            cpu: self.cpu.to_string(),
-            model: self.model.name().to_string(),
-            operation: self.operation.name().to_string(),
-            instructions: self.mean as f64,
-            error: format!("{:.3e}", self.error).parse().unwrap_or(f64::NAN),
-        }
-    }
-}
-
-fn rel(got: f64, want: f64) -> f64 {
+/// Relative error of `got` against `want`; equal values (zeros, infinities) give 0.
+pub fn rel(got: f64, want: f64) -> f64 {
     if got == want {
         0.0
     } else {
@@ -60,7 +38,8 @@ fn rel(got: f64, want: f64) -> f64 {
     }
 }
 
-fn read(name: &str) -> Result<Vec<Record>, String> {
+/// The rows of a reference file of tests/data/ (or `$MISALIGN_REFERENCE_DIR`).
+pub fn read(name: &str) -> Result<Vec<Record>, String> {
     let dir = std::env::var_os("MISALIGN_REFERENCE_DIR").map_or_else(
         || crate::root().join("tests/data"),
         std::path::PathBuf::from,
@@ -80,11 +59,11 @@ fn read(name: &str) -> Result<Vec<Record>, String> {
         .collect()
 }
 
-fn num(row: &Record, key: &str) -> f64 {
+pub fn num(row: &Record, key: &str) -> f64 {
     row[key].parse().unwrap_or(f64::NAN)
 }
 
-fn scene(row: &Record) -> Scene {
+pub fn scene(row: &Record) -> Scene {
     Scene::new(
         num(row, "R1"),
         num(row, "R2"),
@@ -103,7 +82,7 @@ fn worst3(got: (f64, f64, f64), row: &Record) -> f64 {
 }
 
 /// Angle counts with the sign of phi.
-fn signed(counts: u32, phi: f64) -> i32 {
+pub fn signed(counts: u32, phi: f64) -> i32 {
     if phi < 0.0 {
         -(counts as i32)
     } else {
@@ -112,7 +91,7 @@ fn signed(counts: u32, phi: f64) -> i32 {
 }
 
 /// d/b, F and phi0 of a fixed-point estimate, as f64.
-fn fixed3(x: &misalign::fixed::FixedEstimate) -> (f64, f64, f64) {
+pub fn fixed3(x: &misalign::fixed::FixedEstimate) -> (f64, f64, f64) {
     let force = x.axial_force.to_f64() * if x.axial_force_negative { -1.0 } else { 1.0 };
     (
         x.slip_ratio.to_f64(),
@@ -278,7 +257,8 @@ fn monitor_errors(e: &mut Errors) -> Result<(), String> {
     Ok(())
 }
 
-type Record = HashMap<String, String>;
+/// One row of a reference file: column name to text.
+pub type Record = HashMap<String, String>;
 
 /// The whole elliptic estimate of every model against one reference row.
 fn elliptic_errors(e: &mut Errors, row: &Record) -> Result<(), String> {
@@ -352,7 +332,7 @@ fn line_errors(e: &mut Errors, row: &Record) -> Result<(), String> {
 }
 
 /// d/b, F and phi0 of an f32 estimate, as f64.
-fn f32s(f: &misalign::Estimate) -> (f64, f64, f64) {
+pub fn f32s(f: &misalign::Estimate) -> (f64, f64, f64) {
     (
         f.slip_ratio as f64,
         f.axial_force as f64,
@@ -458,7 +438,7 @@ type Measured = (&'static str, Model, Operation, u64, u64);
 
 /// Builds and runs the benchmark image on every CPU (or only on `only`).
 fn measure(samples: usize, only: Option<&str>) -> Result<Vec<Measured>, String> {
-    crate::firmware::preflight()?;
+    crate::tools::preflight()?;
     let mut out = Vec::new();
     let mut built: HashMap<&str, std::path::PathBuf> = HashMap::new();
     for cpu in CPUS.iter().filter(|c| only.is_none_or(|id| c.id == id)) {
@@ -485,65 +465,53 @@ fn measure(samples: usize, only: Option<&str>) -> Result<Vec<Measured>, String> 
 
 /// `bench model=<m> op=<op> n=<calls> mean=<x> max=<y>`.
 fn parse_bench_line(line: &str) -> Option<(Model, Operation, u64, u64)> {
-    let rest = &line[line.find("bench model=")? + 6..];
-    let field = |k: &str| {
-        rest.split_whitespace()
-            .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
-    };
+    let f = Fields::of(line, "bench model=")?;
     Some((
-        Model::from_name(field("model")?)?,
-        Operation::from_name(field("op")?)?,
-        field("mean")?.parse().unwrap_or(0),
-        field("max")?.parse().unwrap_or(0),
+        Model::from_name(f.get("model").ok()?)?,
+        Operation::from_name(f.get("op").ok()?)?,
+        f.num("mean").ok()?,
+        f.num("max").ok()?,
     ))
 }
 
-fn csv_text(rows: &[Row]) -> String {
-    let mut s =
-        String::from("cpu,model,operation,instructions_mean,instructions_max,max_rel_error\n");
-    for r in rows {
-        // No error measured (the monitor's profile): an empty field, which
-        // `cargo xtask figures` passes over.
-        let error = if r.error.is_nan() {
-            String::new()
-        } else {
-            format!("{:.3e}", r.error)
-        };
-        writeln!(
-            s,
-            "{},{},{},{},{},{error}",
-            r.cpu,
-            r.model.name(),
-            r.operation.name(),
-            r.mean,
-            r.max,
-        )
-        .unwrap();
-    }
-    s
-}
-
-fn find<'a>(rows: &'a [Row], cpu: &str, model: Model, op: Operation) -> Option<&'a Row> {
+/// The row of `(cpu, model, operation)`.
+pub fn find<'a>(
+    rows: &'a [BenchRow],
+    cpu: &str,
+    model: Model,
+    op: Operation,
+) -> Option<&'a BenchRow> {
     rows.iter()
-        .find(|r| r.cpu == cpu && r.model == model && r.operation == op)
+        .find(|r| r.cpu == cpu && r.model == model.name() && r.operation == op.name())
 }
 
-/// The readable table: per CPU the full estimate of every model, with ratios to the
-/// baseline and the reference.
-fn readable(rows: &[Row]) -> String {
+/// `mean / max` of a row.
+fn counts(r: &BenchRow) -> String {
+    format!("{} / {}", r.mean, r.max)
+}
+
+/// An error as the tables print it (two digits), `-` where none was measured.
+fn error(r: &BenchRow) -> String {
+    r.error.map_or("-".to_string(), |e| format!("{e:.1e}"))
+}
+
+/// The estimates table: per CPU the full estimate of every model, with ratios to the
+/// reference and to Hamrock & Brewe.
+pub fn estimates(rows: &[BenchRow]) -> String {
     let mut s = String::new();
     writeln!(s, "| cpu | model | operation | instructions mean / max | max relative error | fewer instructions than the reference | more accurate than Hamrock & Brewe |").unwrap();
     writeln!(s, "|---|---|---|--:|--:|--:|--:|").unwrap();
-    for r in rows.iter().filter(|r| r.operation.is_estimate()) {
+    let estimate =
+        |r: &&BenchRow| Operation::from_name(&r.operation).is_some_and(|o| o.is_estimate());
+    for r in rows.iter().filter(estimate) {
         writeln!(
             s,
-            "| {} | {} | {} | {} / {} | {:.1e} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} |",
             r.cpu,
-            r.model.name(),
-            r.operation.name(),
-            r.mean,
-            r.max,
-            r.error,
+            r.model,
+            r.operation,
+            counts(r),
+            error(r),
             fewer_instructions(rows, r),
             more_accurate(rows, r)
         )
@@ -553,20 +521,27 @@ fn readable(rows: &[Row]) -> String {
 }
 
 /// How many times fewer instructions `r` takes than the reference on its CPU.
-fn fewer_instructions(rows: &[Row], r: &Row) -> String {
-    find(rows, r.cpu, Model::Reference, r.operation)
-        .filter(|_| r.model != Model::Reference)
+fn fewer_instructions(rows: &[BenchRow], r: &BenchRow) -> String {
+    rows.iter()
+        .find(|x| {
+            x.cpu == r.cpu && x.model == Model::Reference.name() && x.operation == r.operation
+        })
+        .filter(|_| r.model != Model::Reference.name())
         .map_or(String::from("-"), |x| {
             format!("{:.0}x", x.mean as f64 / r.mean.max(1) as f64)
         })
 }
 
 /// How many times more accurate a core's `r` is than Hamrock & Brewe.
-fn more_accurate(rows: &[Row], r: &Row) -> String {
-    let core = matches!(r.model, Model::F32 | Model::Fixed);
-    find(rows, r.cpu, Model::HamrockBrewe, r.operation)
-        .filter(|_| core && r.error > 0.0)
-        .map_or(String::from("-"), |b| format!("{:.0}x", b.error / r.error))
+fn more_accurate(rows: &[BenchRow], r: &BenchRow) -> String {
+    let core = r.model == Model::F32.name() || r.model == Model::Fixed.name();
+    let hb = rows.iter().find(|x| {
+        x.cpu == r.cpu && x.model == Model::HamrockBrewe.name() && x.operation == r.operation
+    });
+    match (hb.and_then(|b| b.error), r.error) {
+        (Some(b), Some(e)) if core && e > 0.0 => format!("{:.0}x", b / e),
+        _ => String::from("-"),
+    }
 }
 
 /// Bytes of table data (flash) that an operation reads, from the generated tables
@@ -603,31 +578,33 @@ fn table_bytes(model: Model, operation: Operation) -> Option<usize> {
     })
 }
 
-/// The README's "Accuracy and cost" table: per kernel and per core, error and
-/// instructions on the M0 and the M4F.
-fn accuracy_and_cost(rows: &[Row]) -> String {
+/// The cost table: per kernel and per core, error and instructions on the M0 and the
+/// M4F, and the table bytes it reads.
+pub fn cost(rows: &[BenchRow]) -> String {
     let mut s = String::new();
     writeln!(s, "| model | operation | max relative error | instructions on Cortex-M0 (mean / max) | instructions on Cortex-M4F (mean / max) | table bytes |").unwrap();
     writeln!(s, "|---|---|--:|--:|--:|--:|").unwrap();
     let mut seen = Vec::new();
-    // The monitor's profile has its own table (`pipeline`) and no error of its own.
-    let profile = |o: Operation| o.is_monitor() && o != Operation::Monitor;
-    for r in rows.iter().filter(|r| !profile(r.operation)) {
-        if seen.contains(&(r.model, r.operation)) {
+    for r in rows {
+        let (Some(model), Some(op)) = (
+            Model::from_name(&r.model),
+            Operation::from_name(&r.operation),
+        ) else {
+            continue;
+        };
+        // The monitor's profile has its own table (`stages`) and no error of its own.
+        if (op.is_monitor() && op != Operation::Monitor) || seen.contains(&(model, op)) {
             continue;
         }
-        seen.push((r.model, r.operation));
-        let on = |cpu: &str| {
-            find(rows, cpu, r.model, r.operation)
-                .map_or("-".to_string(), |x| format!("{} / {}", x.mean, x.max))
-        };
-        let bytes = table_bytes(r.model, r.operation).map_or("-".to_string(), |b| b.to_string());
+        seen.push((model, op));
+        let on = |cpu: &str| find(rows, cpu, model, op).map_or("-".to_string(), counts);
+        let bytes = table_bytes(model, op).map_or("-".to_string(), |b| b.to_string());
         writeln!(
             s,
-            "| {} | `{}` | {:.1e} | {} | {} | {} |",
-            r.model.name(),
-            r.operation.name(),
-            r.error,
+            "| {} | `{}` | {} | {} | {} | {} |",
+            r.model,
+            r.operation,
+            error(r),
             on("cortex-m0"),
             on("cortex-m4f"),
             bytes
@@ -637,85 +614,73 @@ fn accuracy_and_cost(rows: &[Row]) -> String {
     s
 }
 
-/// Issue 10's targets for the monitor's mean instructions per sample: the core a CPU
-/// would run (f32 with an FPU, fixed-point without).
-const MONITOR_TARGETS: [(&str, Model, u64); 2] = [
-    ("cortex-m4f", Model::F32, 300),
-    ("cortex-m0", Model::Fixed, 1200),
-];
-
-/// The README's pipeline table: per CPU and core, the monitor's whole per-sample
-/// pipeline beside the bare estimate, where the rest goes (a stage's cost is the mean
-/// with it on minus the mean with it off), and the monitor's target where one is set.
-fn pipeline(rows: &[Row]) -> String {
+/// The monitor's stages table: per CPU and core, the monitor's whole per-sample
+/// pipeline beside the bare estimate, and where the rest goes: a stage's cost is the
+/// mean with it on minus the mean with it off, in the same run.
+pub fn stages(rows: &[BenchRow]) -> String {
     let mut s = String::new();
-    writeln!(s, "| cpu | core | monitor per sample (mean / max) | bare estimate (mean / max) | spike test | smoothing | trend | checks, states, wear, statistics, conversions | target (mean) |").unwrap();
-    writeln!(s, "|---|---|--:|--:|--:|--:|--:|--:|--:|").unwrap();
-    for r in rows.iter().filter(|r| r.operation == Operation::Monitor) {
-        let mean = |op| find(rows, r.cpu, r.model, op).map(|x| x.mean as i64);
+    writeln!(s, "| cpu | core | monitor per sample (mean / max) | bare estimate (mean / max) | spike test | smoothing | trend | checks, states, wear, statistics, conversions |").unwrap();
+    writeln!(s, "|---|---|--:|--:|--:|--:|--:|--:|").unwrap();
+    for r in rows
+        .iter()
+        .filter(|r| r.operation == Operation::Monitor.name())
+    {
+        let Some(model) = Model::from_name(&r.model) else {
+            continue;
+        };
+        let mean = |op| find(rows, &r.cpu, model, op).map(|x| x.mean as i64);
         let minus = |a: Option<i64>, b: Option<i64>| match (a, b) {
             (Some(a), Some(b)) => (a - b).to_string(),
             _ => "-".to_string(),
         };
         let all = Some(r.mean as i64);
-        let bare = find(rows, r.cpu, r.model, Operation::Estimate);
-        let target = MONITOR_TARGETS
-            .iter()
-            .find(|(cpu, model, _)| *cpu == r.cpu && *model == r.model)
-            .map_or("-".to_string(), |&(_, _, t)| {
-                let met = if r.mean <= t { "met" } else { "missed" };
-                format!("{t}: {met}")
-            });
+        let bare = find(rows, &r.cpu, model, Operation::Estimate);
         writeln!(
             s,
-            "| {} | {} | {} / {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
             r.cpu,
-            r.model.name(),
-            r.mean,
-            r.max,
-            bare.map_or("-".to_string(), |b| format!("{} / {}", b.mean, b.max)),
+            r.model,
+            counts(r),
+            bare.map_or("-".to_string(), counts),
             minus(all, mean(Operation::MonitorNoSpikes)),
             minus(all, mean(Operation::MonitorNoSmoothing)),
             minus(all, mean(Operation::MonitorNoTrend)),
             minus(mean(Operation::MonitorBare), bare.map(|b| b.mean as i64)),
-            target
         )
         .unwrap();
     }
     s
 }
 
-/// Errors on the host and instructions in QEMU, paired per (model, operation).
-fn rows(samples: usize, only: Option<&str>) -> Result<Vec<Row>, String> {
+/// Errors on the host and instructions in QEMU, paired per (model, operation); the
+/// error as docs/bench.csv holds it, so that tables and figure redrawn from the CSV
+/// are these.
+fn rows(samples: usize, only: Option<&str>) -> Result<Vec<BenchRow>, String> {
     let errors = errors()?;
     let measured = measure(samples, only)?;
     Ok(measured
         .into_iter()
-        .map(|(cpu, model, operation, mean, max)| Row {
-            cpu,
-            model,
-            operation,
+        .map(|(cpu, model, operation, mean, max)| BenchRow {
+            cpu: cpu.to_string(),
+            model: model.name().to_string(),
+            operation: operation.name().to_string(),
             mean,
             max,
-            error: errors.get(&(model, operation)).copied().unwrap_or(f64::NAN),
+            error: errors
+                .get(&(model, operation))
+                .filter(|e| !e.is_nan())
+                .map(|&e| records::rounded(e)),
         })
         .collect())
 }
 
-/// docs/bench.csv, docs/speed-vs-error.svg and the README's tables.
-fn write_outputs(rows: &[Row]) -> Result<(), String> {
-    let docs = crate::root().join("docs");
-    std::fs::write(docs.join("bench.csv"), csv_text(rows)).map_err(|e| e.to_string())?;
-    let plotted: Vec<BenchRow> = rows.iter().map(Row::plotted).collect();
-    crate::figures::speed_vs_error(&plotted, &docs.join("speed-vs-error.svg"))
-        .map_err(|e| e.to_string())?;
-    let tables = format!(
-        "{}\n{}\n{}",
-        readable(rows),
-        accuracy_and_cost(rows),
-        pipeline(rows)
-    );
-    crate::write_readme_section("bench", &tables)
+/// docs/bench.csv, docs/speed-vs-error.svg and the tables drawn from them.
+fn write_outputs(rows: &[BenchRow]) -> Result<(), String> {
+    records::write(rows)?;
+    let svg = crate::root().join("docs").join(crate::figures::SPEED_SVG);
+    crate::figures::speed_vs_error(rows, &svg).map_err(|e| e.to_string())?;
+    eprintln!("wrote {}", svg.display());
+    crate::measurements::update()
 }
 
 pub fn run(csv: bool, short: bool, only: Option<&str>) -> ExitCode {
@@ -733,20 +698,15 @@ pub fn run(csv: bool, short: bool, only: Option<&str>) -> ExitCode {
         }
     };
     if csv {
-        print!("{}", csv_text(&rows));
+        print!("{}", records::to_csv(&rows));
     } else {
-        print!("{}\n{}", readable(&rows), pipeline(&rows));
+        print!("{}\n{}", estimates(&rows), stages(&rows));
     }
     if only.is_some() && !short {
         eprintln!("xtask bench: a run on one cpu writes nothing");
-    } else if !short {
-        if let Err(e) = write_outputs(&rows) {
-            eprintln!("xtask bench: {e}");
-            return ExitCode::FAILURE;
-        }
-        eprintln!(
-            "wrote docs/bench.csv, docs/speed-vs-error.svg and the README's Accuracy and cost table"
-        );
+    } else if !short && let Err(e) = write_outputs(&rows) {
+        eprintln!("xtask bench: {e}");
+        return ExitCode::FAILURE;
     }
     ExitCode::SUCCESS
 }

@@ -1,12 +1,9 @@
 //! What the firmware chores share: the Cortex-M cores, cargo for a Cortex-M target
-//! (the harness's images and the root's firmware example), the LLVM tools of the
-//! toolchain, QEMU through `tools/qemu-run`.
+//! (the harness's images and the root's firmware example), section sizes, QEMU through
+//! `tools/qemu-run`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
-
-/// defmt-print, pinned to the defmt wire format of the defmt in Cargo.lock (1.x).
-pub const DEFMT_PRINT_VERSION: &str = "1.2.0";
 
 /// A Cortex-M core the firmware chores run on.
 pub struct Cpu {
@@ -149,36 +146,6 @@ pub fn artifact(built: &Artifacts, name: &str) -> Result<PathBuf, String> {
         .ok_or_else(|| format!("cargo built no `{name}`"))
 }
 
-/// An LLVM tool of the toolchain (`rustup component add llvm-tools`).
-pub fn llvm_tool(name: &str) -> Result<PathBuf, String> {
-    let rustc = |arg: &str| -> Result<String, String> {
-        let out = Command::new(std::env::var_os("RUSTC").unwrap_or_else(|| "rustc".into()))
-            .arg(arg)
-            .output()
-            .map_err(|e| format!("cannot run rustc: {e}"))?;
-        Ok(String::from_utf8_lossy(&out.stdout).into_owned())
-    };
-    let sysroot = rustc("--print=sysroot")?;
-    let version = rustc("-vV")?;
-    let host = version
-        .lines()
-        .find_map(|l| l.strip_prefix("host: "))
-        .ok_or("rustc -vV names no host")?;
-    let path = Path::new(sysroot.trim())
-        .join("lib/rustlib")
-        .join(host)
-        .join("bin")
-        .join(name);
-    if path.exists() {
-        Ok(path)
-    } else {
-        Err(format!(
-            "{} not found: rustup component add llvm-tools",
-            path.display()
-        ))
-    }
-}
-
 /// Section sizes and addresses of an ELF (`llvm-size -A`).
 pub struct Sections(Vec<(String, u64, u64)>);
 
@@ -246,14 +213,4 @@ pub fn qemu(machine: &str, elf: &Path) -> Result<(Option<i32>, String), String> 
     let mut log = String::from_utf8_lossy(&out.stdout).into_owned();
     log.push_str(&String::from_utf8_lossy(&out.stderr));
     Ok((out.status.code(), log))
-}
-
-/// Whether `program --version` runs.
-pub fn have(program: &str) -> bool {
-    Command::new(program)
-        .arg("--version")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
 }

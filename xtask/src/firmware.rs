@@ -25,7 +25,9 @@
 //!   stack it measured.
 
 use crate::cross::{self, Artifacts, CPUS, Cpu, Sections};
-use crate::node;
+use crate::log::Fields;
+use crate::records::{self, NodeRow, SizeRow};
+use crate::{node, tools};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -67,18 +69,6 @@ fn board_ram(core: &Cpu) -> u64 {
     } else {
         4 * 1024 * 1024
     }
-}
-
-/// One row of the node table.
-struct NodeRow {
-    core: &'static str,
-    number: &'static str,
-    sensors: bool,
-    flash: u64,
-    ram: u64,
-    measured: node::Measured,
-    board_ram: u64,
-    worst: f64,
 }
 
 /// Checks the node's log on `core` against the host replay (`node.rs`) and measures
@@ -123,14 +113,23 @@ fn node_check(
         );
         let sections = Sections::of(llvm_size, elf)?;
         Ok(NodeRow {
-            core: core.name,
-            number: if fpu { "f32" } else { "fixed" },
-            sensors,
+            core: core.name.into(),
+            number: if fpu { "f32" } else { "fixed" }.into(),
+            input: if sensors {
+                "simulated sensors"
+            } else {
+                "scenario"
+            }
+            .into(),
             flash: sections.flash(),
             ram: sections.ram(),
-            measured,
+            stack: measured.stack,
             board_ram: board_ram(core),
-            worst: c.worst,
+            samples: measured.samples,
+            events: measured.events,
+            worst: records::rounded(c.worst),
+            instructions_mean: measured.instructions_mean,
+            instructions_max: measured.instructions_max,
         })
     })();
     match checked {
@@ -139,50 +138,46 @@ fn node_check(
     }
 }
 
-/// The node table (markdown), and a failure where statics and stack overflow the
-/// board's RAM.
-fn node_table(rows: &[NodeRow]) -> (String, Vec<String>) {
+/// The node table (markdown, docs/measurements.md), and a failure where statics and
+/// stack overflow the board's RAM.
+pub fn node_table(rows: &[NodeRow]) -> (String, Vec<String>) {
     let mut t = String::from(
         "| core | number | input | flash | RAM: statics + stack | events as the host's | instructions per sample mean / max |\n\
          |---|---|---|--:|--:|--:|--:|\n",
     );
     let mut over = Vec::new();
     for r in rows {
-        let total = r.ram + r.measured.stack;
+        let total = r.ram + r.stack;
         let fits = total <= r.board_ram;
         writeln!(
             t,
             "| {} | {} | {} | {} | {} + {} = {}{} | {}, values {} | {} / {} |",
             r.core,
             r.number,
-            if r.sensors {
-                "simulated sensors"
-            } else {
-                "scenario"
-            },
+            r.input,
             r.flash,
             r.ram,
-            r.measured.stack,
+            r.stack,
             total,
             if fits {
                 ""
             } else {
                 " **over the board's RAM**"
             },
-            r.measured.events,
+            r.events,
             if r.worst == 0.0 {
                 "bit for bit".to_string()
             } else {
                 format!("within {:.2} of the tolerance", r.worst)
             },
-            r.measured.instructions_mean,
-            r.measured.instructions_max
+            r.instructions_mean,
+            r.instructions_max
         )
         .unwrap();
         if !fits {
             over.push(format!(
                 "{} node: {} B of statics and {} B of stack exceed the board's {} B of RAM",
-                r.core, r.ram, r.measured.stack, r.board_ram
+                r.core, r.ram, r.stack, r.board_ram
             ));
         }
     }
@@ -198,23 +193,11 @@ struct Run {
     instructions_max: u64,
 }
 
-#[derive(Clone)]
-struct Row {
-    core: &'static str,
-    number: &'static str,
-    model: &'static str,
-    image_flash: u64,
-    image_ram: u64,
-    estimator_flash: u64,
-    preparation_flash: u64,
-    run: Run,
-    budget: bool,
-}
-
-/// `readme`: also write the table into README.md (between its firmware markers).
-pub fn run(readme: bool) -> ExitCode {
+/// `write`: also write docs/firmware.csv and docs/node.csv, and the tables drawn from
+/// them (docs/measurements.md), when everything passed.
+pub fn run(write: bool) -> ExitCode {
     let start = Instant::now();
-    let llvm_size = match preflight().and_then(|()| cross::llvm_tool("llvm-size")) {
+    let llvm_size = match tools::preflight().and_then(|()| tools::llvm_tool("llvm-size")) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("firmware: {e}");
@@ -225,7 +208,7 @@ pub fn run(readme: bool) -> ExitCode {
     let mut rows = Vec::new();
     let mut built: Vec<Built> = Vec::new();
     let mut nodes = Vec::new();
-    // The Cortex-M4F first: the README's table starts with the FPU core.
+    // The Cortex-M4F first: the table starts with the FPU core.
     for core in CPUS.iter().rev() {
         step(
             start,
@@ -247,20 +230,19 @@ pub fn run(readme: bool) -> ExitCode {
     check_commands(start, &llvm_size, &mut failures);
     let (table, over) = table(&rows);
     let (node_table, node_over) = node_table(&nodes);
-    let table = format!(
-        "{table}\nThe monitoring node (`examples/firmware`: the whole image a user flashes, \
-         self-test included; statics and stack must fit the board's RAM):\n\n{node_table}"
-    );
     println!(
-        "\nEstimator on Cortex-M (profile `firmware`, bytes; budget per sample on the FPU core: \
-         {FLASH_BUDGET} B flash, {STACK_BUDGET} B stack; README \"Size, stack, panics\")\n\n{table}"
+        "\nEstimator on Cortex-M (profile `firmware`, bytes; budget per sample: \
+         {FLASH_BUDGET} B flash, {STACK_BUDGET} B stack)\n\n{table}\n\
+         The monitoring node (`examples/firmware`):\n\n{node_table}"
     );
     failures.extend(over);
     failures.extend(node_over);
-    if readme && failures.is_empty() {
-        match crate::write_readme_section("firmware", &table) {
-            Ok(()) => println!("wrote the table into README.md"),
-            Err(e) => failures.push(e),
+    if write && failures.is_empty() {
+        let written = records::write(&rows)
+            .and_then(|()| records::write(&nodes))
+            .and_then(|()| crate::measurements::update());
+        if let Err(e) = written {
+            failures.push(e);
         }
     }
     step(start, "done");
@@ -276,7 +258,7 @@ fn check_core(
     llvm_size: &Path,
     failures: &mut Vec<String>,
     nodes: &mut Vec<NodeRow>,
-) -> Vec<Row> {
+) -> Vec<SizeRow> {
     let runs = match run_firmware(core, &built.firmware) {
         Ok((runs, log)) => {
             node_check(
@@ -368,37 +350,6 @@ fn step(start: Instant, what: &str) {
     println!("\n=== {what} ({}s)", start.elapsed().as_secs());
 }
 
-/// QEMU, defmt-print (installed here if missing, pinned), llvm-size.
-pub(crate) fn preflight() -> Result<(), String> {
-    if !cross::have("qemu-system-arm") {
-        return Err("qemu-system-arm not found: apt-get install -y qemu-system-arm".into());
-    }
-    if !cross::have("defmt-print") {
-        // On stderr, with the install's own output: `cargo xtask bench --csv` keeps
-        // stdout for its CSV.
-        eprintln!(
-            "defmt-print not found: cargo install defmt-print {}",
-            cross::DEFMT_PRINT_VERSION
-        );
-        let status =
-            std::process::Command::new(std::env::var_os("CARGO").unwrap_or("cargo".into()))
-                .args([
-                    "install",
-                    "--locked",
-                    "defmt-print",
-                    "--version",
-                    cross::DEFMT_PRINT_VERSION,
-                ])
-                .stdout(std::io::stderr())
-                .status()
-                .map_err(|e| format!("cannot run cargo install: {e}"))?;
-        if !status.success() || !cross::have("defmt-print") {
-            return Err("could not install defmt-print (is ~/.cargo/bin on PATH?)".into());
-        }
-    }
-    Ok(())
-}
-
 /// What one target's builds made.
 struct Built {
     target: &'static str,
@@ -479,7 +430,9 @@ fn build_firmware(target: &str, features: &str) -> Result<PathBuf, String> {
 /// results and the whole log.
 fn run_firmware(core: &Cpu, elf: &Path) -> Result<(Vec<(String, Run)>, String), String> {
     let (status, log) = cross::qemu(core.machine, elf)?;
-    let results: Vec<(String, Run)> = log.lines().filter_map(parse_result).collect();
+    let results: Vec<(String, Run)> = Fields::all(&log, "result model=")
+        .filter_map(parse_result)
+        .collect();
     if status != Some(0) || results.len() != MODELS.len() {
         return Err(format!(
             "exit {status:?}, {} result lines:\n{log}",
@@ -497,20 +450,14 @@ fn run_firmware(core: &Cpu, elf: &Path) -> Result<(Vec<(String, Run)>, String), 
 }
 
 /// `result model=elliptic core=f32 samples=36 failures=0 worst_relative_error=... stack_bytes=...`.
-fn parse_result(line: &str) -> Option<(String, Run)> {
-    let rest = &line[line.find("result model=")?..];
-    let field = |key: &str| -> Option<&str> {
-        rest.split_whitespace()
-            .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
-    };
-    let num = |key: &str| field(key)?.parse::<u64>().ok();
+fn parse_result(f: Fields) -> Option<(String, Run)> {
     Some((
-        field("model")?.to_string(),
+        f.get("model").ok()?.to_string(),
         Run {
-            worst_relative_error: field("worst_relative_error")?.parse().ok()?,
-            stack: num("stack_bytes")?,
-            instructions_mean: num("instructions_mean")?,
-            instructions_max: num("instructions_max")?,
+            worst_relative_error: f.num("worst_relative_error").ok()?,
+            stack: f.num("stack_bytes").ok()?,
+            instructions_mean: f.num("instructions_mean").ok()?,
+            instructions_max: f.num("instructions_max").ok()?,
         },
     ))
 }
@@ -521,7 +468,7 @@ fn sizes(
     images: &Artifacts,
     llvm_size: &Path,
     runs: &[(String, Run)],
-) -> Result<Vec<Row>, String> {
+) -> Result<Vec<SizeRow>, String> {
     let mut measured = Vec::new();
     for name in MINIMAL {
         let elf = cross::artifact(images, name)?;
@@ -539,53 +486,43 @@ fn sizes(
             .map(|(_, r)| r.clone())
             .unwrap_or_default()
     };
-    let mut rows: Vec<Row> = MODELS
-        .iter()
-        .map(|&model| {
-            let full = get(&format!("minimal_{model}"));
-            let prepare = get(&format!("minimal_{model}_prepare"));
-            Row {
-                core: core.name,
-                number: if core.has_fpu() { "f32" } else { "fixed" },
-                model,
-                image_flash: full.flash(),
-                image_ram: full.ram(),
-                estimator_flash: full.flash().saturating_sub(prepare.flash()),
-                preparation_flash: prepare.flash().saturating_sub(base),
-                run: run(model),
-                budget: core.sizes,
-            }
-        })
-        .collect();
+    let number = if core.has_fpu() { "f32" } else { "fixed" };
+    let row = |model: &str, image: &Sections, estimator: u64, preparation: u64, run: Run| SizeRow {
+        core: core.name.into(),
+        number: number.into(),
+        model: model.into(),
+        image_flash: image.flash(),
+        image_ram: image.ram(),
+        estimator_flash: estimator,
+        preparation_flash: preparation,
+        stack: run.stack,
+        instructions_mean: run.instructions_mean,
+        instructions_max: run.instructions_max,
+    };
+    let mut rows = Vec::new();
+    for model in MODELS {
+        let full = get(&format!("minimal_{model}"));
+        let prepare = get(&format!("minimal_{model}_prepare"));
+        let estimator = full.flash().saturating_sub(prepare.flash());
+        let preparation = prepare.flash().saturating_sub(base);
+        rows.push(row(model, full, estimator, preparation, run(model)));
+    }
     // The same estimators on the build-time scene: loading bytes instead of preparing.
-    for (i, model) in ["elliptic, build-time scene", "line, build-time scene"]
-        .into_iter()
-        .enumerate()
-    {
-        let name = MODELS[i];
-        let constant = get(&format!("minimal_{name}_const"));
+    for (i, model) in MODELS.into_iter().enumerate() {
+        let constant = get(&format!("minimal_{model}_const"));
         let estimator = rows[i].estimator_flash;
-        rows.push(Row {
-            model,
-            image_flash: constant.flash(),
-            image_ram: constant.ram(),
-            estimator_flash: estimator,
-            preparation_flash: constant.flash().saturating_sub(estimator + base),
-            run: run(name),
-            ..rows[i].clone()
-        });
+        let loading = constant.flash().saturating_sub(estimator + base);
+        let name = format!("{model}, build-time scene");
+        rows.push(row(&name, constant, estimator, loading, run(model)));
     }
     Ok(rows)
 }
 
 /// The monitoring node (`minimal_node`): runs it (exit 0, its `node ...` line) and
 /// measures it; RAM is statics plus the stack it measured.
-fn node_row(core: &Cpu, elf: &Path, llvm_size: &Path) -> Result<Row, String> {
+fn node_row(core: &Cpu, elf: &Path, llvm_size: &Path) -> Result<SizeRow, String> {
     let (status, log) = cross::qemu(core.machine, elf)?;
-    let stack = log
-        .lines()
-        .find_map(|l| l.split("stack_bytes=").nth(1))
-        .and_then(|v| v.trim().parse::<u64>().ok());
+    let stack = Fields::all(&log, "stack_bytes=").find_map(|f| f.num::<u64>("stack_bytes").ok());
     let (Some(0), Some(stack)) = (status, stack) else {
         return Err(format!("{NODE} exit {status:?}:\n{log}"));
     };
@@ -596,19 +533,17 @@ fn node_row(core: &Cpu, elf: &Path, llvm_size: &Path) -> Result<Row, String> {
         s.flash(),
         s.ram()
     );
-    Ok(Row {
-        core: core.name,
-        number: if core.has_fpu() { "f32" } else { "fixed" },
-        model: "node: monitor + elliptic, build-time scene, defmt",
+    Ok(SizeRow {
+        core: core.name.into(),
+        number: if core.has_fpu() { "f32" } else { "fixed" }.into(),
+        model: NODE_MODEL.into(),
         image_flash: s.flash(),
         image_ram: s.ram() + stack,
         estimator_flash: 0,
         preparation_flash: 0,
-        run: Run {
-            stack,
-            ..Run::default()
-        },
-        budget: false,
+        stack,
+        instructions_mean: 0,
+        instructions_max: 0,
     })
 }
 
@@ -661,20 +596,23 @@ fn board(llvm_size: &Path) -> Result<String, String> {
     }
 }
 
-/// The size and stack table (markdown), and the budget failures.
-fn table(rows: &[Row]) -> (String, Vec<String>) {
+/// The size table's row of the monitoring node's minimal image.
+const NODE_MODEL: &str = "node: monitor + elliptic, build-time scene, defmt";
+
+/// The size and stack table (markdown, docs/measurements.md), and the budget failures.
+pub fn table(rows: &[SizeRow]) -> (String, Vec<String>) {
     let mut t = String::from(
         "| core | number | model | image flash | image RAM | estimator flash | preparation | estimator stack | instructions mean / max |\n\
          |---|---|---|--:|--:|--:|--:|--:|--:|\n",
     );
     let mut over = Vec::new();
     for r in rows {
-        if r.model.starts_with("node") {
+        if r.model == NODE_MODEL {
             node_line(&mut t, r);
             continue;
         }
-        let flash_over = r.budget && r.estimator_flash > FLASH_BUDGET;
-        let stack_over = r.budget && r.run.stack > STACK_BUDGET;
+        let flash_over = r.estimator_flash > FLASH_BUDGET;
+        let stack_over = r.stack > STACK_BUDGET;
         let mark = |over: bool| if over { " **over budget**" } else { "" };
         writeln!(
             t,
@@ -687,16 +625,16 @@ fn table(rows: &[Row]) -> (String, Vec<String>) {
             r.estimator_flash,
             mark(flash_over),
             r.preparation_flash,
-            r.run.stack,
+            r.stack,
             mark(stack_over),
-            r.run.instructions_mean,
-            r.run.instructions_max
+            r.instructions_mean,
+            r.instructions_max
         )
         .unwrap();
         if flash_over || stack_over {
             over.push(format!(
                 "{} {} estimator over budget: {} B flash (budget {FLASH_BUDGET}), {} B stack (budget {STACK_BUDGET})",
-                r.core, r.model, r.estimator_flash, r.run.stack
+                r.core, r.model, r.estimator_flash, r.stack
             ));
         }
     }
@@ -705,7 +643,7 @@ fn table(rows: &[Row]) -> (String, Vec<String>) {
 
 /// The node's row: its image and its whole RAM (statics and stack), marked where the
 /// Cortex-M0's targets are missed; no per-sample columns.
-fn node_line(t: &mut String, r: &Row) {
+fn node_line(t: &mut String, r: &SizeRow) {
     let m0 = r.core == "Cortex-M0";
     let mark = |over: bool| if m0 && over { " **over target**" } else { "" };
     writeln!(
@@ -718,7 +656,7 @@ fn node_line(t: &mut String, r: &Row) {
         mark(r.image_flash > NODE_FLASH_TARGET),
         r.image_ram,
         mark(r.image_ram > NODE_RAM_TARGET),
-        r.run.stack,
+        r.stack,
     )
     .unwrap();
 }

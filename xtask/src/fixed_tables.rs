@@ -79,7 +79,7 @@ pub const SPLIT_G: f64 = -4.0;
 /// The same for theta(g): its third derivative stays under 1.3e-3 below log2 g = -6.
 pub const SPLIT_THETA: f64 = -6.0;
 
-/// Spacing exponents, chosen by `cargo xtask tables --explore-fixed`.
+/// Spacing exponents (the shapes weighed by `cargo xtask shapes`).
 pub fn specs() -> [UniformSpec; 9] {
     let top = FRAC_PI_2.log2();
     [
@@ -245,39 +245,4 @@ pub fn source() -> String {
     }
     out.pop();
     out
-}
-
-/// `--explore-fixed`: worst error and size by spacing.
-pub fn explore() {
-    println!("table,spacing,bytes,max_abs_error,max_second_difference");
-    for spec in specs() {
-        for k in 2..=8 {
-            let s = UniformSpec {
-                spacing_log2: k,
-                ..spec
-            };
-            let v = values(&s);
-            let (e, d2) = measure(&s, &v, 32);
-            println!("{},1/{},{},{:.2e},{}", s.name, 1 << k, v.len() * 4, e, d2);
-        }
-    }
-}
-
-/// `--derivatives`: second and third derivatives of the log-log functions, which set
-/// where their tables split and how fine each piece must be.
-pub fn derivatives() {
-    for (name, f, lo, hi) in [
-        ("G", g_of_log_theta as fn(f64) -> f64, -40.0, 0.65),
-        ("Theta", log_theta_of_log_g as fn(f64) -> f64, -27.0, 0.65),
-    ] {
-        let h = 1e-2;
-        let mut y = lo;
-        while y <= hi {
-            let d2 = (f(y + h) - 2.0 * f(y) + f(y - h)) / (h * h);
-            let d3 = (f(y + 2.0 * h) - 2.0 * f(y + h) + 2.0 * f(y - h) - f(y - 2.0 * h))
-                / (2.0 * h * h * h);
-            println!("{name} y={y:.2} d2={d2:.3e} d3={d3:.3e}");
-            y += if y < -6.0 { 4.0 } else { 0.5 };
-        }
-    }
 }

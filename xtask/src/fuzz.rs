@@ -1,4 +1,4 @@
-//! `cargo xtask fuzz [--seconds N]`: every fuzz target under fuzz/ (libFuzzer through
+//! `cargo xtask fuzz [--seconds N | --runs N]`: every fuzz target under fuzz/ (libFuzzer through
 //! cargo-fuzz, which needs a nightly toolchain) for a bounded time each. A crash stops
 //! with a non-zero status and leaves the input under fuzz/artifacts/: turn it into a
 //! test in tests/fuzz_regressions.rs. Each target starts from its seed inputs in
@@ -6,15 +6,12 @@
 //! past defects, written by fuzz/seeds/make.py) and its growing corpus in
 //! fuzz/corpus/<target>/ (not committed).
 
+use crate::tools::{have, install};
 use std::path::Path;
 use std::process::Command;
 
 /// The targets, as named in fuzz/Cargo.toml.
 pub const TARGETS: [&str; 4] = ["estimator_csv", "reference", "float_core", "fixed_core"];
-
-fn have(cmd: &mut Command) -> bool {
-    cmd.output().map(|o| o.status.success()).unwrap_or(false)
-}
 
 /// How long each target runs.
 pub enum Budget {
@@ -27,20 +24,14 @@ pub enum Budget {
 
 /// Runs the targets; Err with a message on a crash or a missing tool.
 pub fn run(root: &Path, budget: Budget) -> Result<(), String> {
-    if !have(Command::new("cargo").args(["+nightly", "--version"])) {
+    if !have("cargo", &["+nightly", "--version"]) {
         return Err(
             "cargo-fuzz needs a nightly toolchain (`rustup toolchain install nightly`)".into(),
         );
     }
-    if !have(Command::new("cargo").args(["+nightly", "fuzz", "--version"])) {
-        eprintln!("installing cargo-fuzz (about 2.5 minutes)");
-        let ok = Command::new("cargo")
-            .args(["install", "cargo-fuzz", "--locked"])
-            .status()
-            .map(|s| s.success());
-        if !matches!(ok, Ok(true)) {
-            return Err("cargo install cargo-fuzz failed".into());
-        }
+    if !have("cargo", &["+nightly", "fuzz", "--version"]) {
+        // About 2.5 minutes.
+        install("cargo-fuzz", None)?;
     }
     let limits: Vec<String> = match budget {
         Budget::Seconds(s) => vec![format!("-max_total_time={s}")],

@@ -1,5 +1,7 @@
-//! Chores for people and CI alike: `cargo xtask <task>`.
+//! Chores for people and CI alike: `cargo xtask <task>` (`cargo xtask help` lists
+//! them). A task is a variant of [`Task`] and its arm in [`main`].
 
+mod accuracy;
 mod bench;
 mod cross;
 mod figures;
@@ -7,130 +9,156 @@ mod firmware;
 mod fit;
 mod fixed_tables;
 mod fuzz;
+mod log;
+mod measurements;
 mod node;
 mod nopanic;
+mod records;
 mod shapes;
 mod sweep;
 mod tables;
+mod tools;
 mod trace;
 
+use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-const USAGE: &str = "\
-usage: cargo xtask <task>
+#[derive(Parser)]
+#[command(
+    name = "cargo xtask",
+    bin_name = "cargo xtask",
+    about = "Chores for people and CI alike"
+)]
+struct Cli {
+    #[command(subcommand)]
+    task: Task,
+}
 
-tasks:
-    tables [--check]               generate src/float/tables.rs, src/fixed/tables.rs and the
-                                   firmware's trace (examples/firmware/trace.rs) from the
-                                   f64 reference (--check: fail if a committed file differs)
-    fuzz [--seconds N | --runs N]  every fuzz target for N seconds (default 60), or for N
-                                   inputs from a fixed seed (repeatable; CI); nightly
-    sweep [--quick] [--readme]     every f32 kernel over every input of its domain against
-                                   the reference (--quick strides; --readme writes the table)
-    tables --explore | --explore-force | --explore-fixed | --derivatives
-                                   error and size of the table shapes considered
-    figures [--check]              write the paper's Figs 1-4 (and the speed against
-                                   error from docs/bench.csv, the table shapes from
-                                   docs/shapes.csv, if any) as SVG to docs/
-                                   (--check: fail if a committed SVG differs)
-    bench [--csv] [--short] [--cpu ID]
-                                   speed against error: the benchmark image on Cortex-M0, M3,
-                                   M4F, M7 in QEMU (instructions) and the same code on the
-                                   host against the reference data (error); writes
-                                   docs/bench.csv, docs/speed-vs-error.svg and the README
-                                   table (--short: fewer samples, writes nothing; --cpu
-                                   cortex-m4f etc.: that core only, writes nothing)
-    shapes [--short] [--csv]       the table shapes weighed (f32: variable, segments, degree;
-                                   fixed point: spacing, interpolation, one table or two):
-                                   instructions in QEMU (f32 on the Cortex-M4F, fixed point
-                                   on the M0 and M3) beside the library's kernels, bytes,
-                                   and error against the reference on the host; writes
-                                   docs/shapes.csv and docs/table-shapes.svg (--short:
-                                   fewer inputs, writes nothing)
-    firmware [--readme]            build every firmware image and on-target test, run them
-                                   in QEMU (Cortex-M4F, M7, M3, M0), print the size and
-                                   stack table (--readme: write it into README.md); fail
-                                   on any failure or over budget
-    nopanic                        prove the estimator has no panic path (panic-never)
-";
+#[derive(Subcommand)]
+enum Task {
+    /// Generate src/float/tables.rs, src/fixed/tables.rs and the firmware's trace
+    /// (examples/firmware/trace.rs) from the f64 reference.
+    Tables {
+        /// Fail if a committed file differs instead of writing it.
+        #[arg(long)]
+        check: bool,
+    },
+    /// Every fuzz target for N seconds each (default 60), or N inputs from a fixed seed
+    /// (repeatable; CI); needs a nightly toolchain.
+    Fuzz {
+        /// Wall-clock seconds per target (exploration; differs from run to run).
+        #[arg(long, value_name = "N", conflicts_with = "runs")]
+        seconds: Option<u32>,
+        /// Inputs per target from a fixed seed (the same inputs on every machine).
+        #[arg(long, value_name = "N")]
+        runs: Option<u64>,
+    },
+    /// Every one-argument f32 kernel and fixed-point function over every input of its
+    /// domain against the reference.
+    Sweep {
+        /// Stride through the domains (a short pass).
+        #[arg(long)]
+        quick: bool,
+        /// Write docs/sweep.csv and its table in docs/measurements.md.
+        #[arg(long, alias = "readme", conflicts_with = "quick")]
+        write: bool,
+    },
+    /// Draw the paper's Figs 1-4 from the reference, and docs/speed-vs-error.svg and
+    /// docs/table-shapes.svg from docs/bench.csv and docs/shapes.csv, as SVG in docs/.
+    Figures {
+        /// Fail if a committed SVG differs instead of writing it.
+        #[arg(long)]
+        check: bool,
+    },
+    /// Speed against error: the benchmark image on the Cortex-M0, M3, M4F, M7 in QEMU
+    /// (instructions) and the same code on the host against the reference data
+    /// (error); writes docs/bench.csv, docs/speed-vs-error.svg and their tables.
+    Bench {
+        /// Print the CSV (else a readable table).
+        #[arg(long)]
+        csv: bool,
+        /// Fewer samples; writes nothing.
+        #[arg(long)]
+        short: bool,
+        /// That core only (cortex-m0, cortex-m3, cortex-m4f, cortex-m7); writes nothing.
+        #[arg(long, value_name = "ID")]
+        cpu: Option<String>,
+    },
+    /// The table shapes weighed: instructions in QEMU beside the library's kernels,
+    /// bytes, and error on the host; writes docs/shapes.csv, docs/table-shapes.svg and
+    /// their table.
+    Shapes {
+        /// Fewer inputs; writes nothing.
+        #[arg(long)]
+        short: bool,
+        /// Print the CSV (else the fronts as a table).
+        #[arg(long)]
+        csv: bool,
+    },
+    /// Build every firmware image and on-target test, run them in QEMU (Cortex-M4F, M7,
+    /// M3, M0), print the size and stack tables; fail on any failure or over budget.
+    Firmware {
+        /// Also write docs/firmware.csv, docs/node.csv and their tables.
+        #[arg(long, alias = "readme")]
+        write: bool,
+    },
+    /// The worst relative error of every quantity of every model against the
+    /// reference data, on the host; writes docs/accuracy.csv and its table.
+    Accuracy,
+    /// Prove the estimator and the monitor have no panic path (panic-never).
+    Nopanic,
+    /// Draw every table of docs/measurements.md and the README's headline from the
+    /// committed CSVs under docs/.
+    Measurements {
+        /// Fail if a committed table differs instead of writing it.
+        #[arg(long)]
+        check: bool,
+    },
+}
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let flag = |f: &str| args.iter().any(|a| a == f);
-    match args.first().map(String::as_str) {
-        Some("tables") if flag("--explore-octaves") => {
-            tables::explore_octaves(0, 6);
-            ExitCode::SUCCESS
-        }
-        Some("tables") if flag("--explore-force") => {
-            tables::explore_force();
-            ExitCode::SUCCESS
-        }
-        Some("fuzz") => {
-            let value = |name: &str| {
-                args.iter()
-                    .position(|a| a == name)
-                    .and_then(|i| args.get(i + 1))
-                    .and_then(|s| s.parse::<u64>().ok())
+    match Cli::parse().task {
+        Task::Tables { check } => tables_task(check),
+        Task::Fuzz { seconds, runs } => {
+            let budget = match runs {
+                Some(n) => fuzz::Budget::Runs(n),
+                None => fuzz::Budget::Seconds(seconds.unwrap_or(60)),
             };
-            let budget = match (value("--runs"), value("--seconds")) {
-                (Some(n), _) => fuzz::Budget::Runs(n),
-                (None, s) => fuzz::Budget::Seconds(s.unwrap_or(60) as u32),
-            };
-            match fuzz::run(&root(), budget) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => {
+            fuzz::run(&root(), budget).map_or_else(
+                |e| {
                     eprintln!("xtask fuzz: {e}");
                     ExitCode::FAILURE
-                }
-            }
+                },
+                |()| ExitCode::SUCCESS,
+            )
         }
-        Some("sweep") => {
-            let quick = flag("--quick");
-            let start = std::time::Instant::now();
-            let rows = sweep::run(quick);
-            let table = sweep::markdown(&rows, quick);
-            print!("{table}");
-            eprintln!("swept in {:.0} s", start.elapsed().as_secs_f64());
-            if flag("--readme") {
-                write_readme_section("sweep", &table).expect("write README.md");
-            }
-            ExitCode::SUCCESS
-        }
-        Some("tables") if flag("--derivatives") => {
-            fixed_tables::derivatives();
-            ExitCode::SUCCESS
-        }
-        Some("tables") if flag("--explore-fixed") => {
-            fixed_tables::explore();
-            ExitCode::SUCCESS
-        }
-        Some("tables") if flag("--explore") => {
-            tables::explore();
-            ExitCode::SUCCESS
-        }
-        Some("tables") => tables_task(flag("--check")),
-        Some("figures") => figures::run(&root().join("docs"), flag("--check")),
-        Some("shapes") => shapes::run(flag("--short"), flag("--csv")),
-        Some("bench") => {
-            let cpu = args
-                .iter()
-                .position(|a| a == "--cpu")
-                .map(|i| args.get(i + 1).map(String::as_str).unwrap_or(""));
-            bench::run(flag("--csv"), flag("--short"), cpu)
-        }
-        Some("firmware") => firmware::run(flag("--readme")),
-        Some("nopanic") => nopanic::run(),
-        _ => {
-            eprint!("{USAGE}");
-            ExitCode::from(2)
-        }
+        Task::Sweep { quick, write } => sweep_task(quick, write),
+        Task::Figures { check } => figures::run(&root().join("docs"), check),
+        Task::Bench { csv, short, cpu } => bench::run(csv, short, cpu.as_deref()),
+        Task::Shapes { short, csv } => shapes::run(short, csv),
+        Task::Firmware { write } => firmware::run(write),
+        Task::Accuracy => accuracy::run(),
+        Task::Nopanic => nopanic::run(),
+        Task::Measurements { check } => measurements::run(check),
     }
+}
+
+/// `cargo xtask sweep [--quick] [--write]`.
+fn sweep_task(quick: bool, write: bool) -> ExitCode {
+    let start = std::time::Instant::now();
+    let rows = sweep::run(quick);
+    print!("{}", sweep::markdown(&rows, quick));
+    eprintln!("swept in {:.0} s", start.elapsed().as_secs_f64());
+    if write && let Err(e) = records::write(&rows).and_then(|()| measurements::update()) {
+        eprintln!("xtask sweep: {e}");
+        return ExitCode::FAILURE;
+    }
+    ExitCode::SUCCESS
 }
 
 /// `cargo xtask tables [--check]`: writes (or checks) every generated file.
@@ -155,22 +183,6 @@ fn tables_task(check: bool) -> ExitCode {
     } else {
         ExitCode::SUCCESS
     }
-}
-
-/// Writes `section` between the markers `<!-- {name}:begin -->` and
-/// `<!-- {name}:end -->` of README.md.
-pub fn write_readme_section(name: &str, section: &str) -> Result<(), String> {
-    let path = root().join("README.md");
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("README.md: {e}"))?;
-    let (begin, end) = (
-        format!("<!-- {name}:begin -->"),
-        format!("<!-- {name}:end -->"),
-    );
-    let (Some(a), Some(b)) = (text.find(&begin), text.find(&end)) else {
-        return Err(format!("README.md has no {name} markers"));
-    };
-    let new = format!("{}{begin}\n{section}{}", &text[..a], &text[b..]);
-    std::fs::write(&path, new).map_err(|e| format!("README.md: {e}"))
 }
 
 #[cfg(test)]

@@ -23,6 +23,7 @@
 //! frozen codes instead of the monitor's 2 minutes: that comparison would have to be
 //! loose, this one need not be.)
 
+use crate::log::Fields;
 use misalign::fixed::{FixedAuto, FixedEllipticScene};
 use misalign::float::Auto;
 use misalign::monitor::scenario::{self, Scenario};
@@ -91,67 +92,26 @@ pub struct Measured {
     pub instructions_max: u64,
 }
 
-/// `key=value` fields of `line` after `marker` (values without spaces).
-fn fields<'a>(line: &'a str, marker: &str) -> Option<Vec<(&'a str, &'a str)>> {
-    let rest = &line[line.find(marker)?..];
-    Some(
-        rest.split_whitespace()
-            .filter_map(|kv| kv.split_once('='))
-            .collect(),
-    )
-}
-
-fn get<'a>(f: &[(&str, &'a str)], key: &str) -> Result<&'a str, String> {
-    f.iter()
-        .find(|(k, _)| *k == key)
-        .map(|(_, v)| *v)
-        .ok_or_else(|| format!("no `{key}=`"))
-}
-
-fn num<T: std::str::FromStr>(f: &[(&str, &str)], key: &str) -> Result<T, String> {
-    let v = get(f, key)?;
-    v.parse()
-        .map_err(|_| format!("`{key}={v}` is not a number"))
-}
-
-/// An f32 value, exactly (defmt prints the shortest form that reads back to it).
-fn f32v(f: &[(&str, &str)], key: &str) -> Result<f64, String> {
-    num::<f32>(f, key).map(f64::from)
-}
-
-/// `None` or `Some(x)`, as defmt prints an `Option<f32>`.
-fn opt(f: &[(&str, &str)], key: &str) -> Result<Option<f64>, String> {
-    match get(f, key)? {
-        "None" => Ok(None),
-        v => v
-            .strip_prefix("Some(")
-            .and_then(|v| v.strip_suffix(')'))
-            .and_then(|v| v.parse::<f32>().ok())
-            .map(|x| Some(f64::from(x)))
-            .ok_or_else(|| format!("`{key}={v}` is neither None nor Some(number)")),
-    }
-}
-
 fn parse_event(line: &str) -> Result<Event, String> {
     let (head, fault) = line
         .split_once(" fault=")
         .ok_or("an event line without `fault=`")?;
-    let f = fields(head, "event seq=").ok_or("not an event line")?;
+    let f = Fields::of(head, "event seq=").ok_or("not an event line")?;
     Ok(Event {
-        seq: num(&f, "seq")?,
-        time_ms: num(&f, "time_ms")?,
-        elapsed_ms: num(&f, "elapsed_ms")?,
-        kind: get(&f, "kind")?.into(),
-        from: get(&f, "from")?.into(),
-        to: get(&f, "to")?.into(),
+        seq: f.num("seq")?,
+        time_ms: f.num("time_ms")?,
+        elapsed_ms: f.num("elapsed_ms")?,
+        kind: f.get("kind")?.into(),
+        from: f.get("from")?.into(),
+        to: f.get("to")?.into(),
         fault: fault.trim().into(),
-        ttc: opt(&f, "ttc")?,
-        load: f32v(&f, "P")?,
-        phi: f32v(&f, "phi")?,
-        slip_ratio: f32v(&f, "s")?,
-        force: f32v(&f, "F")?,
-        critical_angle: opt(&f, "phi0")?,
-        margin: opt(&f, "margin")?,
+        ttc: f.opt_f32("ttc")?,
+        load: f.f32("P")?,
+        phi: f.f32("phi")?,
+        slip_ratio: f.f32("s")?,
+        force: f.f32("F")?,
+        critical_angle: f.opt_f32("phi0")?,
+        margin: f.opt_f32("margin")?,
     })
 }
 
@@ -163,25 +123,25 @@ pub fn parse_log(log: &str) -> Result<Log, String> {
         let what = |e: String| format!("{e} in: {line}");
         if line.contains("event seq=") {
             out.events.push(parse_event(line).map_err(what)?);
-        } else if let Some(f) = fields(line, "summary samples=") {
+        } else if let Some(f) = Fields::of(line, "summary samples=") {
             let s = &mut out.summary;
             s.counts = [
-                num(&f, "samples").map_err(what)?,
-                num(&f, "repeated").map_err(what)?,
-                num(&f, "spikes").map_err(what)?,
-                num(&f, "faults").map_err(what)?,
-                num(&f, "dropped").map_err(what)?,
+                f.num("samples").map_err(what)?,
+                f.num("repeated").map_err(what)?,
+                f.num("spikes").map_err(what)?,
+                f.num("faults").map_err(what)?,
+                f.num("dropped").map_err(what)?,
             ];
-            s.final_state = get(&f, "final").map_err(what)?.into();
-            s.max_slip_ratio = f32v(&f, "max_s").map_err(what)?;
-            s.max_force = f32v(&f, "max_F").map_err(what)?;
-            s.min_margin = opt(&f, "min_margin").map_err(what)?;
+            s.final_state = f.get("final").map_err(what)?.into();
+            s.max_slip_ratio = f.f32("max_s").map_err(what)?;
+            s.max_force = f.f32("max_F").map_err(what)?;
+            s.min_margin = f.opt_f32("min_margin").map_err(what)?;
             counts_seen = true;
-        } else if let Some(f) = fields(line, "summary state=") {
+        } else if let Some(f) = Fields::of(line, "summary state=") {
             out.summary.states.push((
-                get(&f, "state").map_err(what)?.into(),
-                num(&f, "time_ms").map_err(what)?,
-                num(&f, "energy_j").map_err(what)?,
+                f.get("state").map_err(what)?.into(),
+                f.num("time_ms").map_err(what)?,
+                f.num("energy_j").map_err(what)?,
             ));
         }
     }
@@ -193,17 +153,13 @@ pub fn parse_log(log: &str) -> Result<Log, String> {
 
 /// The `node core=... stack_bytes=...` line.
 pub fn parse_measured(log: &str) -> Result<Measured, String> {
-    let line = log
-        .lines()
-        .find(|l| l.contains("node core="))
-        .ok_or("no `node core=` line in the log")?;
-    let f = fields(line, "node core=").ok_or("no fields")?;
+    let f = Fields::first(log, "node core=")?;
     Ok(Measured {
-        samples: num(&f, "samples")?,
-        events: num(&f, "events")?,
-        stack: num(&f, "stack_bytes")?,
-        instructions_mean: num(&f, "instructions_mean")?,
-        instructions_max: num(&f, "instructions_max")?,
+        samples: f.num("samples")?,
+        events: f.num("events")?,
+        stack: f.num("stack_bytes")?,
+        instructions_mean: f.num("instructions_mean")?,
+        instructions_max: f.num("instructions_max")?,
     })
 }
 

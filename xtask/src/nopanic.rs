@@ -17,7 +17,7 @@ use std::process::ExitCode;
 const PANIC_NEVER: &str = "error(panic-never)";
 
 pub fn run() -> ExitCode {
-    let qemu = cross::have("qemu-system-arm");
+    let qemu = crate::tools::have("qemu-system-arm", &["--version"]);
     let mut failed = false;
     for cpu in CPUS.iter().filter(|c| c.sizes) {
         let (target, machine) = (cpu.target, cpu.machine);

@@ -29,9 +29,11 @@
 //! `--csv` the whole CSV.
 
 use crate::cross::{self, CPUS};
-use crate::figures::{ShapeRow, fronts, shapes_csv};
+use crate::figures::fronts;
 use crate::fit::chebyshev_fit;
 use crate::fixed_tables::{self, UniformSpec};
+use crate::log::Fields;
+use crate::records::{self, ShapeRow};
 use crate::tables::{self, OctaveSpec};
 use misalign::fixed::tables as fixed_lib;
 use misalign::fixed::uniform::{ONE, UniformTable};
@@ -656,7 +658,7 @@ const RUNS: [(&str, &str); 3] = [
 type Counts = HashMap<(String, String, String), (u64, u64)>;
 
 fn measure(source: &str, samples: usize) -> Result<Counts, String> {
-    crate::firmware::preflight()?;
+    crate::tools::preflight()?;
     let target_dir = std::env::var_os("CARGO_TARGET_DIR")
         .map_or_else(|| crate::root().join("target"), PathBuf::from);
     let dir = target_dir.join("shapes");
@@ -689,16 +691,12 @@ fn measure(source: &str, samples: usize) -> Result<Counts, String> {
 
 /// `shape table=<t> shape=<id> n=<calls> mean=<x> max=<y>`.
 fn parse_line(line: &str) -> Option<(String, String, u64, u64)> {
-    let rest = &line[line.find("shape table=")? + 6..];
-    let field = |k: &str| {
-        rest.split_whitespace()
-            .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
-    };
+    let f = Fields::of(line, "shape table=")?;
     Some((
-        field("table")?.to_string(),
-        field("shape")?.to_string(),
-        field("mean")?.parse().ok()?,
-        field("max")?.parse().ok()?,
+        f.get("table").ok()?.to_string(),
+        f.get("shape").ok()?.to_string(),
+        f.num("mean").ok()?,
+        f.num("max").ok()?,
     ))
 }
 
@@ -729,9 +727,9 @@ fn rows(weighed: &[Weighed], counts: &Counts) -> Result<Vec<ShapeRow>, String> {
                 bytes: w.bytes as u64,
                 mean: mean as f64,
                 max: max as f64,
-                // As the CSV holds it (four digits), so that `cargo xtask figures`
-                // redraws the same figure from the CSV.
-                error: format!("{:.3e}", w.error).parse().unwrap_or(f64::INFINITY),
+                // As the CSV holds it, so that the figure and the table redrawn from
+                // the CSV are these.
+                error: records::rounded(w.error),
             });
         }
     }
@@ -768,8 +766,8 @@ fn check_baselines(rows: &[ShapeRow]) -> Result<(), String> {
 
 /// Per core and table, by instructions: the library's kernel, the shipped shape and
 /// the shapes on either Pareto front (within the library's bytes, at any size), as
-/// Markdown.
-fn readable(rows: &[ShapeRow]) -> String {
+/// Markdown (docs/measurements.md).
+pub fn table(rows: &[ShapeRow]) -> String {
     let mut s = String::new();
     writeln!(
         s,
@@ -835,17 +833,16 @@ fn run_inner(short: bool, csv: bool) -> Result<(), String> {
     let rows = rows(&weighed, &counts)?;
     check_baselines(&rows)?;
     if csv {
-        print!("{}", shapes_csv(&rows));
+        print!("{}", records::to_csv(&rows));
     } else {
-        print!("{}", readable(&rows));
+        print!("{}", table(&rows));
     }
     if !short {
-        let docs = crate::root().join("docs");
-        std::fs::write(docs.join(crate::figures::SHAPES_CSV), shapes_csv(&rows))
-            .map_err(|e| e.to_string())?;
-        crate::figures::table_shapes(&rows, &docs.join(crate::figures::SHAPES_SVG))
-            .map_err(|e| e.to_string())?;
-        eprintln!("wrote docs/shapes.csv and docs/table-shapes.svg");
+        records::write(&rows)?;
+        let svg = crate::root().join("docs").join(crate::figures::SHAPES_SVG);
+        crate::figures::table_shapes(&rows, &svg).map_err(|e| e.to_string())?;
+        eprintln!("wrote {}", svg.display());
+        crate::measurements::update()?;
     }
     eprintln!("shapes: {:.0} s", start.elapsed().as_secs_f64());
     Ok(())

@@ -2,8 +2,9 @@
 //! fraction) of its domain, against the f64 reference; maximum error in ulps of the
 //! result and relative. The table functions need the reference's root finding per
 //! point, so they are swept on every 2^k-th f32 of each octave instead (said so).
-//! With `--readme` it writes the table between the README's sweep markers.
+//! With `--write` it writes docs/sweep.csv and its table in docs/measurements.md.
 
+use crate::records::SweepRow as Row;
 use misalign::fixed::logexp::{exp2_fixed, log2_u32};
 use misalign::fixed::uniform::ONE;
 use misalign::float::kernels::axial_force::axial_force_ratio;
@@ -13,16 +14,6 @@ use misalign::float::kernels::theta_top::theta_of_g_top;
 use misalign::float::tables::{G_OF_THETA, INV_M_OF_THETA, THETA_OF_G};
 use misalign::reference::{normal, tangential};
 use std::fmt::Write;
-
-/// One row of the result.
-pub struct Row {
-    pub kernel: &'static str,
-    pub domain: String,
-    pub points: u64,
-    pub max_ulps: f64,
-    pub max_rel: f64,
-    pub at: f64,
-}
 
 /// Distance in f32 ulps of `got` from the exact `want` (ulp of the f32 nearest want).
 fn ulps(got: f32, want: f64) -> f64 {
@@ -83,7 +74,7 @@ fn f32_row(
         (ulps(got, want), ((got as f64 - want) / want).abs())
     });
     Row {
-        kernel,
+        kernel: kernel.into(),
         domain: domain.into(),
         points: n,
         max_ulps: u,
@@ -198,7 +189,7 @@ pub fn run(quick: bool) -> Vec<Row> {
         (e * ONE as f64, e)
     });
     rows.push(Row {
-        kernel: "log2_u32 (log2 units)",
+        kernel: "log2_u32 (log2 units)".into(),
         domain: "every u32 >= 1".into(),
         points: n,
         max_ulps: worst * ONE as f64,
@@ -213,7 +204,7 @@ pub fn run(quick: bool) -> Vec<Row> {
         (r * (1u64 << 29) as f64, r)
     });
     rows.push(Row {
-        kernel: "exp2_fixed",
+        kernel: "exp2_fixed".into(),
         domain: "all 2^24 Q8.24 fractions".into(),
         points: n,
         max_ulps: worst * (1u64 << 29) as f64,
@@ -223,7 +214,8 @@ pub fn run(quick: bool) -> Vec<Row> {
     rows
 }
 
-/// The table as Markdown.
+/// The table as Markdown (docs/measurements.md); `quick` says the f32 kernels were
+/// strided.
 pub fn markdown(rows: &[Row], quick: bool) -> String {
     let mut out = String::new();
     writeln!(

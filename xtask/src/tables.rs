@@ -52,7 +52,7 @@ pub fn theta_of_g(g: f64) -> f64 {
     normal::theta_for_g(g).expect("g in the domain").theta
 }
 
-/// The tables the library ships, with the shape chosen by `cargo xtask tables --explore`.
+/// The tables the library ships (their shapes weighed by `cargo xtask shapes`).
 pub fn specs() -> [OctaveSpec; 3] {
     [
         OctaveSpec {
@@ -179,7 +179,7 @@ pub fn measure(spec: &OctaveSpec, coeffs: &[Vec<f32>], samples: usize) -> (f64, 
     worst
 }
 
-/// Degrees of the two pieces of the axial-force kernel (chosen by `--explore`).
+/// Degrees of the two pieces of the axial-force kernel.
 pub const AXIAL_FORCE_DEGREES: (usize, usize) = (5, 4);
 
 /// `F/(mu P) / s` as a polynomial in s on [0, 1/2] (eq 21 is analytic there), and
@@ -345,72 +345,4 @@ pub fn source() -> String {
     }
     out.pop();
     out
-}
-
-/// `--explore`: worst error and size of each table shape considered.
-pub fn explore() {
-    println!("table,segments_per_octave,degree,bytes,max_rel_error,at");
-    for spec in specs() {
-        for m in 0..=2 {
-            for d in 3..=7 {
-                let s = OctaveSpec {
-                    segments_log2: m,
-                    degree: d,
-                    ..spec
-                };
-                let c = fit(&s);
-                let (e, at) = measure(&s, &c, 400);
-                let bytes = c.len() * (d + 1) * 4;
-                println!("{},{},{},{},{:.3e},{:.3e}", s.name, 1 << m, d, bytes, e, at);
-            }
-        }
-    }
-}
-
-/// `--explore-octaves`: worst error per octave for one shape.
-pub fn explore_octaves(m: u32, d: usize) {
-    for spec in specs() {
-        let s = OctaveSpec {
-            segments_log2: m,
-            degree: d,
-            ..spec
-        };
-        let c = fit(&s);
-        print!("{}:", s.name);
-        for o in 0..s.octaves {
-            let sub = OctaveSpec {
-                first_exponent: s.first_exponent + o,
-                octaves: 1,
-                ..s
-            };
-            let per = 1usize << m;
-            let cc = &c[o as usize * per..(o as usize + 1) * per];
-            let (e, _) = measure(&sub, cc, 200);
-            print!(" {}:{:.1e}", s.first_exponent + o, e);
-        }
-        println!();
-    }
-}
-
-/// `--explore-force`: worst error of the axial-force kernel's pieces by degree,
-/// evaluated in f32 as the library does (u from the exact f64 square root).
-pub fn explore_force() {
-    let f = |s: f64| tangential::axial_force_ratio(s);
-    for d in 3..=9 {
-        let (lo, hi) = fit_axial_force(d, d);
-        let (mut e_lo, mut e_hi) = (0.0f64, 0.0f64);
-        for k in 1..200_000 {
-            let s = (k as f64 / 200_000.0) as f32;
-            if s < 0.5 {
-                let got = s * horner_f32(&lo, s);
-                e_lo = e_lo.max((got as f64 / f(s as f64) - 1.0).abs());
-            } else {
-                let v = 1.0 - s;
-                let u = (v as f64).sqrt() as f32;
-                let got = 1.0 - v * v * u * horner_f32(&hi, u);
-                e_hi = e_hi.max((got as f64 / f(s as f64) - 1.0).abs());
-            }
-        }
-        println!("degree {d}: low {e_lo:.2e} high {e_hi:.2e}");
-    }
 }

@@ -7,83 +7,38 @@ use super::{
     Area, BLUE_, FONT, GREEN_, GREY, LIGHT, NOTE, ORANGE, PURPLE, Res, SKY, VERMILION, log_axis,
     power_of_ten, render_sized, ten_to, text,
 };
+use crate::records::{self, BenchRow};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 use std::path::Path;
 
-/// One row of the benchmark's CSV that the speed-against-error figure uses.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BenchRow {
-    /// `cortex-m0`, ...
-    pub cpu: String,
-    /// `reference`, `f32`, `fixed`, `hamrock-brewe`, ...
-    pub model: String,
-    /// `estimate`, or `table:...` / `kernel:...` for the variants weighed.
-    pub operation: String,
-    /// Mean instructions per call.
-    pub instructions: f64,
-    /// Maximum relative error against the f64 reference.
-    pub error: f64,
-}
-
-/// The rows of `cpu,model,operation,instructions_mean,instructions_max,max_rel_error`
-/// (columns by name, in any order) that the figure plots ([`plotted`]). Rows with an
-/// empty instruction count or error are left out.
+/// The rows of docs/bench.csv that the figure plots ([`plotted`]).
 ///
 /// # Errors
 /// A missing column, a malformed record or a number that does not parse.
 pub fn parse_bench_csv(text: &str) -> Res<Vec<BenchRow>> {
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
-    let headers = reader.headers()?.clone();
-    let column = |name: &str| {
-        headers
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| format!("bench CSV has no column `{name}`"))
-    };
-    let cols = [
-        column("cpu")?,
-        column("model")?,
-        column("operation")?,
-        column("instructions_mean")?,
-        column("max_rel_error")?,
-    ];
-    let mut rows = Vec::new();
-    for (index, record) in reader.records().enumerate() {
-        let record = record?;
-        let line = index + 2;
-        let field = |c: usize| {
-            record
-                .get(c)
-                .ok_or_else(|| format!("bench CSV line {line}: too few fields"))
-        };
-        let (instr, err) = (field(cols[3])?, field(cols[4])?);
-        if instr.is_empty() || err.is_empty() {
-            continue;
-        }
-        let number = |s: &str| {
-            s.parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite() && *v >= 0.0)
-                .ok_or_else(|| format!("bench CSV line {line}: bad number `{s}`"))
-        };
-        rows.push(BenchRow {
-            cpu: field(cols[0])?.to_string(),
-            model: field(cols[1])?.to_string(),
-            operation: field(cols[2])?.to_string(),
-            instructions: number(instr)?,
-            error: number(err)?,
-        });
-    }
+    let rows = records::parse::<BenchRow>(text, "bench CSV")?;
     Ok(rows.into_iter().filter(plotted).collect())
+}
+
+/// A row's instructions per call (mean): the x axis.
+fn x(r: &BenchRow) -> f64 {
+    r.mean as f64
+}
+
+/// A row's error: the y axis (NaN where none was measured; such rows are not plotted).
+fn err(r: &BenchRow) -> f64 {
+    r.error.unwrap_or(f64::NAN)
 }
 
 /// Whether the figure plots `row`: every elliptic estimate, and the `table:` and
 /// `kernel:` variants where their core runs: f32 where there is an FPU (Cortex-M4F,
-/// M7), fixed point where there is none (Cortex-M0, M3).
+/// M7), fixed point where there is none (Cortex-M0, M3); each with an error measured
+/// and instructions counted.
 pub fn plotted(row: &BenchRow) -> bool {
+    if row.error.is_none_or(|e| !e.is_finite() || e < 0.0) || row.mean == 0 {
+        return false;
+    }
     let variant = row.operation.starts_with("table:") || row.operation.starts_with("kernel:");
     let fpu = matches!(row.cpu.as_str(), "cortex-m4f" | "cortex-m7");
     let where_it_runs = (row.model == "f32" && fpu) || (row.model == "fixed" && !fpu);
@@ -113,7 +68,7 @@ impl Axes {
     fn of(rows: &[BenchRow]) -> Self {
         let min_err = rows
             .iter()
-            .map(|r| r.error)
+            .map(err)
             .filter(|e| *e > 0.0)
             .fold(f64::INFINITY, f64::min);
         let floor = if min_err.is_finite() {
@@ -122,10 +77,10 @@ impl Axes {
             1e-16
         };
         // Three times the largest count leaves room for the labels right of the points.
-        let (x_lo, _) = decades(rows.iter().map(|r| r.instructions));
-        let (_, x_hi) = decades(rows.iter().map(|r| r.instructions * 3.0));
-        let (y_lo, y_hi) = decades(rows.iter().map(|r| r.error.max(floor)));
-        let has_zero = rows.iter().any(|r| r.error == 0.0);
+        let (x_lo, _) = decades(rows.iter().map(x));
+        let (_, x_hi) = decades(rows.iter().map(|r| x(r) * 3.0));
+        let (y_lo, y_hi) = decades(rows.iter().map(|r| err(r).max(floor)));
+        let has_zero = rows.iter().any(|r| err(r) == 0.0);
         Axes {
             floor,
             x_lo,
@@ -196,14 +151,7 @@ fn panels(rows: &[BenchRow]) -> Vec<Panel> {
     }
     let of =
         |cpu: &str| -> Vec<BenchRow> { rows.iter().filter(|r| r.cpu == cpu).cloned().collect() };
-    let key = |r: &BenchRow| {
-        (
-            r.model.clone(),
-            r.operation.clone(),
-            r.instructions,
-            r.error,
-        )
-    };
+    let key = |r: &BenchRow| (r.model.clone(), r.operation.clone(), x(r), err(r));
     let m4f: Vec<_> = of("cortex-m4f").iter().map(key).collect();
     let m7 = of("cortex-m7");
     let merged = !m4f.is_empty() && !m7.is_empty() && m7.iter().all(|r| m4f.contains(&key(r)));
@@ -244,11 +192,7 @@ pub fn speed_vs_error_svg(rows: &[BenchRow]) -> Res<String> {
 
 /// The figure and where its point labels went (for the tests).
 pub(super) fn speed_vs_error_layout(rows: &[BenchRow]) -> Res<(String, LabelReport)> {
-    let rows: Vec<BenchRow> = rows
-        .iter()
-        .filter(|r| plotted(r) && r.instructions > 0.0)
-        .cloned()
-        .collect();
+    let rows: Vec<BenchRow> = rows.iter().filter(|r| plotted(r)).cloned().collect();
     if rows.is_empty() {
         return Err("bench CSV has no estimate, table: or kernel: row to plot".into());
     }
@@ -282,7 +226,7 @@ fn draw_panel(
     models: &[(&str, RGBColor)],
     numbered: &[(String, String)],
 ) -> Res<Labels> {
-    let y_of = |r: &BenchRow| r.error.max(axes.floor);
+    let y_of = |r: &BenchRow| err(r).max(axes.floor);
     let mut chart = ChartBuilder::on(cell)
         .caption(&panel.title, (FONT, PANEL_TITLE))
         .margin(12)
@@ -328,7 +272,7 @@ fn draw_panel(
     // Markers first; their boxes keep the labels off them.
     let mut pending: Vec<(String, (i32, i32), RGBColor)> = Vec::new();
     for r in panel.rows.iter().filter(|r| r.operation != "estimate") {
-        let at = chart.backend_coord(&(r.instructions, y_of(r)));
+        let at = chart.backend_coord(&(x(r), y_of(r)));
         root.draw(&TriangleMarker::new(at, 6, GREY.filled()))?;
         labels.mark(at, 6);
         let k = (r.model.clone(), r.operation.clone());
@@ -341,7 +285,7 @@ fn draw_panel(
             .iter()
             .filter(|r| r.operation == "estimate" && r.model == model)
         {
-            let at = chart.backend_coord(&(r.instructions, y_of(r)));
+            let at = chart.backend_coord(&(x(r), y_of(r)));
             root.draw(&Circle::new(at, 7, color.filled()))?;
             labels.mark(at, 7);
             // The estimates' names first: the fewer labels, the larger.
@@ -444,24 +388,16 @@ cortex-m4f,f32,cbrt,18,18,1.0e-7
 ";
 
     #[test]
-    fn bench_csv_rows_are_read_by_name() {
+    fn bench_csv_rows_plotted() {
         let rows = parse_bench_csv(SAMPLE).unwrap();
         assert_eq!(rows.len(), 8, "the plain `cbrt` row is not plotted");
         assert_eq!(rows[1].model, "f32");
-        assert_eq!((rows[1].instructions, rows[1].error), (120.0, 5.6e-7));
-        assert!(parse_bench_csv("cpu,model,operation\n").is_err());
-        let bad = "cpu,model,operation,instructions_mean,instructions_max,max_rel_error\n\
-                   m0,f32,estimate,abc,1,1e-7\n";
-        assert!(parse_bench_csv(bad).is_err());
-        let reordered = "max_rel_error,operation,model,cpu,instructions_mean\n\
-                         1e-7,estimate,f32,cortex-m7,100\n\
-                         ,estimate,f32,cortex-m7,100\n";
-        let rows = parse_bench_csv(reordered).unwrap();
-        assert_eq!(rows.len(), 1);
-        assert_eq!(
-            (rows[0].cpu.as_str(), rows[0].instructions),
-            ("cortex-m7", 100.0)
-        );
+        assert_eq!((x(&rows[1]), err(&rows[1])), (120.0, 5.6e-7));
+        let profile = "cpu,model,operation,instructions_mean,instructions_max,max_rel_error
+                       cortex-m7,f32,estimate,100,120,1e-7
+                       cortex-m7,f32,estimate,100,120,
+";
+        assert_eq!(parse_bench_csv(profile).unwrap().len(), 1);
     }
 
     #[test]
@@ -521,7 +457,7 @@ cortex-m4f,f32,cbrt,18,18,1.0e-7
         // One count differs: the M7 has a panel of its own.
         rows.retain(|r| r.cpu != "cortex-m7");
         rows.extend(m7.into_iter().map(|r| BenchRow {
-            instructions: r.instructions + 1.0,
+            mean: r.mean + 1,
             ..r
         }));
         assert_eq!(titles(&rows), ["Cortex-M4F", "Cortex-M0", "Cortex-M7"]);

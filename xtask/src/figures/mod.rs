@@ -13,9 +13,10 @@ mod labels;
 mod paper;
 mod shapes_plot;
 
-pub use bench_plot::{BenchRow, speed_vs_error};
-pub use shapes_plot::{ShapeRow, fronts, shapes_csv};
+pub use bench_plot::speed_vs_error;
+pub use shapes_plot::fronts;
 
+use crate::records::{self, BenchRow, Record, ShapeRow};
 use std::error::Error;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -142,11 +143,8 @@ fn legend_dashed(
     move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 28, y)], 9, 5, style)
 }
 
-/// Name of the benchmark's CSV and of its figure under `docs/`.
-const BENCH_CSV: &str = "bench.csv";
-const SPEED_SVG: &str = "speed-vs-error.svg";
-/// Name of the table shapes' CSV and of its figure under `docs/`.
-pub const SHAPES_CSV: &str = "shapes.csv";
+/// Names of the benchmark's figure and of the table shapes' under `docs/`.
+pub const SPEED_SVG: &str = "speed-vs-error.svg";
 pub const SHAPES_SVG: &str = "table-shapes.svg";
 
 /// Writes the table shapes' figure of `rows` to `svg_path`.
@@ -188,7 +186,7 @@ fn warn_labels(name: &str, report: &labels::LabelReport) {
 /// (docs/shapes.csv), with where their labels went.
 fn measured_figures(docs: &Path) -> Res<Vec<(&'static str, String, labels::LabelReport)>> {
     let mut out = Vec::new();
-    let csv = docs.join(BENCH_CSV);
+    let csv = docs.join(BenchRow::FILE);
     if csv.exists() {
         let rows = bench_plot::parse_bench_csv(&std::fs::read_to_string(&csv)?)?;
         let (svg, report) = bench_plot::speed_vs_error_layout(&rows)?;
@@ -199,9 +197,9 @@ fn measured_figures(docs: &Path) -> Res<Vec<(&'static str, String, labels::Label
             csv.display()
         );
     }
-    let csv = docs.join(SHAPES_CSV);
+    let csv = docs.join(ShapeRow::FILE);
     if csv.exists() {
-        let rows = shapes_plot::parse_shapes_csv(&std::fs::read_to_string(&csv)?)?;
+        let rows = records::parse::<ShapeRow>(&std::fs::read_to_string(&csv)?, "shapes CSV")?;
         let (svg, report) = shapes_plot::table_shapes_layout(&rows)?;
         out.push((SHAPES_SVG, svg, report));
     } else {

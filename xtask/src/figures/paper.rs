@@ -6,6 +6,7 @@ use super::{
 };
 use misalign::Scene;
 use misalign::reference::{self, Elliptic, line, normal, tangential};
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
@@ -157,6 +158,80 @@ pub fn fig2_traction(case: &Fig2Case) -> Vec<(f64, f64, f64)> {
         .collect()
 }
 
+/// A chart of the paper's figures: f64 on both axes.
+type Chart<'a, 'b, X, Y> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>;
+
+/// Two curves of `data` `(x, y1, y2)`: y1 solid blue, y2 dashed vermilion, each with
+/// its legend entry.
+fn solid_and_dashed<X, Y>(
+    chart: &mut Chart<'_, '_, X, Y>,
+    data: &[(f64, f64, f64)],
+    solid: &str,
+    dashed: &str,
+) -> Res<()>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let style = BLUE_.stroke_width(3);
+    chart
+        .draw_series(LineSeries::new(data.iter().map(|&(x, y, _)| (x, y)), style))?
+        .label(solid)
+        .legend(legend_line(style));
+    let style = VERMILION.stroke_width(3);
+    chart
+        .draw_series(DashedLineSeries::new(
+            data.iter().map(|&(x, _, y)| (x, y)),
+            12,
+            6,
+            style,
+        ))?
+        .label(dashed)
+        .legend(legend_dashed(style));
+    Ok(())
+}
+
+/// An axis: its description and its labels' format.
+type Axis<'a> = (&'a str, &'a dyn Fn(&f64) -> String);
+
+/// The grid, the axes' descriptions and labels, in the figure font.
+fn mesh<X, Y>(chart: &mut Chart<'_, '_, X, Y>, x: Axis, y: Axis) -> Res<()>
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    chart
+        .configure_mesh()
+        .x_desc(x.0)
+        .y_desc(y.0)
+        .x_label_formatter(x.1)
+        .y_label_formatter(y.1)
+        .axis_desc_style((FONT, DESC))
+        .label_style((FONT, LABEL))
+        .light_line_style(WHITE)
+        .bold_line_style(LIGHT)
+        .draw()?;
+    Ok(())
+}
+
+/// The legend box at `at`, `margin` px from the plot's edge.
+fn legend<'a, 'b: 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, SVGBackend<'b>, CT>,
+    at: SeriesLabelPosition,
+    margin: u32,
+) -> Res<()> {
+    chart
+        .configure_series_labels()
+        .position(at)
+        .margin(margin)
+        .legend_area_size(40)
+        .background_style(WHITE)
+        .border_style(GREY)
+        .label_font((FONT, LABEL))
+        .draw()?;
+    Ok(())
+}
+
 /// Fig. 1: m and n versus theta, log-log.
 pub fn fig1() -> Res<String> {
     let data = fig1_data(&theta_grid(THETA_POINTS));
@@ -170,44 +245,21 @@ pub fn fig1() -> Res<String> {
             .x_label_area_size(62)
             .y_label_area_size(90)
             .build_cartesian_2d(log_axis(-6, -1), log_axis(-3, 5))?;
-        chart
-            .configure_mesh()
-            .x_desc("auxiliary angle θ (rad), eq (4); θ = φ for equal radii")
-            .y_desc("m, n (dimensionless): a = m L, b = n L")
-            .x_label_formatter(&power_of_ten)
-            .y_label_formatter(&power_of_ten)
-            .axis_desc_style((FONT, DESC))
-            .label_style((FONT, LABEL))
-            .light_line_style(WHITE)
-            .bold_line_style(LIGHT)
-            .draw()?;
-        let m_style = BLUE_.stroke_width(3);
-        chart
-            .draw_series(LineSeries::new(
-                data.iter().map(|&(t, m, _)| (t, m)),
-                m_style,
-            ))?
-            .label("m: semi-axis a along the rollers")
-            .legend(legend_line(m_style));
-        let n_style = VERMILION.stroke_width(3);
-        chart
-            .draw_series(DashedLineSeries::new(
-                data.iter().map(|&(t, _, n)| (t, n)),
-                12,
-                6,
-                n_style,
-            ))?
-            .label("n: semi-axis b across (rolling direction)")
-            .legend(legend_dashed(n_style));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .margin(12)
-            .legend_area_size(40)
-            .background_style(WHITE)
-            .border_style(GREY)
-            .label_font((FONT, LABEL))
-            .draw()?;
+        mesh(
+            &mut chart,
+            (
+                "auxiliary angle θ (rad), eq (4); θ = φ for equal radii",
+                &power_of_ten,
+            ),
+            ("m, n (dimensionless): a = m L, b = n L", &power_of_ten),
+        )?;
+        solid_and_dashed(
+            &mut chart,
+            &data,
+            "m: semi-axis a along the rollers",
+            "n: semi-axis b across (rolling direction)",
+        )?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight, 12)?;
         root.draw_text(
             "L³ = 3P(1 − ν)R1R2 / (2G(R1 + R2)); a/b = m/n = 1/k′",
             &text(NOTE, GREY, HPos::Right, VPos::Bottom),
@@ -401,17 +453,14 @@ pub fn fig3() -> Res<String> {
             .x_label_area_size(62)
             .y_label_area_size(90)
             .build_cartesian_2d(log_axis(-6, -1), log_axis(-13, -1))?;
-        chart
-            .configure_mesh()
-            .x_desc("auxiliary angle θ (rad), eq (4); θ = φ for equal radii")
-            .y_desc("μ³ P₀* (dimensionless; P* of eq 17)")
-            .x_label_formatter(&power_of_ten)
-            .y_label_formatter(&power_of_ten)
-            .axis_desc_style((FONT, DESC))
-            .label_style((FONT, LABEL))
-            .light_line_style(WHITE)
-            .bold_line_style(LIGHT)
-            .draw()?;
+        mesh(
+            &mut chart,
+            (
+                "auxiliary angle θ (rad), eq (4); θ = φ for equal radii",
+                &power_of_ten,
+            ),
+            ("μ³ P₀* (dimensionless; P* of eq 17)", &power_of_ten),
+        )?;
         let style = BLUE_.stroke_width(3);
         chart
             .draw_series(LineSeries::new(data.iter().copied(), style))?
@@ -429,15 +478,7 @@ pub fn fig3() -> Res<String> {
                 text(NOTE, BLACK, HPos::Center, VPos::Center),
             ),
         ])?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .margin(12)
-            .legend_area_size(40)
-            .background_style(WHITE)
-            .border_style(GREY)
-            .label_font((FONT, LABEL))
-            .draw()?;
+        legend(&mut chart, SeriesLabelPosition::UpperLeft, 12)?;
         Ok(())
     })
 }
@@ -455,17 +496,14 @@ pub fn fig4() -> Res<String> {
             .x_label_area_size(62)
             .y_label_area_size(80)
             .build_cartesian_2d(0.0..1.2, 0.0..1.1)?;
-        chart
-            .configure_mesh()
-            .x_desc("slip ratio d/b (dimensionless), eqs (15)-(16)")
-            .y_desc("F/(μP) (dimensionless)")
-            .x_label_formatter(&one_decimal)
-            .y_label_formatter(&one_decimal)
-            .axis_desc_style((FONT, DESC))
-            .label_style((FONT, LABEL))
-            .light_line_style(WHITE)
-            .bold_line_style(LIGHT)
-            .draw()?;
+        mesh(
+            &mut chart,
+            (
+                "slip ratio d/b (dimensionless), eqs (15)-(16)",
+                &one_decimal,
+            ),
+            ("F/(μP) (dimensionless)", &one_decimal),
+        )?;
         chart.draw_series(DashedLineSeries::new(
             [(1.0, 0.0), (1.0, 1.1)],
             4,
@@ -484,30 +522,13 @@ pub fn fig4() -> Res<String> {
                 text(NOTE, GREY, HPos::Center, VPos::Center),
             ),
         ])?;
-        let ell = BLUE_.stroke_width(3);
-        chart
-            .draw_series(LineSeries::new(data.iter().map(|&(s, f, _)| (s, f)), ell))?
-            .label("contact ellipse, eq (21)")
-            .legend(legend_line(ell));
-        let strip = VERMILION.stroke_width(3);
-        chart
-            .draw_series(DashedLineSeries::new(
-                data.iter().map(|&(s, _, l)| (s, l)),
-                12,
-                6,
-                strip,
-            ))?
-            .label("line contact, 2(d/b) − (d/b)², eq (27)")
-            .legend(legend_dashed(strip));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .margin(16)
-            .legend_area_size(40)
-            .background_style(WHITE)
-            .border_style(GREY)
-            .label_font((FONT, LABEL))
-            .draw()?;
+        solid_and_dashed(
+            &mut chart,
+            &data,
+            "contact ellipse, eq (21)",
+            "line contact, 2(d/b) − (d/b)², eq (27)",
+        )?;
+        legend(&mut chart, SeriesLabelPosition::LowerRight, 16)?;
         Ok(())
     })
 }

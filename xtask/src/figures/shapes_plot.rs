@@ -6,118 +6,9 @@ use super::{
     Area, BLUE_, FONT, GREEN_, GREY, LIGHT, ORANGE, Res, VERMILION, log_axis, power_of_ten,
     render_sized, text,
 };
+use crate::records::ShapeRow;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
-use std::fmt::Write as _;
-
-/// One row of docs/shapes.csv: one shape of one table on one core.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ShapeRow {
-    /// `cortex-m4f`, ...
-    pub cpu: String,
-    /// `g`, `theta_of_g`, `log_g`, `log_theta_of_g`.
-    pub table: String,
-    /// `f32` or `fixed`.
-    pub core: String,
-    /// `library` (the library's kernel, measured in the same run), `shipped` (the
-    /// shape the library ships, generated and measured like every other) or `variant`.
-    pub kind: String,
-    /// `u-s1-d6`, `quad-4+32`, ...; `library` for the library's kernel.
-    pub shape: String,
-    /// `u`, `t` (f32) or `log2` (fixed point).
-    pub variable: String,
-    /// Segments per octave of the table's argument: `4`, or `4+32` for two tables.
-    pub segments: String,
-    /// Polynomial degree per segment (fixed point: 1 linear, 2 quadratic).
-    pub degree: u32,
-    /// Table data in flash.
-    pub bytes: u64,
-    /// Instructions per evaluation, mean and maximum.
-    pub mean: f64,
-    pub max: f64,
-    /// Worst relative error against the f64 reference.
-    pub error: f64,
-}
-
-const HEADER: &str = "cpu,table,core,kind,shape,variable,segments_per_octave,degree,bytes,instructions_mean,instructions_max,max_rel_error";
-
-/// docs/shapes.csv's text of `rows`.
-pub fn shapes_csv(rows: &[ShapeRow]) -> String {
-    let mut s = format!("{HEADER}\n");
-    for r in rows {
-        writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{},{},{:.3e}",
-            r.cpu,
-            r.table,
-            r.core,
-            r.kind,
-            r.shape,
-            r.variable,
-            r.segments,
-            r.degree,
-            r.bytes,
-            r.mean,
-            r.max,
-            r.error
-        )
-        .unwrap();
-    }
-    s
-}
-
-/// The rows of docs/shapes.csv (columns by name, in any order).
-///
-/// # Errors
-/// A missing column, a malformed record or a number that does not parse.
-pub fn parse_shapes_csv(text: &str) -> Res<Vec<ShapeRow>> {
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
-    let headers = reader.headers()?.clone();
-    let names: Vec<&str> = HEADER.split(',').collect();
-    let cols = names
-        .iter()
-        .map(|name| {
-            headers
-                .iter()
-                .position(|h| h == *name)
-                .ok_or_else(|| format!("shapes CSV has no column `{name}`"))
-        })
-        .collect::<Result<Vec<usize>, String>>()?;
-    let mut rows = Vec::new();
-    for (index, record) in reader.records().enumerate() {
-        let record = record?;
-        let line = index + 2;
-        let field = |i: usize| {
-            record
-                .get(cols[i])
-                .ok_or_else(|| format!("shapes CSV line {line}: too few fields"))
-        };
-        let number = |i: usize| -> Res<f64> {
-            let s = field(i)?;
-            Ok(s.parse::<f64>()
-                .ok()
-                .filter(|v| !v.is_nan() && *v >= 0.0)
-                .ok_or_else(|| format!("shapes CSV line {line}: bad number `{s}`"))?)
-        };
-        rows.push(ShapeRow {
-            cpu: field(0)?.to_string(),
-            table: field(1)?.to_string(),
-            core: field(2)?.to_string(),
-            kind: field(3)?.to_string(),
-            shape: field(4)?.to_string(),
-            variable: field(5)?.to_string(),
-            segments: field(6)?.to_string(),
-            degree: number(7)? as u32,
-            bytes: number(8)? as u64,
-            mean: number(9)?,
-            max: number(10)?,
-            error: number(11)?,
-        });
-    }
-    Ok(rows)
-}
 
 /// Errors within this factor of each other count as equal on the Pareto front: each
 /// is the maximum over a sample of the domain, and at the f32 floor (about 1e-7) what
@@ -614,16 +505,17 @@ mod tests {
 
     #[test]
     fn the_csv_reads_back_what_it_wrote() {
+        use crate::records::{parse, to_csv};
         let rows = vec![
             row("library", 23.0, 4.126e-7, 1312),
             row("u-s1-d6", 23.0, 4.126e-7, 1312),
         ];
-        let text = shapes_csv(&rows);
+        let text = to_csv(&rows);
         assert!(text.starts_with("cpu,table,core,kind,shape,"));
-        assert_eq!(parse_shapes_csv(&text).unwrap(), rows);
-        assert!(parse_shapes_csv("cpu,table\ncortex-m0,g\n").is_err());
+        assert_eq!(parse::<ShapeRow>(&text, "t").unwrap(), rows);
+        assert!(parse::<ShapeRow>("cpu,table\ncortex-m0,g\n", "t").is_err());
         let bad = text.replace("4.126e-7\n", "x\n");
-        assert!(parse_shapes_csv(&bad).is_err());
+        assert!(parse::<ShapeRow>(&bad, "t").is_err());
     }
 
     #[test]
