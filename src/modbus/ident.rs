@@ -105,7 +105,7 @@ pub(crate) fn read(
         slot[1] = bytes.len() as u8;
         slot[2..].copy_from_slice(bytes);
         at = end;
-        count += 1;
+        count = count.saturating_add(1);
     }
     if let Some(tail) = out.get_mut(4..7) {
         tail.copy_from_slice(&[more, next, count]);

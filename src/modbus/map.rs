@@ -202,6 +202,13 @@ pub struct Entry {
     pub(crate) field: Field,
 }
 
+impl Entry {
+    /// The address after the value.
+    pub const fn end(&self) -> u16 {
+        self.address.saturating_add(self.ty.words())
+    }
+}
+
 /// A block of `count` records of `stride` registers (or bits) from `address`.
 #[derive(Debug, Clone, Copy)]
 pub struct Block {
@@ -222,7 +229,8 @@ pub struct Block {
 impl Block {
     /// The address after the block.
     pub const fn end(&self) -> u16 {
-        self.address + self.count * self.stride
+        self.address
+            .saturating_add(self.count.saturating_mul(self.stride))
     }
 }
 
@@ -550,7 +558,7 @@ impl TableMap {
 
     /// The address after the single entries.
     pub fn entries_end(&self) -> u16 {
-        self.entries.last().map_or(0, |e| e.address + e.ty.words())
+        self.entries.last().map_or(0, Entry::end)
     }
 
     /// The address after the table.
@@ -562,27 +570,24 @@ impl TableMap {
     /// entry), and the register's word within the value (0 high, 1 low).
     pub(crate) fn locate(&self, address: u16) -> Option<Located> {
         if address < self.entries_end() {
-            let i = self
-                .entries
-                .partition_point(|e| e.address + e.ty.words() <= address);
+            let i = self.entries.partition_point(|e| e.end() <= address);
             let entry = self.entries.get(i)?;
             return Some(Located {
                 entry,
                 record: 0,
-                word: address - entry.address,
+                word: address.checked_sub(entry.address)?,
             });
         }
         let block = self.blocks.iter().find(|b| address < b.end())?;
         let offset = address.checked_sub(block.address)?;
-        let (record, at) = (offset / block.stride, offset % block.stride);
-        let i = block
-            .fields
-            .partition_point(|e| e.address + e.ty.words() <= at);
+        let record = offset.checked_div(block.stride)?;
+        let at = offset.checked_rem(block.stride)?;
+        let i = block.fields.partition_point(|e| e.end() <= at);
         let entry = block.fields.get(i)?;
         Some(Located {
             entry,
             record,
-            word: at - entry.address,
+            word: at.checked_sub(entry.address)?,
         })
     }
 }

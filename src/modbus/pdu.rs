@@ -112,11 +112,9 @@ impl<E: Estimator> Core<E> {
             }
         };
         self.response[0] = self.unit;
-        let end = 1 + len;
-        let Some(body) = self.response.get(..end) else {
-            return;
-        };
-        let crc = crc::crc16(body).to_le_bytes();
+        // The PDU is at most 253 bytes: the ADU at most 256.
+        let end = len.min(253) + 1;
+        let crc = crc::crc16(self.response.get(..end).unwrap_or(&[])).to_le_bytes();
         if let Some(tail) = self.response.get_mut(end..end + 2) {
             tail.copy_from_slice(&crc);
             self.response_len = end + 2;
@@ -159,10 +157,13 @@ impl<E: Estimator> Core<E> {
         }
         let map = TableMap::of(table_of(function));
         in_map(map, start, quantity)?;
-        let bytes = usize::from(quantity.div_ceil(8));
+        // At most 2000 bits: 250 bytes.
+        let bytes = usize::from(quantity.div_ceil(8)).min(250);
         let mut packed = [0u8; 250];
         for i in 0..quantity {
-            let l = map.locate(start + i).ok_or(Exception::IllegalDataAddress)?;
+            let l = map
+                .locate(start.wrapping_add(i))
+                .ok_or(Exception::IllegalDataAddress)?;
             if self.value(l.entry.field, l.record) & 1 != 0
                 && let Some(b) = packed.get_mut(usize::from(i / 8))
             {
@@ -174,7 +175,9 @@ impl<E: Estimator> Core<E> {
             .get_mut(1..2 + bytes)
             .ok_or(Exception::ServerDeviceFailure)?;
         dest[0] = bytes as u8;
-        dest[1..].copy_from_slice(packed.get(..bytes).unwrap_or(&[]));
+        for (d, s) in dest[1..].iter_mut().zip(&packed) {
+            *d = *s;
+        }
         Ok(2 + bytes)
     }
 
@@ -187,10 +190,10 @@ impl<E: Estimator> Core<E> {
         in_map(map, start, quantity)?;
         let mut words = [0u16; READ_REGISTERS_MAX as usize];
         let words = words.get_mut(..usize::from(quantity)).unwrap_or(&mut []);
-        let mut i = 0;
+        let mut i = 0usize;
         while i < words.len() {
             let l = map
-                .locate(start + i as u16)
+                .locate(start.wrapping_add(i as u16))
                 .ok_or(Exception::IllegalDataAddress)?;
             let v = self.value(l.entry.field, l.record);
             let n = l.entry.ty.words();
@@ -204,7 +207,7 @@ impl<E: Estimator> Core<E> {
                 i += 1;
             }
         }
-        let bytes = 2 * usize::from(quantity);
+        let bytes = 2 * words.len();
         let out = self.out(function);
         let dest = out
             .get_mut(1..2 + bytes)
@@ -259,13 +262,13 @@ impl<E: Estimator> Core<E> {
         let map = TableMap::of(Table::Coil);
         in_map(map, start, quantity)?;
         for i in 0..quantity {
-            Self::writable(map, start + i)?;
+            Self::writable(map, start.wrapping_add(i))?;
         }
         for i in 0..quantity {
             let on = data
                 .get(usize::from(i / 8))
                 .is_some_and(|b| b >> (i % 8) & 1 != 0);
-            let l = Self::writable(map, start + i)?;
+            let l = Self::writable(map, start.wrapping_add(i))?;
             self.write_bit(l.entry.field, on);
         }
         self.echo(pdu)
@@ -309,7 +312,8 @@ impl<E: Estimator> Core<E> {
                 .and_then(|()| self.echo(pdu));
         }
         // Single entries only, each whole and writable: checked, then written.
-        let end = start + quantity;
+        // Inside the map (checked above): no u16 below wraps.
+        let end = start.wrapping_add(quantity);
         if end > map.entries_end() {
             return Err(Exception::IllegalDataAddress);
         }
@@ -318,12 +322,12 @@ impl<E: Estimator> Core<E> {
             while a < end {
                 let l = Self::writable(map, a)?;
                 let n = l.entry.ty.words();
-                if l.word != 0 || a + n > end {
+                if l.word != 0 || a.wrapping_add(n) > end {
                     return Err(Exception::IllegalDataAddress);
                 }
-                let i = a - start;
+                let i = a.wrapping_sub(start);
                 let v = if n == 2 {
-                    u32::from(word(i)) << 16 | u32::from(word(i + 1))
+                    u32::from(word(i)) << 16 | u32::from(word(i.wrapping_add(1)))
                 } else {
                     u32::from(word(i))
                 };
@@ -332,7 +336,7 @@ impl<E: Estimator> Core<E> {
                 } else {
                     self.check_word(l.entry.field, v)?;
                 }
-                a += n;
+                a = a.wrapping_add(n);
             }
         }
         self.echo(pdu)

@@ -197,21 +197,22 @@ impl Framer {
             if self.start == 0 {
                 self.drop_one();
             }
-            let start = self.start.min(self.len);
-            self.buf.copy_within(start..self.len, 0);
+            let len = self.len.min(ADU_MAX);
+            let start = self.start.min(len);
+            self.buf.copy_within(start..len, 0);
             self.overflowed |= self.consumed < start;
-            self.len -= start;
+            self.len = len - start;
             self.consumed = self.consumed.saturating_sub(start);
             self.start = 0;
         }
         if let Some(slot) = self.buf.get_mut(self.len) {
             *slot = byte;
-            self.len += 1;
+            self.len = self.len.saturating_add(1);
         }
     }
 
     fn drop_one(&mut self) {
-        self.start += 1;
+        self.start = self.start.saturating_add(1);
         self.counters.discarded = self.counters.discarded.saturating_add(1);
     }
 
@@ -237,7 +238,7 @@ impl Framer {
     }
 
     fn take(&mut self, n: usize) -> Range<usize> {
-        let range = self.start..self.start + n;
+        let range = self.start..self.start.saturating_add(n);
         self.start = range.end;
         self.consumed = range.end;
         self.counters.frames = self.counters.frames.saturating_add(1);
@@ -257,7 +258,7 @@ impl Framer {
             && crc::valid(bytes);
         if whole {
             // The bytes counted as dropped were a frame after all.
-            let n = (self.start - self.consumed) as u32;
+            let n = self.start.saturating_sub(self.consumed) as u32;
             self.counters.discarded = self.counters.discarded.saturating_sub(n);
             self.start = span.start;
             Some(self.take(span.len()))
