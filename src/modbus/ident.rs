@@ -6,7 +6,7 @@
 use super::pdu::Exception;
 
 /// What the node says it is (function 43/14). Each object is sent as is; one longer
-/// than [`OBJECT_MAX`] bytes is cut there.
+/// than 240 bytes is cut there (an object must fit one response).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Identification {
