@@ -570,24 +570,82 @@ impl TableMap {
     /// entry), and the register's word within the value (0 high, 1 low).
     pub(crate) fn locate(&self, address: u16) -> Option<Located> {
         if address < self.entries_end() {
-            let i = self.entries.partition_point(|e| e.end() <= address);
-            let entry = self.entries.get(i)?;
+            let index = self.entries.partition_point(|e| e.end() <= address);
+            let entry = self.entries.get(index)?;
             return Some(Located {
                 entry,
                 record: 0,
                 word: address.checked_sub(entry.address)?,
+                block: None,
+                index,
             });
         }
-        let block = self.blocks.iter().find(|b| address < b.end())?;
+        let b = self.blocks.iter().position(|b| address < b.end())?;
+        let block = self.blocks.get(b)?;
         let offset = address.checked_sub(block.address)?;
         let record = offset.checked_div(block.stride)?;
         let at = offset.checked_rem(block.stride)?;
-        let i = block.fields.partition_point(|e| e.end() <= at);
-        let entry = block.fields.get(i)?;
+        let index = block.fields.partition_point(|e| e.end() <= at);
+        let entry = block.fields.get(index)?;
         Some(Located {
             entry,
             record,
             word: at.checked_sub(entry.address)?,
+            block: Some(b),
+            index,
+        })
+    }
+
+    /// The value after `l` (its first word), in address order.
+    fn after(&self, l: &Located) -> Option<Located> {
+        let first_of = |b: usize, record: u16| {
+            let block = self.blocks.get(b)?;
+            Some(Located {
+                entry: block.fields.first()?,
+                record,
+                word: 0,
+                block: Some(b),
+                index: 0,
+            })
+        };
+        let next = l.index.wrapping_add(1);
+        match l.block {
+            None => match self.entries.get(next) {
+                Some(entry) => Some(Located {
+                    entry,
+                    record: 0,
+                    word: 0,
+                    block: None,
+                    index: next,
+                }),
+                None => first_of(0, 0),
+            },
+            Some(b) => {
+                let block = self.blocks.get(b)?;
+                if let Some(entry) = block.fields.get(next) {
+                    Some(Located {
+                        entry,
+                        index: next,
+                        word: 0,
+                        ..*l
+                    })
+                } else if l.record.wrapping_add(1) < block.count {
+                    first_of(b, l.record.wrapping_add(1))
+                } else {
+                    first_of(b.wrapping_add(1), 0)
+                }
+            }
+        }
+    }
+
+    /// The values from `address` on, in address order, the first from the word that
+    /// holds `address`: one search, then steps.
+    pub(crate) fn walk(&self, address: u16) -> impl Iterator<Item = Located> + '_ {
+        let mut next = self.locate(address);
+        core::iter::from_fn(move || {
+            let current = next?;
+            next = self.after(&current);
+            Some(current)
         })
     }
 }
@@ -598,6 +656,10 @@ pub(crate) struct Located {
     pub entry: &'static Entry,
     pub record: u16,
     pub word: u16,
+    /// The block's index in the table, `None` for a single entry.
+    block: Option<usize>,
+    /// The entry's index in the single entries or the block's fields.
+    index: usize,
 }
 
 /// Writes the map as CSV with the header
@@ -682,6 +744,17 @@ mod tests {
                 assert!(l.word < l.entry.ty.words());
             }
             assert!(t.locate(t.end()).is_none());
+            // The walk from 0 steps through every value, as locating each does.
+            let mut at = 0;
+            for l in t.walk(0) {
+                let found = t.locate(at).unwrap();
+                assert_eq!(
+                    (l.entry.name, l.record, l.word),
+                    (found.entry.name, found.record, 0)
+                );
+                at += l.entry.ty.words();
+            }
+            assert_eq!(at, t.end());
         }
         let l = INPUTS
             .locate(EVENT_SLOTS_ADDRESS + EVENT_STRIDE + 12)

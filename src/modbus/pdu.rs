@@ -160,10 +160,8 @@ impl<E: Estimator> Core<E> {
         // At most 2000 bits: 250 bytes.
         let bytes = usize::from(quantity.div_ceil(8)).min(250);
         let mut packed = [0u8; 250];
-        for i in 0..quantity {
-            let l = map
-                .locate(start.wrapping_add(i))
-                .ok_or(Exception::IllegalDataAddress)?;
+        // Inside the map (checked above): one value a bit.
+        for (i, l) in (0..quantity).zip(map.walk(start)) {
             if self.value(l.entry.field, l.record) & 1 != 0
                 && let Some(b) = packed.get_mut(usize::from(i / 8))
             {
@@ -190,21 +188,21 @@ impl<E: Estimator> Core<E> {
         in_map(map, start, quantity)?;
         let mut words = [0u16; READ_REGISTERS_MAX as usize];
         let words = words.get_mut(..usize::from(quantity)).unwrap_or(&mut []);
-        let mut i = 0usize;
-        while i < words.len() {
-            let l = map
-                .locate(start.wrapping_add(i as u16))
-                .ok_or(Exception::IllegalDataAddress)?;
+        // Inside the map (checked above): each value computed once, its words taken
+        // from the one that holds `start`.
+        let mut slots = words.iter_mut();
+        'values: for l in map.walk(start) {
             let v = self.value(l.entry.field, l.record);
             let n = l.entry.ty.words();
             for w in l.word..n {
-                let Some(slot) = words.get_mut(i) else { break };
+                let Some(slot) = slots.next() else {
+                    break 'values;
+                };
                 *slot = if n == 2 && w == 0 {
                     (v >> 16) as u16
                 } else {
                     v as u16
                 };
-                i += 1;
             }
         }
         let bytes = 2 * words.len();
