@@ -233,6 +233,19 @@ fn exceptions_as_the_specification_orders_them() {
     );
     assert_eq!(exception(&request(&mut s, 5, &be(&[0, 0x1234])), 5), 3);
     assert_eq!(exception(&request(&mut s, 5, &be(&[6, 0xFF00])), 5), 2);
+    // Read-only holding registers: 02 by function 6 and 16, nothing changes.
+    assert_eq!(read(&mut s, 3, 5, 2), vec![1, 1]);
+    assert_eq!(
+        exception(&request(&mut s, 6, &be(&[5, 9])), 6),
+        2,
+        "unit_id"
+    );
+    assert_eq!(
+        exception(&write(&mut s, 4, &[1, 9]), 16),
+        2,
+        "external_mode, unit_id"
+    );
+    assert!(!s.external_samples(), "a refused write applies nothing");
     // A byte count that does not match the quantity: 03.
     let mut data = be(&[2, 1]);
     data.extend([4, 0, 1, 0, 2]);
@@ -242,7 +255,7 @@ fn exceptions_as_the_specification_orders_them() {
         3
     );
     // Every refused request left the state alone and was counted.
-    assert_eq!(s.counters().exceptions, 16);
+    assert_eq!(s.counters().exceptions, 18);
     assert_eq!(s.annunciator().latching(), AlarmSet::NONE);
 }
 

@@ -145,6 +145,9 @@ pub(crate) enum Field {
     AcknowledgeAlarms,
     LatchingAlarms,
     ExternalMode,
+    UnitId,
+    MapVersion,
+
     /// An external sample's field (the basic or the full record).
     Sample(SampleField),
 }
@@ -314,6 +317,10 @@ pub static DISCRETES: TableMap = TableMap {
     blocks: &[],
 };
 
+/// The register map's version (holding register `map_version`): a change of an
+/// address, a type or a meaning increments it.
+pub const MAP_VERSION: u16 = 1;
+
 /// Where the event window's header starts (input registers).
 pub const EVENT_WINDOW_ADDRESS: u16 = 82;
 /// Where the event window's slots start (input registers).
@@ -469,7 +476,7 @@ static EVENT_FIELDS: [Entry; 15] = [
 ];
 
 /// Where the basic external samples start (holding registers).
-pub const SAMPLES_ADDRESS: u16 = 5;
+pub const SAMPLES_ADDRESS: u16 = 7;
 /// Records of the basic block: the most one function-16 write carries.
 pub const SAMPLES: u16 = 20;
 /// Registers per basic record (time, P, phi).
@@ -520,7 +527,11 @@ pub static HOLDINGS: TableMap = TableMap {
         e!(Holding, 3, "latching", U16, "", Rw, F::LatchingAlarms,
             "the alarms that latch, bits 0-3 as in acknowledge_alarms (the coils latch_* alike)"),
         e!(Holding, 4, "external_mode", U16, "", Rw, F::ExternalMode,
-            "1: external samples are processed, 0: refused (the coil external_samples alike)"),
+                        "1: external samples are processed, 0: refused (the coil external_samples alike)"),
+        e!(Holding, 5, "unit_id", U16, "", R, F::UnitId,
+            "the unit id this node answers (read only)"),
+        e!(Holding, 6, "map_version", U16, "", R, F::MapVersion,
+            "the version of this register map (read only): a change of an address, type or meaning increments it"),
     ],
     blocks: &[
         Block {

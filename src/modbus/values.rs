@@ -343,6 +343,8 @@ impl<E: Estimator> Core<E> {
             Field::EventsMissed => self.events.missed(m.next_event_seq()),
             Field::Event(f) => self.events.slot(record).map_or(0, |e| event_value(e, f)),
             Field::EventFrom => self.events.from,
+            Field::UnitId => u32::from(self.unit),
+            Field::MapVersion => u32::from(super::map::MAP_VERSION),
         }
     }
 
