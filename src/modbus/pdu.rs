@@ -141,15 +141,6 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    /// The response PDU's buffer: `[function, ...]`, 253 bytes.
-    fn out(&mut self, function: u8) -> &mut [u8] {
-        let out = self.response.get_mut(1..254).unwrap_or(&mut []);
-        if let Some(f) = out.first_mut() {
-            *f = function;
-        }
-        out
-    }
-
     fn read_bits(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
         let (start, quantity) = head(pdu)?;
         if quantity == 0 || quantity > READ_BITS_MAX {
@@ -157,24 +148,20 @@ impl<E: Estimator> Core<E> {
         }
         let map = TableMap::of(table_of(function));
         in_map(map, start, quantity)?;
-        // At most 2000 bits: 250 bytes.
+        // At most 2000 bits: 250 bytes, from response[3].
         let bytes = usize::from(quantity.div_ceil(8)).min(250);
-        let mut packed = [0u8; 250];
-        // Inside the map (checked above): one value a bit.
+        self.response[1] = function;
+        self.response[2] = bytes as u8;
+        if let Some(packed) = self.response.get_mut(3..3 + bytes) {
+            packed.fill(0);
+        }
+        // Inside the map (checked above): one value a bit, packed into the response as
+        // it is computed.
         for (i, l) in (0..quantity).zip(map.walk(start)) {
-            if self.value(l.entry.field, l.record) & 1 != 0
-                && let Some(b) = packed.get_mut(usize::from(i / 8))
-            {
+            let on = self.value(l.entry.field, l.record) & 1 != 0;
+            if on && let Some(b) = self.response.get_mut(3 + usize::from(i / 8)) {
                 *b |= 1 << (i % 8);
             }
-        }
-        let out = self.out(function);
-        let dest = out
-            .get_mut(1..2 + bytes)
-            .ok_or(Exception::ServerDeviceFailure)?;
-        dest[0] = bytes as u8;
-        for (d, s) in dest[1..].iter_mut().zip(&packed) {
-            *d = *s;
         }
         Ok(2 + bytes)
     }
@@ -186,33 +173,27 @@ impl<E: Estimator> Core<E> {
         }
         let map = TableMap::of(table_of(function));
         in_map(map, start, quantity)?;
-        let mut words = [0u16; READ_REGISTERS_MAX as usize];
-        let words = words.get_mut(..usize::from(quantity)).unwrap_or(&mut []);
-        // Inside the map (checked above): each value computed once, its words taken
-        // from the one that holds `start`.
-        let mut slots = words.iter_mut();
+        // At most 125 registers: 250 bytes, from response[3].
+        let bytes = 2 * usize::from(quantity).min(125);
+        self.response[1] = function;
+        self.response[2] = bytes as u8;
+        // Inside the map (checked above): each value computed once and its words
+        // written into the response, from the word that holds `start`.
+        let mut at = 3;
+        let end = 3 + bytes;
         'values: for l in map.walk(start) {
             let v = self.value(l.entry.field, l.record);
             let n = l.entry.ty.words();
             for w in l.word..n {
-                let Some(slot) = slots.next() else {
+                let word = if n == 2 && w == 0 { v >> 16 } else { v } as u16;
+                if at >= end {
                     break 'values;
-                };
-                *slot = if n == 2 && w == 0 {
-                    (v >> 16) as u16
-                } else {
-                    v as u16
-                };
+                }
+                if let Some(slot) = self.response.get_mut(at..at + 2) {
+                    slot.copy_from_slice(&word.to_be_bytes());
+                }
+                at += 2;
             }
-        }
-        let bytes = 2 * words.len();
-        let out = self.out(function);
-        let dest = out
-            .get_mut(1..2 + bytes)
-            .ok_or(Exception::ServerDeviceFailure)?;
-        dest[0] = bytes as u8;
-        for (d, w) in dest[1..].chunks_exact_mut(2).zip(words.iter()) {
-            d.copy_from_slice(&w.to_be_bytes());
         }
         Ok(2 + bytes)
     }
