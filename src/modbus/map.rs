@@ -676,7 +676,7 @@ pub(crate) struct Located {
 /// Writes the map as CSV with the header
 /// `table,address,name,type,scale,unit,access,description`: one row per value, a
 /// block's records expanded (`event_0_seq`, ...). `docs/modbus/registers.csv` is this
-/// output (`cargo run --example modbus_registers > docs/modbus/registers.csv`).
+/// output (`cargo run --example modbus_registers --features modbus > docs/modbus/registers.csv`).
 pub fn registers_csv(out: &mut impl fmt::Write) -> fmt::Result {
     writeln!(out, "table,address,name,type,scale,unit,access,description")?;
     let row = |out: &mut dyn fmt::Write, e: &Entry, address: u16, prefix: Option<(&str, u16)>| {

@@ -28,9 +28,19 @@
 //! [`Server::idle`]; without a clock the framer still finds every frame of a known
 //! function code from its length and CRC, resynchronising after garbage, and answers
 //! a function code it does not know (exception 01) only at a silence. The node's own
-//! sensors' samples go through [`Server::process`], so that the map follows them. With the feature
-//! `embedded-io`, [`Server::poll`] and [`Server::serve`] do the byte loop over any
-//! UART implementing the `embedded-io` 0.7 traits.
+//! sensors' samples go through [`Server::process`], so that the map follows them. With
+//! the feature `embedded-io`, `Server::poll` (without blocking) and `Server::serve`
+//! (blocking, one request) do the byte loop over any UART implementing the
+//! `embedded-io` 0.7 traits.
+//!
+//! The whole API: [`Server::new`] (or [`Server::with_friction`] for an f32 scene, mu
+//! tracked from a measured axial force) with a [`ServerConfig`] (unit id,
+//! [`Identification`], external samples on or off, the latching [`AlarmSet`]);
+//! `receive`, `idle`, `response`, `sent` for the bus; `process` for samples;
+//! `monitor`, `annunciator`, `acknowledge`, `external_samples`, `unit_id`,
+//! `counters`, `into_monitor`. Beside it: [`registers_csv`], [`silence_us`], the map's
+//! addresses in [`map`], and for a master written in Rust [`event_from_registers`]
+//! and [`fault_from_code`].
 //!
 //! **External samples** written by a master over the bus (holding blocks `sample_*`,
 //! up to 20 in one function-16 write, and `sample_full_*` with speed and axial force)
@@ -43,7 +53,7 @@
 //!
 //! **The map** ([`map`]) is one table in code: the server reads and writes through it,
 //! and [`registers_csv`] writes it as `docs/modbus/registers.csv`
-//! (`cargo run --example modbus_registers > docs/modbus/registers.csv`). 32-bit
+//! (`cargo run --example modbus_registers --features modbus > docs/modbus/registers.csv`). 32-bit
 //! values take two registers, high word first; a value with none reads as the quiet
 //! NaN `0x7FC0_0000` ([`NONE`]). `docs/modbus.md` is the integrator's page.
 //!
