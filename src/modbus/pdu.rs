@@ -190,7 +190,8 @@ impl<E: Estimator> Core<E> {
                     break 'values;
                 }
                 if let Some(slot) = self.response.get_mut(at..at + 2) {
-                    slot.copy_from_slice(&word.to_be_bytes());
+                    slot[0] = (word >> 8) as u8;
+                    slot[1] = word as u8;
                 }
                 at += 2;
             }
