@@ -184,17 +184,21 @@ type Step<E> = fn(&mut Monitor<E>, Sample) -> RiskState;
 
 /// The Modbus RTU server: the monitor, the register map's state, the framer.
 #[derive(Debug, Clone)]
+#[repr(C)]
 pub struct Server<E> {
     framer: Framer,
     core: Core<E>,
 }
 
 /// Everything but the framer (whose buffer holds the request being answered).
+/// `repr(C)`: what every request touches first, the buffers and the monitor after.
 #[derive(Debug, Clone)]
+#[repr(C)]
 struct Core<E> {
-    monitor: Monitor<E>,
-    step: Step<E>,
+    /// The response's length; 0: none due.
+    response_len: usize,
     unit: u8,
+    step: Step<E>,
     ident: Identification,
     model_name: &'static str,
     annunciator: Annunciator,
@@ -204,8 +208,7 @@ struct Core<E> {
     last_time_ms: u32,
     counters: Counters,
     response: [u8; ADU_MAX],
-    /// The response's length; 0: none due.
-    response_len: usize,
+    monitor: Monitor<E>,
 }
 
 impl<E: Estimator> Server<E> {

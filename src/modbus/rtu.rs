@@ -149,10 +149,11 @@ pub struct FramingCounters {
     pub discarded: u32,
 }
 
-/// The byte-fed framer.
+/// The byte-fed framer. `repr(C)`, the buffer last: the per-byte fields stay within
+/// the short load and store offsets of a Cortex-M0.
 #[derive(Debug, Clone)]
+#[repr(C)]
 pub struct Framer {
-    buf: [u8; ADU_MAX],
     len: usize,
     /// The candidate's first byte.
     start: usize,
@@ -165,6 +166,7 @@ pub struct Framer {
     /// reach it costs no classification.
     need: usize,
     counters: FramingCounters,
+    buf: [u8; ADU_MAX],
 }
 
 impl Default for Framer {
