@@ -553,6 +553,38 @@ pub static HOLDINGS: TableMap = TableMap {
     ],
 };
 
+/// The index of the single entry that holds each address of `entries` (sorted,
+/// without a hole from 0), formed at compile time: a read finds its first value by one
+/// load, not a search.
+const fn index<const N: usize>(entries: &[Entry]) -> [u8; N] {
+    let mut out = [0u8; N];
+    let mut i = 0;
+    while i < entries.len() {
+        let e = &entries[i];
+        let mut a = e.address as usize;
+        let end = e.end() as usize;
+        while a < end && a < N {
+            out[a] = i as u8;
+            a += 1;
+        }
+        i += 1;
+    }
+    out
+}
+
+/// The address after the last of `entries`.
+const fn entries_end(entries: &[Entry]) -> usize {
+    match entries.last() {
+        Some(e) => e.end() as usize,
+        None => 0,
+    }
+}
+
+static COIL_INDEX: [u8; entries_end(COILS.entries)] = index(COILS.entries);
+static DISCRETE_INDEX: [u8; entries_end(DISCRETES.entries)] = index(DISCRETES.entries);
+static INPUT_INDEX: [u8; entries_end(INPUTS.entries)] = index(INPUTS.entries);
+static HOLDING_INDEX: [u8; entries_end(HOLDINGS.entries)] = index(HOLDINGS.entries);
+
 /// The four tables in the CSV's order.
 pub static MAP: [&TableMap; 4] = [&COILS, &DISCRETES, &INPUTS, &HOLDINGS];
 
@@ -564,6 +596,17 @@ impl TableMap {
             Table::Discrete => &DISCRETES,
             Table::Input => &INPUTS,
             Table::Holding => &HOLDINGS,
+        }
+    }
+
+    /// The single entries' index by address.
+    fn index(&self) -> &'static [u8] {
+        match self.entries.first().map(|e| e.table) {
+            Some(Table::Coil) => &COIL_INDEX,
+            Some(Table::Discrete) => &DISCRETE_INDEX,
+            Some(Table::Input) => &INPUT_INDEX,
+            Some(Table::Holding) => &HOLDING_INDEX,
+            None => &[],
         }
     }
 
@@ -581,7 +624,7 @@ impl TableMap {
     /// entry), and the register's word within the value (0 high, 1 low).
     pub(crate) fn locate(&self, address: u16) -> Option<Located> {
         if address < self.entries_end() {
-            let index = self.entries.partition_point(|e| e.end() <= address);
+            let index = usize::from(*self.index().get(usize::from(address))?);
             let entry = self.entries.get(index)?;
             return Some(Located {
                 entry,

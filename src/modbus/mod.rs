@@ -260,6 +260,9 @@ impl<E: Estimator> Server<E> {
     /// Takes one received byte; a request it completes is answered at once (see
     /// [`response`](Self::response)).
     pub fn receive(&mut self, byte: u8) {
+        if self.framer.push_waiting(byte) {
+            return;
+        }
         self.framer.push(byte);
         while let Some(range) = self.framer.next(self.core.unit, false) {
             self.core.counters.framing = self.framer.counters();

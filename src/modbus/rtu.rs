@@ -202,6 +202,24 @@ impl Framer {
         self.buf.get(range).unwrap_or(&[])
     }
 
+    /// Appends one received byte when it cannot decide the candidate (fewer bytes wait
+    /// than it needs) and the buffer has room: the usual byte of a frame, at the cost
+    /// of a compare and a store. Returns whether it did; if not, call
+    /// [`push`](Self::push) and [`next`](Self::next).
+    #[inline]
+    pub fn push_waiting(&mut self, byte: u8) -> bool {
+        let len = self.len;
+        let waiting = len.wrapping_sub(self.start).wrapping_add(1);
+        match self.buf.get_mut(len) {
+            Some(slot) if waiting < self.need => {
+                *slot = byte;
+                self.len = len + 1;
+                true
+            }
+            _ => false,
+        }
+    }
+
     /// Appends one received byte. A full buffer first drops the bytes before the
     /// candidate (or the candidate's first byte).
     pub fn push(&mut self, byte: u8) {
