@@ -599,6 +599,14 @@ impl TableMap {
         }
     }
 
+    /// The single entry that holds `address` (its index) and the word of it, if a
+    /// single entry does.
+    pub(crate) fn single(&self, address: u16) -> Option<(usize, u16)> {
+        let i = usize::from(*self.index().get(usize::from(address))?);
+        let entry = self.entries.get(i)?;
+        Some((i, address.checked_sub(entry.address)?))
+    }
+
     /// The single entries' index by address.
     fn index(&self) -> &'static [u8] {
         match self.entries.first().map(|e| e.table) {

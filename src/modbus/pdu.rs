@@ -178,25 +178,46 @@ impl<E: Estimator> Core<E> {
         self.response[1] = function;
         self.response[2] = bytes as u8;
         // Inside the map (checked above): each value computed once and its words
-        // written into the response, from the word that holds `start`.
+        // written into the response, from the word that holds `start`; the single
+        // entries one after the other, the blocks' records by the walk.
         let mut at = 3;
         let end = 3 + bytes;
-        'values: for l in map.walk(start) {
-            let v = self.value(l.entry.field, l.record);
-            let n = l.entry.ty.words();
-            for w in l.word..n {
-                let word = if n == 2 && w == 0 { v >> 16 } else { v } as u16;
+        let mut address = start;
+        if let Some((mut i, mut word)) = map.single(start) {
+            while at < end {
+                let Some(e) = map.entries.get(i) else { break };
+                let v = self.value(e.field, 0);
+                self.put(&mut at, end, v, e.ty.words(), word);
+                address = e.end();
+                (i, word) = (i + 1, 0);
+            }
+        }
+        if at < end {
+            for l in map.walk(address) {
+                let v = self.value(l.entry.field, l.record);
+                self.put(&mut at, end, v, l.entry.ty.words(), l.word);
                 if at >= end {
-                    break 'values;
+                    break;
                 }
-                if let Some(slot) = self.response.get_mut(at..at + 2) {
-                    slot[0] = (word >> 8) as u8;
-                    slot[1] = word as u8;
-                }
-                at += 2;
             }
         }
         Ok(2 + bytes)
+    }
+
+    /// Writes the words `from..n` of the `n`-word value `v` at `*at` (below `end`),
+    /// high word first.
+    fn put(&mut self, at: &mut usize, end: usize, v: u32, n: u16, from: u16) {
+        for w in from..n {
+            if *at >= end {
+                return;
+            }
+            let word = if n == 2 && w == 0 { v >> 16 } else { v } as u16;
+            if let Some(slot) = self.response.get_mut(*at..*at + 2) {
+                slot[0] = (word >> 8) as u8;
+                slot[1] = word as u8;
+            }
+            *at += 2;
+        }
     }
 
     /// Echoes the request's address and value (functions 5 and 6) or address and
