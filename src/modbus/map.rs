@@ -719,9 +719,9 @@ pub(crate) struct Located {
     pub record: u16,
     pub word: u16,
     /// The block's index in the table, `None` for a single entry.
-    block: Option<usize>,
+    pub block: Option<usize>,
     /// The entry's index in the single entries or the block's fields.
-    index: usize,
+    pub index: usize,
 }
 
 /// Writes the map as CSV with the header

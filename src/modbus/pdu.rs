@@ -177,31 +177,58 @@ impl<E: Estimator> Core<E> {
         let bytes = 2 * usize::from(quantity).min(125);
         self.response[1] = function;
         self.response[2] = bytes as u8;
-        // Inside the map (checked above): each value computed once and its words
-        // written into the response, from the word that holds `start`; the single
-        // entries one after the other, the blocks' records by the walk.
+        // Each table's values from a function of its own (small enough to inline).
+        if function == 3 {
+            self.fill(map, start, 3 + bytes, Self::value_holding);
+        } else {
+            self.fill(map, start, 3 + bytes, Self::value);
+        }
+        Ok(2 + bytes)
+    }
+
+    /// The response from byte 3 to `end` with the words of `map` from `start`, each
+    /// value computed once by `value`: inside the map (checked), from the word that
+    /// holds `start`; the single entries one after the other, the blocks' records
+    /// field by field.
+    #[inline(always)]
+    fn fill(
+        &mut self,
+        map: &TableMap,
+        start: u16,
+        end: usize,
+        value: impl Fn(&Self, Field, u16) -> u32,
+    ) {
         let mut at = 3;
-        let end = 3 + bytes;
         let mut address = start;
         if let Some((mut i, mut word)) = map.single(start) {
             while at < end {
                 let Some(e) = map.entries.get(i) else { break };
-                let v = self.value(e.field, 0);
+                let v = value(self, e.field, 0);
                 self.put(&mut at, end, v, e.ty.words(), word);
                 address = e.end();
                 (i, word) = (i + 1, 0);
             }
         }
-        if at < end {
-            for l in map.walk(address) {
-                let v = self.value(l.entry.field, l.record);
-                self.put(&mut at, end, v, l.entry.ty.words(), l.word);
-                if at >= end {
-                    break;
+        if at < end
+            && let Some(l) = map.locate(address)
+            && let Some(mut b) = l.block
+        {
+            let (mut record, mut i, mut word) = (l.record, l.index, l.word);
+            'blocks: while let Some(block) = map.blocks.get(b) {
+                while record < block.count {
+                    while let Some(e) = block.fields.get(i) {
+                        let v = value(self, e.field, record);
+                        self.put(&mut at, end, v, e.ty.words(), word);
+                        if at >= end {
+                            break 'blocks;
+                        }
+                        (i, word) = (i + 1, 0);
+                    }
+                    (record, i) = (record + 1, 0);
                 }
+                (b, record) = (b + 1, 0);
             }
         }
-        Ok(2 + bytes)
     }
 
     /// Writes the words `from..n` of the `n`-word value `v` at `*at` (below `end`),

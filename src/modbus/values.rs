@@ -283,6 +283,20 @@ impl<E: Estimator> Core<E> {
         }
     }
 
+    /// [`value`](Self::value) of a holding register, as cheap as the poll's.
+    #[inline]
+    pub(super) fn value_holding(&self, field: Field, record: u16) -> u32 {
+        match field {
+            Field::Sample(_) | Field::AcknowledgeAlarms => 0,
+            Field::EventFrom => self.events.from,
+            Field::LatchingAlarms => u32::from(self.annunciator.latching().bits()),
+            Field::ExternalMode => u32::from(self.external),
+            Field::UnitId => u32::from(self.unit),
+            Field::MapVersion => u32::from(super::map::MAP_VERSION),
+            _ => self.value_other(field, record),
+        }
+    }
+
     /// [`value`](Self::value) of the other fields.
     #[inline(never)]
     fn value_other(&self, field: Field, record: u16) -> u32 {
