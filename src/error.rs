@@ -104,4 +104,6 @@ const _: () = {
     );
     #[cfg(feature = "_mock-flash")]
     every_error!(crate::storage::MockError);
+    #[cfg(feature = "modbus")]
+    every_error!(crate::modbus::ServerConfigError, crate::modbus::DecodeError,);
 };

@@ -11,7 +11,13 @@ use std::path::Path;
 use std::process::Command;
 
 /// The targets, as named in fuzz/Cargo.toml.
-pub const TARGETS: [&str; 4] = ["estimator_csv", "reference", "float_core", "fixed_core"];
+pub const TARGETS: [&str; 5] = [
+    "estimator_csv",
+    "reference",
+    "float_core",
+    "fixed_core",
+    "modbus",
+];
 
 /// How long each target runs.
 pub enum Budget {
