@@ -63,6 +63,7 @@
 //! # Ok::<(), misalign::Error>(())
 //! ```
 
+pub mod annunciation;
 #[cfg(feature = "sequential-storage")]
 mod checkpoint;
 mod condition;
@@ -281,6 +282,12 @@ impl<E: Estimator> Monitor<E> {
     /// Undelivered events.
     pub fn pending_events(&self) -> usize {
         self.events.len()
+    }
+
+    /// The sequence number the next event will get (the events so far, delivered,
+    /// pending or dropped, took those before it).
+    pub fn next_event_seq(&self) -> u32 {
+        self.status.next_seq
     }
 
     fn emit(&mut self, kind: EventKind, time_ms: u32) {
