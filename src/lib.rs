@@ -52,6 +52,8 @@ mod error;
 pub mod estimator;
 pub mod fixed;
 pub mod float;
+#[cfg(feature = "modbus")]
+pub mod modbus;
 pub mod monitor;
 pub mod prepared;
 mod recip;

@@ -12,7 +12,11 @@
 //! event queue, the statistics, `snapshot` and `restore`, `model_for_range`), the
 //! sensors' conversions (load cell, probes, phi, rolling speed) with a calibration
 //! decoded from a stored record, and the checkpoint codec (`storage::codec::decode`
-//! and `encode` of `SensorCalibration`). Its panic handler is panic-never's, which
+//! and `encode` of `SensorCalibration`), and the Modbus server's request path
+//! (`modbus::Server` over the f32 monitor: every byte of a stream as unknown as the
+//! bus's through `receive`, the silence through `idle`, `response` and `sent`, the
+//! node's own samples through `process`: framing, every function, the register map,
+//! identification, the event window, acknowledgement, external samples). Its panic handler is panic-never's, which
 //! refers to a symbol that does not exist: the image links only if the optimiser
 //! (profile `nopanic`: release, fat LTO, overflow checks on) removed every path to a
 //! panic, an integer overflow included. It also runs: in QEMU it exits with 0.
@@ -43,6 +47,16 @@ static SAMPLES: [Sample; 6] = [
         ..Sample::new(100, 1000.0, 2e-4)
     },
     Sample::new(2500, 10.0, 0.0).with_speed(0.0),
+];
+
+/// What a Modbus master sends: a read of the map's first 16 input registers, a
+/// function-16 write of external samples, an identification request, coil writes and
+/// garbage. Read through volatile reads, so each byte is as unknown as the bus's.
+static MODBUS_STREAM: [u8; 64] = [
+    0x01, 0x04, 0x00, 0x00, 0x00, 0x10, 0xF1, 0xC6, 0xFF, 0x00, 0x01, 0x2B, 0x0E, 0x02, 0x00, 0x00,
+    0x00, 0x01, 0x10, 0x00, 0x05, 0x00, 0x06, 0x0C, 0x00, 0x00, 0x03, 0xE8, 0x44, 0x7A, 0x00, 0x00,
+    0x38, 0xD1, 0xB7, 0x17, 0x00, 0x00, 0x01, 0x0F, 0x00, 0x00, 0x00, 0x06, 0x01, 0x3F, 0x00, 0x00,
+    0x01, 0x03, 0x00, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x01, 0x05, 0x00, 0x05, 0xFF, 0x00, 0x00,
 ];
 
 /// A checkpoint record of the sensors' calibration as flash would hold it (its bytes are
@@ -186,6 +200,38 @@ mod paths {
         io::emit(out);
     }
 
+    /// The Modbus server over the f32 monitor: every byte of `stream` received (the
+    /// silence after each eighth), the answers taken, the node's samples processed.
+    pub fn modbus(scene: &Scene, samples: &[Sample], stream: &[u8]) -> Result<(), Error> {
+        use misalign::modbus::{Server, ServerConfig};
+        let core = Auto::with_choice(scene, model_for_range(scene, 5e3, 1e-5)?)?;
+        let Ok(monitor) = Monitor::new(core, io::read(&Config::default())) else {
+            return Ok(());
+        };
+        let config = ServerConfig {
+            external_samples: io::read(&true),
+            ..ServerConfig::default()
+        };
+        let Ok(mut server) = Server::new(monitor, config) else {
+            return Ok(());
+        };
+        for s in samples {
+            io::emit(server.process(io::read(s)));
+        }
+        for (i, byte) in stream.iter().enumerate() {
+            server.receive(io::read(byte));
+            if i % 8 == 7 {
+                server.idle();
+            }
+            if let Some(answer) = server.response() {
+                io::emit(answer);
+                server.sent();
+            }
+        }
+        io::emit(server.counters());
+        Ok(())
+    }
+
     /// The f64 reference, with the scene's length and theta relation as configured.
     pub fn reference(
         scene: &Scene,
@@ -231,6 +277,7 @@ fn main() -> ! {
             risk as f32,
         )?;
         paths::monitors(&with_length, &SAMPLES, 5e3)?;
+        paths::modbus(&with_length, &SAMPLES, &io::read(&MODBUS_STREAM))?;
         paths::sensors_and_storage(&io::read(&CALIBRATION_RECORD), angle_counts, load_counts);
         paths::reference(&scene, length, exact, (load as f64, phi as f64), (x, y))
     });

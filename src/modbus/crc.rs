@@ -1,0 +1,93 @@
+//! CRC-16/MODBUS (polynomial 0xA001 reflected, initial value 0xFFFF, no final XOR),
+//! sent low byte first. One 512-byte table: a byte costs a shift, an XOR and a load
+//! instead of eight conditional shifts (about ten instructions on a Cortex-M0
+//! against about seventy).
+
+/// The table, built at compile time.
+static TABLE: [u16; 256] = table();
+
+const fn table() -> [u16; 256] {
+    let mut t = [0u16; 256];
+    let mut i = 0;
+    while i < 256 {
+        let mut c = i as u16;
+        let mut bit = 0;
+        while bit < 8 {
+            c = if c & 1 != 0 {
+                (c >> 1) ^ 0xA001
+            } else {
+                c >> 1
+            };
+            bit += 1;
+        }
+        t[i] = c;
+        i += 1;
+    }
+    t
+}
+
+/// The CRC's initial value.
+pub(crate) const INIT: u16 = 0xFFFF;
+
+/// `crc` advanced over one byte.
+#[inline(always)]
+pub(crate) fn step(crc: u16, byte: u8) -> u16 {
+    (crc >> 8) ^ TABLE[usize::from((crc as u8) ^ byte)]
+}
+
+/// The CRC of `bytes`.
+pub fn crc16(bytes: &[u8]) -> u16 {
+    bytes.iter().fold(INIT, |c, &b| step(c, b))
+}
+
+/// Whether `frame` (at least the two CRC bytes) ends with the CRC of what precedes
+/// them, low byte first.
+pub(crate) fn valid(frame: &[u8]) -> bool {
+    match frame.split_last_chunk::<2>() {
+        Some((body, crc)) => crc16(body) == u16::from_le_bytes(*crc),
+        None => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A bit at a time, as the specification's appendix describes it.
+    fn bitwise(bytes: &[u8]) -> u16 {
+        let mut crc = 0xFFFFu16;
+        for &b in bytes {
+            crc ^= u16::from(b);
+            for _ in 0..8 {
+                crc = if crc & 1 != 0 {
+                    (crc >> 1) ^ 0xA001
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        crc
+    }
+
+    #[test]
+    fn check_value_and_known_frame() {
+        // The catalogue's check value of CRC-16/MODBUS over "123456789".
+        assert_eq!(crc16(b"123456789"), 0x4B37);
+        // Read holding registers 0x006B, 3 of them, unit 0x11: CRC bytes 76 87.
+        assert_eq!(
+            crc16(&[0x11, 0x03, 0x00, 0x6B, 0x00, 0x03]).to_le_bytes(),
+            [0x76, 0x87]
+        );
+        assert!(valid(&[0x11, 0x03, 0x00, 0x6B, 0x00, 0x03, 0x76, 0x87]));
+        assert!(!valid(&[0x11, 0x03, 0x00, 0x6B, 0x00, 0x03, 0x87, 0x76]));
+        assert!(!valid(&[0x11]));
+    }
+
+    #[test]
+    fn table_matches_bitwise() {
+        let data: std::vec::Vec<u8> = (0..=255u8).chain((0..=255u8).rev()).collect();
+        for n in 0..data.len() {
+            assert_eq!(crc16(&data[..n]), bitwise(&data[..n]), "length {n}");
+        }
+    }
+}

@@ -1,0 +1,691 @@
+//! The register map: one table in code, from which the server reads and writes and
+//! [`registers_csv`] writes `docs/modbus/registers.csv`.
+//!
+//! Each of the four Modbus tables is a run of single entries from address 0 without a
+//! hole, then blocks of repeated records (the event window's slots, the external
+//! samples). A 32-bit value takes two registers, the high word first.
+
+use crate::monitor::annunciation::AlarmSet;
+use core::fmt;
+
+/// The Modbus table an entry is in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Table {
+    /// Coils (bits, read by function 1, written by 5 and 15).
+    Coil,
+    /// Discrete inputs (bits, read by function 2).
+    Discrete,
+    /// Input registers (read by function 4).
+    Input,
+    /// Holding registers (read by function 3, written by 6 and 16).
+    Holding,
+}
+
+impl Table {
+    /// The name in the CSV's `table` column.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Table::Coil => "coil",
+            Table::Discrete => "discrete",
+            Table::Input => "input",
+            Table::Holding => "holding",
+        }
+    }
+}
+
+/// A value's type on the wire.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Type {
+    /// Unsigned 16 bits (for a coil or discrete input: the bit, 0 or 1).
+    U16,
+    /// Signed 16 bits.
+    I16,
+    /// Unsigned 32 bits, two registers, high word first.
+    U32,
+    /// Signed 32 bits, two registers, high word first.
+    I32,
+    /// IEEE 754 binary32, two registers, high word first.
+    F32,
+}
+
+impl Type {
+    /// The name in the CSV's `type` column.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Type::U16 => "u16",
+            Type::I16 => "i16",
+            Type::U32 => "u32",
+            Type::I32 => "i32",
+            Type::F32 => "f32",
+        }
+    }
+
+    /// Registers the value takes.
+    pub const fn words(self) -> u16 {
+        match self {
+            Type::U16 | Type::I16 => 1,
+            Type::U32 | Type::I32 | Type::F32 => 2,
+        }
+    }
+}
+
+/// Whether a master may write an entry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Access {
+    /// Read only.
+    R,
+    /// Read and write.
+    Rw,
+}
+
+impl Access {
+    /// The name in the CSV's `access` column.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Access::R => "r",
+            Access::Rw => "rw",
+        }
+    }
+}
+
+/// What an entry holds: the server computes it when it is read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Field {
+    // Coils.
+    Acknowledge,
+    Latching(AlarmSet),
+    ExternalSamples,
+    // Discrete inputs.
+    Indicated(AlarmSet),
+    Unacknowledged(AlarmSet),
+    Running,
+    EventAvailable,
+    // Input registers.
+    Status,
+    Alarms,
+    SlipRatio,
+    AxialForce,
+    CriticalAngle,
+    Margin,
+    Load,
+    Misalignment,
+    TimeToCritical,
+    Friction,
+    Samples,
+    RepeatedTimestamps,
+    Spikes,
+    EventsDropped,
+    EventSeqNext,
+    /// Faults by cause, in the order of [`FaultCounts`](crate::monitor::FaultCounts).
+    Faults(u8),
+    /// Per risk state, by [`RiskState::index`](crate::monitor::RiskState::index).
+    TimeInState(u8),
+    Energy(u8),
+    MaxSlipRatio,
+    MaxAxialForce,
+    MinMargin,
+    Elapsed,
+    LastSampleTime,
+    ExternalAccepted,
+    ExternalRefused,
+    BusFrames,
+    BusServerMessages,
+    BusDiscarded,
+    BusExceptions,
+    EventFirst,
+    EventCount,
+    EventsMissed,
+    /// An event slot's field.
+    Event(EventField),
+    // Holding registers.
+    EventFrom,
+    AcknowledgeAlarms,
+    LatchingAlarms,
+    ExternalMode,
+    /// An external sample's field (the basic or the full record).
+    Sample(SampleField),
+}
+
+/// The fields of an event slot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum EventField {
+    Seq,
+    TimeMs,
+    ElapsedS,
+    ElapsedMs,
+    Kind,
+    From,
+    To,
+    Fault,
+    Value,
+    Load,
+    Phi,
+    SlipRatio,
+    AxialForce,
+    CriticalAngle,
+    Margin,
+}
+
+/// The fields of an external sample record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum SampleField {
+    Flags,
+    TimeMs,
+    Load,
+    Phi,
+    Speed,
+    AxialForce,
+}
+
+/// One value of the map (in a block, one field of its record, at its offset).
+#[derive(Debug, Clone, Copy)]
+pub struct Entry {
+    /// The table.
+    pub table: Table,
+    /// The 0-based address on the wire (in a block: the offset in the record).
+    pub address: u16,
+    /// The name (in a block, the field's; the CSV prefixes the record's).
+    pub name: &'static str,
+    /// The type on the wire.
+    pub ty: Type,
+    /// The physical value is the register's value times this.
+    pub scale: &'static str,
+    /// The SI unit of the physical value (empty: none).
+    pub unit: &'static str,
+    /// Whether a master may write it.
+    pub access: Access,
+    /// What it means.
+    pub description: &'static str,
+    pub(crate) field: Field,
+}
+
+impl Entry {
+    /// The address after the value.
+    pub const fn end(&self) -> u16 {
+        self.address.saturating_add(self.ty.words())
+    }
+}
+
+/// A block of `count` records of `stride` registers (or bits) from `address`.
+#[derive(Debug, Clone, Copy)]
+pub struct Block {
+    /// The table.
+    pub table: Table,
+    /// The first record's address.
+    pub address: u16,
+    /// The records' name, `<prefix>_<index>_<field>` in the CSV.
+    pub prefix: &'static str,
+    /// Records.
+    pub count: u16,
+    /// Registers per record.
+    pub stride: u16,
+    /// The record's fields, their addresses offsets in the record, without a hole.
+    pub fields: &'static [Entry],
+}
+
+impl Block {
+    /// The address after the block.
+    pub const fn end(&self) -> u16 {
+        self.address
+            .saturating_add(self.count.saturating_mul(self.stride))
+    }
+}
+
+/// One table's map: its single entries from address 0, then its blocks.
+#[derive(Debug, Clone, Copy)]
+pub struct TableMap {
+    /// The single entries, sorted by address, without a hole from 0.
+    pub entries: &'static [Entry],
+    /// The blocks, after the entries, without a hole between them.
+    pub blocks: &'static [Block],
+}
+
+macro_rules! e {
+    ($table:ident, $address:expr, $name:expr, $ty:ident, $unit:expr, $access:ident, $field:expr, $description:expr) => {
+        Entry {
+            table: Table::$table,
+            address: $address,
+            name: $name,
+            ty: Type::$ty,
+            scale: "1",
+            unit: $unit,
+            access: Access::$access,
+            description: $description,
+            field: $field,
+        }
+    };
+}
+
+use Field as F;
+
+const W: AlarmSet = AlarmSet::WARNING;
+const A: AlarmSet = AlarmSet::ALARM;
+const S: AlarmSet = AlarmSet::SENSOR_FAULT;
+const P: AlarmSet = AlarmSet::APPROACHING;
+
+/// Coils.
+#[rustfmt::skip]
+pub static COILS: TableMap = TableMap {
+    entries: &[
+        e!(Coil, 0, "acknowledge", U16, "", Rw, F::Acknowledge,
+            "write 1: acknowledge every alarm (ISA-18.2); reads 0"),
+        e!(Coil, 1, "latch_warning", U16, "", Rw, F::Latching(W),
+            "1: the warning latches (stays indicated after it clears until acknowledged)"),
+        e!(Coil, 2, "latch_alarm", U16, "", Rw, F::Latching(A),
+            "1: the alarm latches"),
+        e!(Coil, 3, "latch_sensor_fault", U16, "", Rw, F::Latching(S),
+            "1: the sensor fault latches"),
+        e!(Coil, 4, "latch_approaching", U16, "", Rw, F::Latching(P),
+            "1: the approaching warning latches"),
+        e!(Coil, 5, "external_samples", U16, "", Rw, F::ExternalSamples,
+            "1: samples written to the holding blocks sample_* and sample_full_* are processed; 0: they are refused with exception 01"),
+    ],
+    blocks: &[],
+};
+
+/// Discrete inputs.
+#[rustfmt::skip]
+pub static DISCRETES: TableMap = TableMap {
+    entries: &[
+        e!(Discrete, 0, "warning", U16, "", R, F::Indicated(W),
+            "warning indicated: state microslip or gross slip, or latched and unacknowledged"),
+        e!(Discrete, 1, "alarm", U16, "", R, F::Indicated(A),
+            "alarm indicated: state gross slip, or latched and unacknowledged"),
+        e!(Discrete, 2, "sensor_fault", U16, "", R, F::Indicated(S),
+            "sensor fault indicated: state sensor fault, or latched and unacknowledged"),
+        e!(Discrete, 3, "approaching", U16, "", R, F::Indicated(P),
+            "approaching indicated: time to critical below the horizon while the contact sticks, or latched and unacknowledged"),
+        e!(Discrete, 4, "warning_unacknowledged", U16, "", R, F::Unacknowledged(W),
+            "the warning was raised and is not acknowledged"),
+        e!(Discrete, 5, "alarm_unacknowledged", U16, "", R, F::Unacknowledged(A),
+            "the alarm was raised and is not acknowledged"),
+        e!(Discrete, 6, "sensor_fault_unacknowledged", U16, "", R, F::Unacknowledged(S),
+            "the sensor fault was raised and is not acknowledged"),
+        e!(Discrete, 7, "approaching_unacknowledged", U16, "", R, F::Unacknowledged(P),
+            "the approaching warning was raised and is not acknowledged"),
+        e!(Discrete, 8, "running", U16, "", R, F::Running,
+            "the state is not stopped"),
+        e!(Discrete, 9, "event_available", U16, "", R, F::EventAvailable,
+            "the event window holds an event at or after event_from"),
+    ],
+    blocks: &[],
+};
+
+/// Where the event window's header starts (input registers).
+pub const EVENT_WINDOW_ADDRESS: u16 = 82;
+/// Where the event window's slots start (input registers).
+pub const EVENT_SLOTS_ADDRESS: u16 = EVENT_WINDOW_ADDRESS + 5;
+/// Event slots in the window.
+pub const EVENT_SLOTS: u16 = 4;
+/// Registers per event slot.
+pub const EVENT_STRIDE: u16 = 25;
+
+/// Input registers.
+#[rustfmt::skip]
+pub static INPUTS: TableMap = TableMap {
+    entries: &[
+        e!(Input, 0, "status", U16, "", R, F::Status,
+            "bits 0-7 risk state (0 stopped, 1 normal, 2 microslip, 3 gross slip, 4 sensor fault); bits 8-11 NAMUR NE 107 category (0 good, 1 maintenance required, 2 out of specification, 3 function check, 4 failure); bits 12-15 unacknowledged alarms (warning, alarm, sensor fault, approaching)"),
+        e!(Input, 1, "alarms", U16, "", R, F::Alarms,
+            "bits 0-3 alarms indicated, 4-7 active, 8-11 unacknowledged, 12-15 latching (each: warning, alarm, sensor fault, approaching)"),
+        e!(Input, 2, "slip_ratio", F32, "", R, F::SlipRatio,
+            "slip ratio d/b of the last valid running sample (eq 16; eq 23 for line contact); NaN none yet"),
+        e!(Input, 4, "axial_force", F32, "N", R, F::AxialForce,
+            "axial force F (eq 21, 27, 29; measured when the sample carries one); NaN none yet"),
+        e!(Input, 6, "critical_angle", F32, "rad", R, F::CriticalAngle,
+            "critical misalignment angle phi0 at this load; NaN none (no reading, or none exists at this load)"),
+        e!(Input, 8, "margin", F32, "rad", R, F::Margin,
+            "margin phi0 - |phi|; NaN none"),
+        e!(Input, 10, "load", F32, "N", R, F::Load,
+            "conditioned normal load P; NaN none yet"),
+        e!(Input, 12, "misalignment", F32, "rad", R, F::Misalignment,
+            "conditioned misalignment phi; NaN none yet"),
+        e!(Input, 14, "time_to_critical", F32, "s", R, F::TimeToCritical,
+            "time until gross slip at the margin's current drift; NaN none (the margin does not fall, or the trend is off)"),
+        e!(Input, 16, "friction", F32, "", R, F::Friction,
+            "filtered friction coefficient mu from a measured axial force; NaN none"),
+        e!(Input, 18, "samples", U32, "", R, F::Samples,
+            "samples processed (modulo 2^32)"),
+        e!(Input, 20, "repeated_timestamps", U32, "", R, F::RepeatedTimestamps,
+            "samples with the previous sample's timestamp, counted and ignored"),
+        e!(Input, 22, "spikes", U32, "", R, F::Spikes,
+            "spikes replaced by the window's median"),
+        e!(Input, 24, "events_dropped", U32, "", R, F::EventsDropped,
+            "events lost before a master read them (the monitor's queue and the event window)"),
+        e!(Input, 26, "event_seq_next", U32, "", R, F::EventSeqNext,
+            "the sequence number the next event will get"),
+        e!(Input, 28, "faults_non_finite", U32, "", R, F::Faults(0),
+            "samples refused: a value NaN or infinite"),
+        e!(Input, 30, "faults_out_of_range", U32, "", R, F::Faults(1),
+            "samples refused: a value outside the configured range"),
+        e!(Input, 32, "faults_stuck", U32, "", R, F::Faults(2),
+            "samples refused: a stuck sensor"),
+        e!(Input, 34, "faults_gap", U32, "", R, F::Faults(3),
+            "samples refused: a gap between samples"),
+        e!(Input, 36, "faults_time_backwards", U32, "", R, F::Faults(4),
+            "samples refused: the timestamp went backwards"),
+        e!(Input, 38, "faults_driver", U32, "", R, F::Faults(5),
+            "samples refused: a driver reported a fault"),
+        e!(Input, 40, "faults_estimator", U32, "", R, F::Faults(6),
+            "samples refused by the estimator"),
+        e!(Input, 42, "faults_sensor", U32, "", R, F::Faults(7),
+            "samples refused by the sensors' own fault detection"),
+        e!(Input, 44, "time_stopped", U32, "s", R, F::TimeInState(0),
+            "time in state stopped (whole seconds)"),
+        e!(Input, 46, "time_normal", U32, "s", R, F::TimeInState(1),
+            "time in state normal"),
+        e!(Input, 48, "time_microslip", U32, "s", R, F::TimeInState(2),
+            "time in state microslip"),
+        e!(Input, 50, "time_gross_slip", U32, "s", R, F::TimeInState(3),
+            "time in state gross slip"),
+        e!(Input, 52, "time_sensor_fault", U32, "s", R, F::TimeInState(4),
+            "time in state sensor fault"),
+        e!(Input, 54, "energy_stopped", F32, "J", R, F::Energy(0),
+            "energy dissipated in state stopped (F phi V integrated, section 7)"),
+        e!(Input, 56, "energy_normal", F32, "J", R, F::Energy(1),
+            "energy dissipated in state normal"),
+        e!(Input, 58, "energy_microslip", F32, "J", R, F::Energy(2),
+            "energy dissipated in state microslip"),
+        e!(Input, 60, "energy_gross_slip", F32, "J", R, F::Energy(3),
+            "energy dissipated in state gross slip"),
+        e!(Input, 62, "energy_sensor_fault", F32, "J", R, F::Energy(4),
+            "energy dissipated in state sensor fault"),
+        e!(Input, 64, "max_slip_ratio", F32, "", R, F::MaxSlipRatio,
+            "highest d/b of a valid running sample (0 before one)"),
+        e!(Input, 66, "max_axial_force", F32, "N", R, F::MaxAxialForce,
+            "highest |F| of a valid running sample (0 before one)"),
+        e!(Input, 68, "min_margin", F32, "rad", R, F::MinMargin,
+            "lowest margin; NaN none"),
+        e!(Input, 70, "elapsed", U32, "s", R, F::Elapsed,
+            "monotonic time since the first sample (whole seconds)"),
+        e!(Input, 72, "last_sample_time", U32, "ms", R, F::LastSampleTime,
+            "timestamp of the last sample offered (the sample's own u32 ms counter)"),
+        e!(Input, 74, "external_accepted", U32, "", R, F::ExternalAccepted,
+            "external samples taken from the bus and processed"),
+        e!(Input, 76, "external_refused", U32, "", R, F::ExternalRefused,
+            "writes of external samples refused with an exception (none of their samples processed)"),
+        e!(Input, 78, "bus_frames", U16, "", R, F::BusFrames,
+            "frames with a valid CRC seen on the bus, any unit (modulo 2^16)"),
+        e!(Input, 79, "bus_server_messages", U16, "", R, F::BusServerMessages,
+            "requests for this unit or broadcast (modulo 2^16)"),
+        e!(Input, 80, "bus_discarded", U16, "", R, F::BusDiscarded,
+            "bytes discarded: garbage, wrong CRC, truncated or oversized frames (modulo 2^16)"),
+        e!(Input, 81, "bus_exceptions", U16, "", R, F::BusExceptions,
+            "exception responses sent (modulo 2^16)"),
+        e!(Input, EVENT_WINDOW_ADDRESS, "event_first", U32, "", R, F::EventFirst,
+            "sequence number of event slot 0 (the first event held at or after event_from)"),
+        e!(Input, EVENT_WINDOW_ADDRESS + 2, "event_count", U16, "", R, F::EventCount,
+            "filled event slots (0 to 4), from slot 0"),
+        e!(Input, EVENT_WINDOW_ADDRESS + 3, "events_missed", U32, "", R, F::EventsMissed,
+            "events from event_from to event_first that were lost (the gap this read cannot fill)"),
+    ],
+    blocks: &[Block {
+        table: Table::Input,
+        address: EVENT_SLOTS_ADDRESS,
+        prefix: "event",
+        count: EVENT_SLOTS,
+        stride: EVENT_STRIDE,
+        fields: &EVENT_FIELDS,
+    }],
+};
+
+use EventField as V;
+
+#[rustfmt::skip]
+static EVENT_FIELDS: [Entry; 15] = [
+    e!(Input, 0, "seq", U32, "", R, F::Event(V::Seq),
+        "sequence number"),
+    e!(Input, 2, "time_ms", U32, "ms", R, F::Event(V::TimeMs),
+        "the sample's own timestamp (u32 ms counter)"),
+    e!(Input, 4, "elapsed_s", U32, "s", R, F::Event(V::ElapsedS),
+        "monotonic time since the first sample, whole seconds"),
+    e!(Input, 6, "elapsed_ms", U16, "ms", R, F::Event(V::ElapsedMs),
+        "monotonic time since the first sample, the milliseconds (0-999)"),
+    e!(Input, 7, "kind", U16, "", R, F::Event(V::Kind),
+        "0 empty slot, 1 state change, 2 approaching, 3 friction changed, 4 friction back in band"),
+    e!(Input, 8, "from", U16, "", R, F::Event(V::From),
+        "state change: the state left (risk state code as in status)"),
+    e!(Input, 9, "to", U16, "", R, F::Event(V::To),
+        "state change: the state entered"),
+    e!(Input, 10, "fault", U16, "", R, F::Event(V::Fault),
+        "the fault behind a change to sensor fault: bits 8-15 cause (0 none, 1 non-finite, 2 out of range, 3 stuck, 4 gap, 5 time backwards, 6 driver, 7 estimator, 8 sensor); bits 0-7 the channel (0 load, 1 angle, 2 speed, 3 axial force) or for cause 8 the sensor (bits 4-7: 0 load, 1 probe 1, 2 probe 2, 3 speed) and its fault kind (bits 0-3: 0 disconnected, 1 bus, 2 saturated, 3 stuck, 4 jump, 5 out of range)"),
+    e!(Input, 11, "value", F32, "", R, F::Event(V::Value),
+        "approaching: time to critical (s); friction: the filtered mu; NaN otherwise"),
+    e!(Input, 13, "load", F32, "N", R, F::Event(V::Load),
+        "P of the reading behind the event"),
+    e!(Input, 15, "phi", F32, "rad", R, F::Event(V::Phi),
+        "phi of the reading"),
+    e!(Input, 17, "slip_ratio", F32, "", R, F::Event(V::SlipRatio),
+        "d/b of the reading"),
+    e!(Input, 19, "axial_force", F32, "N", R, F::Event(V::AxialForce),
+        "F of the reading"),
+    e!(Input, 21, "critical_angle", F32, "rad", R, F::Event(V::CriticalAngle),
+        "phi0 of the reading; NaN none"),
+    e!(Input, 23, "margin", F32, "rad", R, F::Event(V::Margin),
+        "margin of the reading; NaN none"),
+];
+
+/// Where the basic external samples start (holding registers).
+pub const SAMPLES_ADDRESS: u16 = 5;
+/// Records of the basic block: the most one function-16 write carries.
+pub const SAMPLES: u16 = 20;
+/// Registers per basic record (time, P, phi).
+pub const SAMPLE_STRIDE: u16 = 6;
+/// Where the full external samples start (holding registers).
+pub const SAMPLES_FULL_ADDRESS: u16 = SAMPLES_ADDRESS + SAMPLES * SAMPLE_STRIDE;
+/// Records of the full block.
+pub const SAMPLES_FULL: u16 = 11;
+/// Registers per full record (flags, time, P, phi, V, F).
+pub const SAMPLE_FULL_STRIDE: u16 = 11;
+
+use SampleField as X;
+
+#[rustfmt::skip]
+static SAMPLE_FIELDS: [Entry; 3] = [
+    e!(Holding, 0, "time_ms", U32, "ms", Rw, F::Sample(X::TimeMs),
+        "the sample's timestamp (a u32 ms counter; wraps are forward steps)"),
+    e!(Holding, 2, "load", F32, "N", Rw, F::Sample(X::Load),
+        "normal load P"),
+    e!(Holding, 4, "phi", F32, "rad", Rw, F::Sample(X::Phi),
+        "misalignment phi"),
+];
+
+#[rustfmt::skip]
+static SAMPLE_FULL_FIELDS: [Entry; 6] = [
+    e!(Holding, 0, "flags", U16, "", Rw, F::Sample(X::Flags),
+        "bit 0: speed measured, bit 1: axial force measured (other bits 0)"),
+    e!(Holding, 1, "time_ms", U32, "ms", Rw, F::Sample(X::TimeMs),
+        "the sample's timestamp"),
+    e!(Holding, 3, "load", F32, "N", Rw, F::Sample(X::Load),
+        "normal load P"),
+    e!(Holding, 5, "phi", F32, "rad", Rw, F::Sample(X::Phi),
+        "misalignment phi"),
+    e!(Holding, 7, "speed", F32, "m/s", Rw, F::Sample(X::Speed),
+        "rolling speed V (used when flags bit 0)"),
+    e!(Holding, 9, "axial_force", F32, "N", Rw, F::Sample(X::AxialForce),
+        "measured axial force F (used when flags bit 1)"),
+];
+
+/// Holding registers.
+#[rustfmt::skip]
+pub static HOLDINGS: TableMap = TableMap {
+    entries: &[
+        e!(Holding, 0, "event_from", U32, "", Rw, F::EventFrom,
+            "the first event sequence number the event window shows; write event_first + event_count after a read"),
+        e!(Holding, 2, "acknowledge_alarms", U16, "", Rw, F::AcknowledgeAlarms,
+            "write a bit set: acknowledge those alarms (bits 0-3: warning, alarm, sensor fault, approaching); reads 0"),
+        e!(Holding, 3, "latching", U16, "", Rw, F::LatchingAlarms,
+            "the alarms that latch, bits 0-3 as in acknowledge_alarms (the coils latch_* alike)"),
+        e!(Holding, 4, "external_mode", U16, "", Rw, F::ExternalMode,
+            "1: external samples are processed, 0: refused (the coil external_samples alike)"),
+    ],
+    blocks: &[
+        Block {
+            table: Table::Holding,
+            address: SAMPLES_ADDRESS,
+            prefix: "sample",
+            count: SAMPLES,
+            stride: SAMPLE_STRIDE,
+            fields: &SAMPLE_FIELDS,
+        },
+        Block {
+            table: Table::Holding,
+            address: SAMPLES_FULL_ADDRESS,
+            prefix: "sample_full",
+            count: SAMPLES_FULL,
+            stride: SAMPLE_FULL_STRIDE,
+            fields: &SAMPLE_FULL_FIELDS,
+        },
+    ],
+};
+
+/// The four tables in the CSV's order.
+pub static MAP: [&TableMap; 4] = [&COILS, &DISCRETES, &INPUTS, &HOLDINGS];
+
+impl TableMap {
+    /// The map of `table`.
+    pub fn of(table: Table) -> &'static TableMap {
+        match table {
+            Table::Coil => &COILS,
+            Table::Discrete => &DISCRETES,
+            Table::Input => &INPUTS,
+            Table::Holding => &HOLDINGS,
+        }
+    }
+
+    /// The address after the single entries.
+    pub fn entries_end(&self) -> u16 {
+        self.entries.last().map_or(0, Entry::end)
+    }
+
+    /// The address after the table.
+    pub fn end(&self) -> u16 {
+        self.blocks.last().map_or(self.entries_end(), Block::end)
+    }
+
+    /// The entry that holds `address`: the entry, the record's index (0 for a single
+    /// entry), and the register's word within the value (0 high, 1 low).
+    pub(crate) fn locate(&self, address: u16) -> Option<Located> {
+        if address < self.entries_end() {
+            let i = self.entries.partition_point(|e| e.end() <= address);
+            let entry = self.entries.get(i)?;
+            return Some(Located {
+                entry,
+                record: 0,
+                word: address.checked_sub(entry.address)?,
+            });
+        }
+        let block = self.blocks.iter().find(|b| address < b.end())?;
+        let offset = address.checked_sub(block.address)?;
+        let record = offset.checked_div(block.stride)?;
+        let at = offset.checked_rem(block.stride)?;
+        let i = block.fields.partition_point(|e| e.end() <= at);
+        let entry = block.fields.get(i)?;
+        Some(Located {
+            entry,
+            record,
+            word: at.checked_sub(entry.address)?,
+        })
+    }
+}
+
+/// An address located in the map.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Located {
+    pub entry: &'static Entry,
+    pub record: u16,
+    pub word: u16,
+}
+
+/// Writes the map as CSV with the header
+/// `table,address,name,type,scale,unit,access,description`: one row per value, a
+/// block's records expanded (`event_0_seq`, ...). `docs/modbus/registers.csv` is this
+/// output (`cargo run --example modbus_registers > docs/modbus/registers.csv`).
+pub fn registers_csv(out: &mut impl fmt::Write) -> fmt::Result {
+    writeln!(out, "table,address,name,type,scale,unit,access,description")?;
+    let row = |out: &mut dyn fmt::Write, e: &Entry, address: u16, prefix: Option<(&str, u16)>| {
+        write!(out, "{},{},", e.table.as_str(), address)?;
+        if let Some((p, i)) = prefix {
+            write!(out, "{p}_{i}_")?;
+        }
+        // Descriptions hold commas: quoted, as CSV quotes (they hold no quote).
+        writeln!(
+            out,
+            "{},{},{},{},{},\"{}\"",
+            e.name,
+            e.ty.as_str(),
+            e.scale,
+            e.unit,
+            e.access.as_str(),
+            e.description
+        )
+    };
+    for table in MAP {
+        for e in table.entries {
+            row(out, e, e.address, None)?;
+        }
+        for b in table.blocks {
+            for i in 0..b.count {
+                for e in b.fields {
+                    row(
+                        out,
+                        e,
+                        b.address + i * b.stride + e.address,
+                        Some((b.prefix, i)),
+                    )?;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every table: entries from 0 without a hole or an overlap, blocks after them
+    /// likewise, each block's fields filling its stride.
+    #[test]
+    fn tables_have_no_hole() {
+        for t in MAP {
+            let mut next = 0;
+            for e in t.entries {
+                assert_eq!(e.address, next, "{}", e.name);
+                next += e.ty.words();
+                if matches!(e.table, Table::Coil | Table::Discrete) {
+                    assert_eq!(e.ty, Type::U16, "{}", e.name);
+                }
+            }
+            for b in t.blocks {
+                assert_eq!(b.address, next, "{}", b.prefix);
+                let mut at = 0;
+                for e in b.fields {
+                    assert_eq!((e.address, e.table), (at, b.table), "{}", e.name);
+                    at += e.ty.words();
+                }
+                assert_eq!(at, b.stride, "{}", b.prefix);
+                next = b.end();
+            }
+            assert_eq!(t.end(), next);
+        }
+    }
+
+    #[test]
+    fn every_address_locates_its_entry() {
+        for t in MAP {
+            for a in 0..t.end() {
+                let l = t.locate(a).expect("inside the table");
+                assert!(l.word < l.entry.ty.words());
+            }
+            assert!(t.locate(t.end()).is_none());
+        }
+        let l = INPUTS
+            .locate(EVENT_SLOTS_ADDRESS + EVENT_STRIDE + 12)
+            .unwrap();
+        assert_eq!((l.entry.name, l.record, l.word), ("value", 1, 1));
+    }
+}

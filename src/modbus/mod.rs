@@ -1,0 +1,364 @@
+//! A Modbus RTU server over a [`Monitor`] of either core (feature `modbus`): `no_std`,
+//! no heap, no panic on any input, transport-agnostic.
+//!
+//! ```
+//! use misalign::modbus::{Server, ServerConfig};
+//! use misalign::monitor::{Config, Monitor, Sample, model_for_range};
+//! use misalign::{Scene, float::Auto};
+//!
+//! let scene = Scene::DEMO;
+//! let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5)?)?;
+//! let monitor = Monitor::new(core, Config::default()).expect("the defaults are valid");
+//! let mut server = Server::new(monitor, ServerConfig::default()).expect("unit 1");
+//! server.process(Sample::new(0, 2e3, 1e-4).with_speed(2.0));
+//! // Read input register 0 (`status`), one register, from unit 1.
+//! for byte in [0x01, 0x04, 0x00, 0x00, 0x00, 0x01, 0x31, 0xCA] {
+//!     server.receive(byte);
+//! }
+//! let answer = server.response().expect("a complete request");
+//! assert_eq!(&answer[..5], &[0x01, 0x04, 0x02, 0x00, 0x01]); // normal, NE 107 good
+//! server.sent();
+//! # Ok::<(), misalign::Error>(())
+//! ```
+//!
+//! **The application's part.** It owns the UART and the clock. Each received byte
+//! goes to [`Server::receive`]; after it, [`Server::response`] holds a complete answer
+//! when one is due: send it, then call [`Server::sent`]. When the application can
+//! see 3.5 character times of silence on the line ([`silence_us`]) it calls
+//! [`Server::idle`]; without a clock the framer still finds every frame of a known
+//! function code from its length and CRC, resynchronising after garbage, and answers
+//! a function code it does not know (exception 01) only at a silence. The node's own
+//! sensors' samples go through [`Server::process`], so that the map follows them. With the feature
+//! `embedded-io`, [`Server::poll`] and [`Server::serve`] do the byte loop over any
+//! UART implementing the `embedded-io` 0.7 traits.
+//!
+//! **External samples** written by a master over the bus (holding blocks `sample_*`,
+//! up to 20 in one function-16 write, and `sample_full_*` with speed and axial force)
+//! are processed by the server itself, in order, before it answers the write, exactly
+//! as [`Server::process`] processes the node's own (the same monitor, clock checks and
+//! counters). Whether they are accepted is chosen at build time
+//! ([`ServerConfig::external_samples`]) and at run time by the coil
+//! `external_samples` or the holding register `external_mode`; while off, such a write
+//! is refused with exception 01 and counted (`external_refused`).
+//!
+//! **The map** ([`map`]) is one table in code: the server reads and writes through it,
+//! and [`registers_csv`] writes it as `docs/modbus/registers.csv`
+//! (`cargo run --example modbus_registers > docs/modbus/registers.csv`). 32-bit
+//! values take two registers, high word first; a value with none reads as the quiet
+//! NaN `0x7FC0_0000` ([`NONE`]). `docs/modbus.md` is the integrator's page.
+//!
+//! **Functions**: 1, 2, 3, 4 (reads), 5, 6, 15, 16 (writes), 43/14 (read device
+//! identification: basic and regular objects, stream and individual access).
+//! Exceptions: 01 for an unknown function (or a MEI type other than 14, or external
+//! samples while they are off), 02 for an address outside the map, a write to a
+//! read-only value, half of a 32-bit value or part of a sample record, 03 for a
+//! quantity or byte count out of range or a value outside a register's domain. No
+//! answer to a wrong CRC, to another unit's frame, or to a broadcast (unit 0), whose
+//! writes are applied.
+//!
+//! The server does not use rmodbus: its frame handling needs the whole frame found
+//! first (the boundaries are this module's work anyway), and its storage model keeps
+//! a copy of every register, where this map computes each value from the monitor when
+//! it is read (no second copy to keep in step, no RAM for it).
+
+mod crc;
+mod events;
+mod ident;
+#[cfg(feature = "embedded-io")]
+mod io;
+pub mod map;
+mod pdu;
+pub mod rtu;
+mod values;
+
+pub use crate::monitor::annunciation::{AlarmSet, Annunciator};
+pub use crc::crc16;
+pub use events::EVENT_WINDOW;
+pub use ident::Identification;
+pub use map::registers_csv;
+pub use pdu::Exception;
+pub use rtu::{ADU_MAX, FramingCounters};
+pub use values::{DecodeError, event_from_registers, fault_code, fault_from_code};
+
+use crate::monitor::{Monitor, RiskState, Sample};
+use crate::{Estimator, FrictionInverse};
+use core::fmt;
+use events::EventWindow;
+use rtu::Framer;
+
+/// What a register holds for a value that is not there (no reading yet, no critical
+/// angle at this load, no time to critical): the quiet NaN, `0x7FC0_0000`.
+pub const NONE: u32 = 0x7FC0_0000;
+
+/// The default unit id.
+pub const DEFAULT_UNIT_ID: u8 = 1;
+
+/// 3.5 character times (us) at `baud` with 11-bit characters (start, 8 data, parity
+/// or a second stop bit, stop), and 1750 us above 19200 baud, as the RTU specification
+/// fixes it: the silence that ends a frame. A `baud` of 0 gives 1750.
+pub const fn silence_us(baud: u32) -> u32 {
+    if baud > 19_200 || baud == 0 {
+        1_750
+    } else {
+        // 3.5 * 11 bits = 38.5 bit times.
+        (38_500_000 / baud) + 1
+    }
+}
+
+/// The server's configuration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ServerConfig {
+    /// The unit id (1 to 247; default 1).
+    pub unit_id: u8,
+    /// What function 43/14 answers.
+    pub ident: Identification,
+    /// Whether external samples written over the bus are processed from the start
+    /// (the coil `external_samples` changes it at run time).
+    pub external_samples: bool,
+    /// The alarms that latch from the start (the coils `latch_*` change it).
+    pub latching: AlarmSet,
+}
+
+impl Default for ServerConfig {
+    fn default() -> Self {
+        ServerConfig {
+            unit_id: DEFAULT_UNIT_ID,
+            ident: Identification::default(),
+            external_samples: false,
+            latching: AlarmSet::NONE,
+        }
+    }
+}
+
+/// A configuration the server refuses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ServerConfigError {
+    /// The unit id is 0 (broadcast) or above 247 (reserved).
+    UnitId,
+}
+
+impl fmt::Display for ServerConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ServerConfigError::UnitId => "the unit id must be 1 to 247",
+        })
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for ServerConfigError {}
+
+/// What the server has counted (besides the monitor's own statistics).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Counters {
+    /// The framer's counts: frames with a valid CRC, bytes discarded.
+    pub framing: FramingCounters,
+    /// Requests for this unit or broadcast.
+    pub server_messages: u32,
+    /// Exception responses sent.
+    pub exceptions: u32,
+    /// Responses replaced by the answer to a later request before they were sent.
+    pub responses_overwritten: u32,
+    /// External samples taken from the bus and processed.
+    pub external_accepted: u32,
+    /// Writes of external samples refused (none of their samples processed).
+    pub external_refused: u32,
+}
+
+/// How a sample reaches the monitor: `Monitor::process`, or
+/// `Monitor::process_with_friction` (f32 scenes).
+type Step<E> = fn(&mut Monitor<E>, Sample) -> RiskState;
+
+/// The Modbus RTU server: the monitor, the register map's state, the framer.
+#[derive(Debug, Clone)]
+pub struct Server<E> {
+    framer: Framer,
+    core: Core<E>,
+}
+
+/// Everything but the framer (whose buffer holds the request being answered).
+#[derive(Debug, Clone)]
+struct Core<E> {
+    monitor: Monitor<E>,
+    step: Step<E>,
+    unit: u8,
+    ident: Identification,
+    model_name: &'static str,
+    annunciator: Annunciator,
+    events: EventWindow,
+    external: bool,
+    /// The last sample's own timestamp.
+    last_time_ms: u32,
+    counters: Counters,
+    response: [u8; ADU_MAX],
+    /// The response's length; 0: none due.
+    response_len: usize,
+}
+
+impl<E: Estimator> Server<E> {
+    /// A server answering as `config.unit_id` over `monitor`; its events still queued
+    /// are taken into the event window, and `event_from` starts at the first of them.
+    ///
+    /// # Errors
+    /// [`ServerConfigError::UnitId`] for a unit id of 0 or above 247.
+    pub fn new(monitor: Monitor<E>, config: ServerConfig) -> Result<Self, ServerConfigError> {
+        Self::with_step(monitor, config, Monitor::process)
+    }
+
+    fn with_step(
+        monitor: Monitor<E>,
+        config: ServerConfig,
+        step: Step<E>,
+    ) -> Result<Self, ServerConfigError> {
+        if !(1..=247).contains(&config.unit_id) {
+            return Err(ServerConfigError::UnitId);
+        }
+        let pending = monitor.pending_events() as u32;
+        let from = monitor.next_event_seq().wrapping_sub(pending);
+        let model_name = if config.ident.model_name.is_empty() {
+            core::any::type_name::<E>()
+        } else {
+            config.ident.model_name
+        };
+        let mut core = Core {
+            monitor,
+            step,
+            unit: config.unit_id,
+            ident: config.ident,
+            model_name,
+            annunciator: Annunciator::new(config.latching),
+            events: EventWindow::new(from),
+            external: config.external_samples,
+            last_time_ms: 0,
+            counters: Counters::default(),
+            response: [0; ADU_MAX],
+            response_len: 0,
+        };
+        core.drain();
+        Ok(Server {
+            framer: Framer::new(),
+            core,
+        })
+    }
+
+    /// Takes one received byte; a request it completes is answered at once (see
+    /// [`response`](Self::response)).
+    pub fn receive(&mut self, byte: u8) {
+        self.framer.push(byte);
+        while let Some(range) = self.framer.next(self.core.unit, false) {
+            self.core.counters.framing = self.framer.counters();
+            self.core.handle(self.framer.bytes(range));
+        }
+    }
+
+    /// The application saw at least 3.5 character times of silence ([`silence_us`])
+    /// after the last byte: what waits is a frame now or never.
+    pub fn idle(&mut self) {
+        let unit = self.core.unit;
+        if let Some(range) = self.framer.silence(unit) {
+            self.core.counters.framing = self.framer.counters();
+            self.core.handle(self.framer.bytes(range));
+        }
+        while let Some(range) = self.framer.next(unit, true) {
+            self.core.counters.framing = self.framer.counters();
+            self.core.handle(self.framer.bytes(range));
+        }
+        self.framer.clear();
+    }
+
+    /// The answer to send, CRC included; `None` while none is due. Send it, then
+    /// call [`sent`](Self::sent). A request completed before then replaces it
+    /// (counted: [`Counters::responses_overwritten`]).
+    pub fn response(&self) -> Option<&[u8]> {
+        match self.core.response_len {
+            0 => None,
+            n => self.core.response.get(..n),
+        }
+    }
+
+    /// The response was sent.
+    pub fn sent(&mut self) {
+        self.core.response_len = 0;
+    }
+
+    /// Processes one of the node's own samples (`Monitor::process`, or
+    /// `Monitor::process_with_friction` for a server made by
+    /// [`with_friction`](Self::with_friction)); the event window and the alarms
+    /// follow. Returns the state after it.
+    pub fn process(&mut self, sample: Sample) -> RiskState {
+        self.core.process(sample)
+    }
+
+    /// The monitor.
+    pub fn monitor(&self) -> &Monitor<E> {
+        &self.core.monitor
+    }
+
+    /// The alarms' annunciation.
+    pub fn annunciator(&self) -> &Annunciator {
+        &self.core.annunciator
+    }
+
+    /// Acknowledges the alarms of `which` (a local button; the bus acknowledges with
+    /// the coil `acknowledge` or the register `acknowledge_alarms`).
+    pub fn acknowledge(&mut self, which: AlarmSet) {
+        self.core.annunciator.acknowledge(which);
+    }
+
+    /// Whether external samples are processed now.
+    pub fn external_samples(&self) -> bool {
+        self.core.external
+    }
+
+    /// The unit id.
+    pub fn unit_id(&self) -> u8 {
+        self.core.unit
+    }
+
+    /// What the server has counted.
+    pub fn counters(&self) -> Counters {
+        Counters {
+            framing: self.framer.counters(),
+            ..self.core.counters
+        }
+    }
+
+    /// The monitor back, the server given up.
+    pub fn into_monitor(self) -> Monitor<E> {
+        self.core.monitor
+    }
+}
+
+impl<E: Estimator + FrictionInverse> Server<E> {
+    /// [`new`](Self::new), with every sample (the node's own and external ones) going
+    /// through `Monitor::process_with_friction`: mu tracked from a measured axial force.
+    ///
+    /// # Errors
+    /// As [`new`](Self::new).
+    pub fn with_friction(
+        monitor: Monitor<E>,
+        config: ServerConfig,
+    ) -> Result<Self, ServerConfigError> {
+        Self::with_step(monitor, config, Monitor::process_with_friction)
+    }
+}
+
+impl<E: Estimator> Core<E> {
+    fn process(&mut self, sample: Sample) -> RiskState {
+        let state = (self.step)(&mut self.monitor, sample);
+        self.last_time_ms = sample.time_ms;
+        self.drain();
+        state
+    }
+
+    /// The monitor's queued events into the window; the alarms from its state.
+    fn drain(&mut self) {
+        while let Some(e) = self.monitor.pop_event() {
+            self.events.push(e);
+        }
+        self.annunciator.update(AlarmSet::of(&self.monitor));
+    }
+}

@@ -1,0 +1,433 @@
+//! Requests to answers: functions 1 to 6, 15, 16 and 43/14 over the register map,
+//! the checks in the specification's order (function, quantity, address, value),
+//! exceptions, broadcasts.
+
+use super::map::{Access, Block, Field, Located, Table, TableMap};
+use super::{Core, crc, ident};
+use crate::Estimator;
+use core::fmt;
+
+/// An exception code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Exception {
+    /// 01: the function is not supported, or not in the server's present state.
+    IllegalFunction = 1,
+    /// 02: an address outside the map, or not writable as asked.
+    IllegalDataAddress = 2,
+    /// 03: a quantity, byte count or value outside what the request allows.
+    IllegalDataValue = 3,
+    /// 04: the server failed while answering (not expected: the answer would not fit
+    /// its buffer).
+    ServerDeviceFailure = 4,
+}
+
+impl fmt::Display for Exception {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Exception::IllegalFunction => "01 illegal function",
+            Exception::IllegalDataAddress => "02 illegal data address",
+            Exception::IllegalDataValue => "03 illegal data value",
+            Exception::ServerDeviceFailure => "04 server device failure",
+        })
+    }
+}
+
+/// Most bits one read returns.
+const READ_BITS_MAX: u16 = 2000;
+/// Most registers one read returns.
+const READ_REGISTERS_MAX: u16 = 125;
+/// Most coils one write sets.
+const WRITE_BITS_MAX: u16 = 1968;
+/// Most registers one write sets.
+const WRITE_REGISTERS_MAX: u16 = 123;
+
+/// The big-endian u16 at `i`.
+fn be(pdu: &[u8], i: usize) -> Option<u16> {
+    let b = pdu.get(i..i + 2)?;
+    Some(u16::from_be_bytes([b[0], b[1]]))
+}
+
+/// Address and quantity (or value) of a request PDU.
+fn head(pdu: &[u8]) -> Result<(u16, u16), Exception> {
+    match (be(pdu, 1), be(pdu, 3)) {
+        (Some(a), Some(q)) => Ok((a, q)),
+        _ => Err(Exception::IllegalDataValue),
+    }
+}
+
+/// Whether `start..start + quantity` lies in `map`.
+fn in_map(map: &TableMap, start: u16, quantity: u16) -> Result<(), Exception> {
+    if u32::from(start) + u32::from(quantity) <= u32::from(map.end()) {
+        Ok(())
+    } else {
+        Err(Exception::IllegalDataAddress)
+    }
+}
+
+/// The table a read or write function addresses.
+const fn table_of(function: u8) -> Table {
+    match function {
+        1 | 5 | 15 => Table::Coil,
+        2 => Table::Discrete,
+        4 => Table::Input,
+        _ => Table::Holding,
+    }
+}
+
+impl<E: Estimator> Core<E> {
+    /// Answers one frame for this unit or a broadcast (CRC checked by the framer).
+    pub(super) fn handle(&mut self, frame: &[u8]) {
+        let (Some(&unit), Some(pdu)) = (frame.first(), frame.get(1..frame.len().saturating_sub(2)))
+        else {
+            return;
+        };
+        let Some(&function) = pdu.first() else {
+            return;
+        };
+        self.counters.server_messages = self.counters.server_messages.wrapping_add(1);
+        let broadcast = unit == 0;
+        let reads = matches!(function, 1..=4 | 43);
+        if broadcast && reads {
+            // Nothing to apply, nothing to answer.
+            return;
+        }
+        if self.response_len != 0 {
+            self.counters.responses_overwritten =
+                self.counters.responses_overwritten.wrapping_add(1);
+            self.response_len = 0;
+        }
+        let result = self.dispatch(function, pdu);
+        if broadcast {
+            return;
+        }
+        let len = match result {
+            Ok(n) => n,
+            Err(x) => {
+                self.counters.exceptions = self.counters.exceptions.wrapping_add(1);
+                if let Some(b) = self.response.get_mut(1..3) {
+                    b.copy_from_slice(&[function | 0x80, x as u8]);
+                }
+                2
+            }
+        };
+        self.response[0] = self.unit;
+        // The PDU is at most 253 bytes: the ADU at most 256.
+        let end = len.min(253) + 1;
+        let crc = crc::crc16(self.response.get(..end).unwrap_or(&[])).to_le_bytes();
+        if let Some(tail) = self.response.get_mut(end..end + 2) {
+            tail.copy_from_slice(&crc);
+            self.response_len = end + 2;
+        }
+    }
+
+    /// The response PDU into `self.response[1..]`; its length.
+    fn dispatch(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
+        match function {
+            1 | 2 => self.read_bits(function, pdu),
+            3 | 4 => self.read_registers(function, pdu),
+            5 => self.write_coil(pdu),
+            6 => self.write_register(pdu),
+            15 => self.write_coils(pdu),
+            16 => self.write_registers(pdu),
+            43 => {
+                let out = self
+                    .response
+                    .get_mut(1..254)
+                    .ok_or(Exception::ServerDeviceFailure)?;
+                ident::read(&self.ident, self.model_name, pdu, out)
+            }
+            _ => Err(Exception::IllegalFunction),
+        }
+    }
+
+    /// The response PDU's buffer: `[function, ...]`, 253 bytes.
+    fn out(&mut self, function: u8) -> &mut [u8] {
+        let out = self.response.get_mut(1..254).unwrap_or(&mut []);
+        if let Some(f) = out.first_mut() {
+            *f = function;
+        }
+        out
+    }
+
+    fn read_bits(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
+        let (start, quantity) = head(pdu)?;
+        if quantity == 0 || quantity > READ_BITS_MAX {
+            return Err(Exception::IllegalDataValue);
+        }
+        let map = TableMap::of(table_of(function));
+        in_map(map, start, quantity)?;
+        // At most 2000 bits: 250 bytes.
+        let bytes = usize::from(quantity.div_ceil(8)).min(250);
+        let mut packed = [0u8; 250];
+        for i in 0..quantity {
+            let l = map
+                .locate(start.wrapping_add(i))
+                .ok_or(Exception::IllegalDataAddress)?;
+            if self.value(l.entry.field, l.record) & 1 != 0
+                && let Some(b) = packed.get_mut(usize::from(i / 8))
+            {
+                *b |= 1 << (i % 8);
+            }
+        }
+        let out = self.out(function);
+        let dest = out
+            .get_mut(1..2 + bytes)
+            .ok_or(Exception::ServerDeviceFailure)?;
+        dest[0] = bytes as u8;
+        for (d, s) in dest[1..].iter_mut().zip(&packed) {
+            *d = *s;
+        }
+        Ok(2 + bytes)
+    }
+
+    fn read_registers(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
+        let (start, quantity) = head(pdu)?;
+        if quantity == 0 || quantity > READ_REGISTERS_MAX {
+            return Err(Exception::IllegalDataValue);
+        }
+        let map = TableMap::of(table_of(function));
+        in_map(map, start, quantity)?;
+        let mut words = [0u16; READ_REGISTERS_MAX as usize];
+        let words = words.get_mut(..usize::from(quantity)).unwrap_or(&mut []);
+        let mut i = 0usize;
+        while i < words.len() {
+            let l = map
+                .locate(start.wrapping_add(i as u16))
+                .ok_or(Exception::IllegalDataAddress)?;
+            let v = self.value(l.entry.field, l.record);
+            let n = l.entry.ty.words();
+            for w in l.word..n {
+                let Some(slot) = words.get_mut(i) else { break };
+                *slot = if n == 2 && w == 0 {
+                    (v >> 16) as u16
+                } else {
+                    v as u16
+                };
+                i += 1;
+            }
+        }
+        let bytes = 2 * words.len();
+        let out = self.out(function);
+        let dest = out
+            .get_mut(1..2 + bytes)
+            .ok_or(Exception::ServerDeviceFailure)?;
+        dest[0] = bytes as u8;
+        for (d, w) in dest[1..].chunks_exact_mut(2).zip(words.iter()) {
+            d.copy_from_slice(&w.to_be_bytes());
+        }
+        Ok(2 + bytes)
+    }
+
+    /// Echoes the request's address and value (functions 5 and 6) or address and
+    /// quantity (15 and 16).
+    fn echo(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
+        let src = pdu.get(..5).ok_or(Exception::IllegalDataValue)?;
+        let dest = self
+            .response
+            .get_mut(1..6)
+            .ok_or(Exception::ServerDeviceFailure)?;
+        dest.copy_from_slice(src);
+        Ok(5)
+    }
+
+    /// The coil at `address`, if a master may write it.
+    fn writable(map: &TableMap, address: u16) -> Result<Located, Exception> {
+        match map.locate(address) {
+            Some(l) if l.entry.access == Access::Rw => Ok(l),
+            _ => Err(Exception::IllegalDataAddress),
+        }
+    }
+
+    fn write_coil(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
+        let (address, value) = head(pdu)?;
+        let on = match value {
+            0xFF00 => true,
+            0x0000 => false,
+            _ => return Err(Exception::IllegalDataValue),
+        };
+        let l = Self::writable(TableMap::of(Table::Coil), address)?;
+        self.write_bit(l.entry.field, on);
+        self.echo(pdu)
+    }
+
+    fn write_coils(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
+        let (start, quantity) = head(pdu)?;
+        let bytes = usize::from(quantity.div_ceil(8));
+        let data = pdu.get(6..).unwrap_or(&[]);
+        let declared = pdu.get(5).map_or(0, |&n| usize::from(n));
+        if quantity == 0 || quantity > WRITE_BITS_MAX || declared != bytes || data.len() != bytes {
+            return Err(Exception::IllegalDataValue);
+        }
+        let map = TableMap::of(Table::Coil);
+        in_map(map, start, quantity)?;
+        for i in 0..quantity {
+            Self::writable(map, start.wrapping_add(i))?;
+        }
+        for i in 0..quantity {
+            let on = data
+                .get(usize::from(i / 8))
+                .is_some_and(|b| b >> (i % 8) & 1 != 0);
+            let l = Self::writable(map, start.wrapping_add(i))?;
+            self.write_bit(l.entry.field, on);
+        }
+        self.echo(pdu)
+    }
+
+    fn write_register(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
+        let (address, value) = head(pdu)?;
+        let l = Self::writable(TableMap::of(Table::Holding), address)?;
+        if l.entry.ty.words() != 1 || matches!(l.entry.field, Field::Sample(_)) {
+            // Half of a 32-bit value, or part of a sample record.
+            return Err(Exception::IllegalDataAddress);
+        }
+        self.check_word(l.entry.field, u32::from(value))?;
+        self.write_word(l.entry.field, u32::from(value));
+        self.echo(pdu)
+    }
+
+    fn write_registers(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
+        let (start, quantity) = head(pdu)?;
+        let data = pdu.get(6..).unwrap_or(&[]);
+        let declared = pdu.get(5).map_or(0, |&n| usize::from(n));
+        let bytes = 2 * usize::from(quantity);
+        if quantity == 0
+            || quantity > WRITE_REGISTERS_MAX
+            || declared != bytes
+            || data.len() != bytes
+        {
+            return Err(Exception::IllegalDataValue);
+        }
+        let map = TableMap::of(Table::Holding);
+        in_map(map, start, quantity)?;
+        let word = |i: u16| be(data, 2 * usize::from(i)).unwrap_or(0);
+        if start >= map.entries_end() {
+            let block = map
+                .blocks
+                .iter()
+                .find(|b| start < b.end())
+                .ok_or(Exception::IllegalDataAddress)?;
+            return self
+                .write_samples(block, start, quantity, data)
+                .and_then(|()| self.echo(pdu));
+        }
+        // Single entries only, each whole and writable: checked, then written.
+        // Inside the map (checked above): no u16 below wraps.
+        let end = start.wrapping_add(quantity);
+        if end > map.entries_end() {
+            return Err(Exception::IllegalDataAddress);
+        }
+        for pass in [false, true] {
+            let mut a = start;
+            while a < end {
+                let l = Self::writable(map, a)?;
+                let n = l.entry.ty.words();
+                if l.word != 0 || a.wrapping_add(n) > end {
+                    return Err(Exception::IllegalDataAddress);
+                }
+                let i = a.wrapping_sub(start);
+                let v = if n == 2 {
+                    u32::from(word(i)) << 16 | u32::from(word(i.wrapping_add(1)))
+                } else {
+                    u32::from(word(i))
+                };
+                if pass {
+                    self.write_word(l.entry.field, v);
+                } else {
+                    self.check_word(l.entry.field, v)?;
+                }
+                a = a.wrapping_add(n);
+            }
+        }
+        self.echo(pdu)
+    }
+
+    /// Whole records of external samples into `block`: checked, then processed in
+    /// order. A refused write processes none and is counted.
+    fn write_samples(
+        &mut self,
+        block: &Block,
+        start: u16,
+        quantity: u16,
+        data: &[u8],
+    ) -> Result<(), Exception> {
+        let result = self.check_samples(block, start, quantity, data);
+        if result.is_err() {
+            self.counters.external_refused = self.counters.external_refused.wrapping_add(1);
+        }
+        let records = result?;
+        for record in data
+            .chunks_exact(2 * usize::from(block.stride))
+            .take(records)
+        {
+            if let Some(sample) = super::values::sample_from_record(block, record) {
+                self.counters.external_accepted = self.counters.external_accepted.wrapping_add(1);
+                self.process(sample);
+            }
+        }
+        Ok(())
+    }
+
+    /// The number of whole records of a write to `block`, or why it is refused.
+    fn check_samples(
+        &self,
+        block: &Block,
+        start: u16,
+        quantity: u16,
+        data: &[u8],
+    ) -> Result<usize, Exception> {
+        let offset = start
+            .checked_sub(block.address)
+            .ok_or(Exception::IllegalDataAddress)?;
+        let stride = block.stride;
+        let whole = offset.is_multiple_of(stride) && quantity.is_multiple_of(stride);
+        if !whole || u32::from(start) + u32::from(quantity) > u32::from(block.end()) {
+            return Err(Exception::IllegalDataAddress);
+        }
+        if !self.external {
+            return Err(Exception::IllegalFunction);
+        }
+        for record in data.chunks_exact(2 * usize::from(stride)) {
+            if super::values::sample_from_record(block, record).is_none() {
+                return Err(Exception::IllegalDataValue);
+            }
+        }
+        Ok(usize::from(quantity / stride))
+    }
+
+    /// Whether `v` is in the domain of the writable register `field`.
+    fn check_word(&self, field: Field, v: u32) -> Result<(), Exception> {
+        let ok = match field {
+            Field::AcknowledgeAlarms | Field::LatchingAlarms => v <= 15,
+            Field::ExternalMode => v <= 1,
+            Field::EventFrom => true,
+            _ => false,
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(Exception::IllegalDataValue)
+        }
+    }
+
+    fn write_bit(&mut self, field: Field, on: bool) {
+        let a = &mut self.annunciator;
+        match field {
+            Field::Acknowledge if on => a.acknowledge(super::AlarmSet::ALL),
+            Field::Latching(which) => a.set_latching(a.latching().with(which, on)),
+            Field::ExternalSamples => self.external = on,
+            _ => {}
+        }
+    }
+
+    fn write_word(&mut self, field: Field, v: u32) {
+        let bits = super::AlarmSet::from_bits(v as u8);
+        match field {
+            Field::EventFrom => self.events.from = v,
+            Field::AcknowledgeAlarms => self.annunciator.acknowledge(bits),
+            Field::LatchingAlarms => self.annunciator.set_latching(bits),
+            Field::ExternalMode => self.external = v != 0,
+            _ => {}
+        }
+    }
+}

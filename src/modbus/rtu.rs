@@ -1,0 +1,357 @@
+//! RTU framing, fed a byte at a time: frame boundaries from the function code's
+//! length, the CRC as the judge, resynchronisation by sliding one byte past whatever
+//! is not a frame, and the 3.5-character silence where the application reports it.
+//!
+//! The bytes since the last frame wait in a buffer of one ADU (256 bytes). After each
+//! byte the *candidate* (the frame that would start at the oldest waiting byte) is
+//! classified from its address and function code: a request of a known length for
+//! this unit or a broadcast is taken once complete with a valid CRC; a frame for
+//! another unit (its request, or another server's response) is skipped once either
+//! length has a valid CRC; anything else (an address above 247, an unknown function
+//! code, a declared length above 256 bytes, a complete candidate with a wrong CRC)
+//! drops its first byte, and the next byte becomes the candidate. Each byte is a
+//! candidate's first byte at most once, and a candidate is checked once per length.
+//!
+//! The silence ([`Framer::silence`]) ends whatever waits: the bytes since the last
+//! frame, whole, are a frame if their CRC holds (the specification's rule, which also
+//! finds requests of function codes whose length this table does not know, to be
+//! answered with exception 01); otherwise the candidates are resolved as if no more
+//! bytes could come (an incomplete one drops its first byte), and the buffer empties.
+
+use super::crc;
+use core::ops::Range;
+
+/// The largest RTU frame (address, PDU of up to 253 bytes, CRC).
+pub const ADU_MAX: usize = 256;
+
+/// The highest unicast address; 248 to 255 are reserved.
+const ADDRESS_MAX: u8 = 247;
+
+/// A frame's length from its first bytes.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Len {
+    /// This many bytes, CRC included.
+    Known(usize),
+    /// The byte that gives it has not arrived yet.
+    NeedMore,
+    /// Not known for this function code.
+    Unknown,
+}
+
+/// The length of a request with function code `b[1]`.
+fn request_len(b: &[u8]) -> Len {
+    let at = |i: usize, base: usize| {
+        b.get(i)
+            .map_or(Len::NeedMore, |&n| Len::Known(base + usize::from(n)))
+    };
+    match b[1] {
+        1..=6 | 8 => Len::Known(8),
+        7 | 11 | 12 | 17 => Len::Known(4),
+        15 | 16 => at(6, 9),
+        20 | 21 => at(2, 5),
+        22 => Len::Known(10),
+        23 => at(10, 13),
+        24 => Len::Known(6),
+        43 => match b.get(2) {
+            Some(&0x0E) => Len::Known(7),
+            Some(_) => Len::Unknown,
+            None => Len::NeedMore,
+        },
+        _ => Len::Unknown,
+    }
+}
+
+/// The length of a response with function code `b[1]` (another server's answer on
+/// a shared bus).
+fn response_len(b: &[u8]) -> Len {
+    match b[1] {
+        0x80..=0xFF => Len::Known(5),
+        1..=4 => b
+            .get(2)
+            .map_or(Len::NeedMore, |&n| Len::Known(5 + usize::from(n))),
+        5 | 6 | 15 | 16 => Len::Known(8),
+        _ => Len::Unknown,
+    }
+}
+
+/// What the candidate at the start of the waiting bytes is.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Class {
+    /// Not decided before more bytes come.
+    Need,
+    /// Not a frame: drop its first byte.
+    Drop,
+    /// A request for this unit (or a broadcast) of this length.
+    Ours(usize),
+    /// A frame for another unit of this length: skip it.
+    Other(usize),
+}
+
+/// The candidate at the start of `b` for unit `unit`.
+fn classify(b: &[u8], unit: u8) -> Class {
+    let Some(&address) = b.first() else {
+        return Class::Need;
+    };
+    if address > ADDRESS_MAX {
+        return Class::Drop;
+    }
+    if b.len() < 2 {
+        return Class::Need;
+    }
+    let complete_with_crc = |n: usize| n <= b.len() && b.get(..n).is_some_and(crc::valid);
+    if address == unit || address == 0 {
+        return match request_len(b) {
+            Len::NeedMore => Class::Need,
+            Len::Known(n) if n <= ADU_MAX => {
+                if n > b.len() {
+                    Class::Need
+                } else if complete_with_crc(n) {
+                    Class::Ours(n)
+                } else {
+                    Class::Drop
+                }
+            }
+            Len::Known(_) | Len::Unknown => Class::Drop,
+        };
+    }
+    // Another unit's request or another server's response: whichever length fits.
+    let mut waiting = false;
+    for len in [request_len(b), response_len(b)] {
+        match len {
+            Len::Known(n) if n <= ADU_MAX => {
+                if n > b.len() {
+                    waiting = true;
+                } else if complete_with_crc(n) {
+                    return Class::Other(n);
+                }
+            }
+            Len::NeedMore => waiting = true,
+            Len::Known(_) | Len::Unknown => {}
+        }
+    }
+    if waiting { Class::Need } else { Class::Drop }
+}
+
+/// Counters of the framing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FramingCounters {
+    /// Frames with a valid CRC, for any unit.
+    pub frames: u32,
+    /// Bytes dropped: not part of a frame with a valid CRC (garbage, a wrong CRC, a
+    /// truncated or oversized frame, a reserved address).
+    pub discarded: u32,
+}
+
+/// The byte-fed framer.
+#[derive(Debug, Clone)]
+pub struct Framer {
+    buf: [u8; ADU_MAX],
+    len: usize,
+    /// The candidate's first byte.
+    start: usize,
+    /// The end of the last frame found (the silence's whole-span check starts here).
+    consumed: usize,
+    /// Bytes since the last frame were moved out of the buffer to make room: the span
+    /// since the last frame is no longer whole.
+    overflowed: bool,
+    counters: FramingCounters,
+}
+
+impl Default for Framer {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Framer {
+    /// An empty framer.
+    pub const fn new() -> Self {
+        Framer {
+            buf: [0; ADU_MAX],
+            len: 0,
+            start: 0,
+            consumed: 0,
+            overflowed: false,
+            counters: FramingCounters {
+                frames: 0,
+                discarded: 0,
+            },
+        }
+    }
+
+    /// The counters.
+    pub const fn counters(&self) -> FramingCounters {
+        self.counters
+    }
+
+    /// The bytes of a range [`next`](Self::next) or [`silence`](Self::silence) gave.
+    pub fn bytes(&self, range: Range<usize>) -> &[u8] {
+        self.buf.get(range).unwrap_or(&[])
+    }
+
+    /// Appends one received byte. A full buffer first drops the bytes before the
+    /// candidate (or the candidate's first byte).
+    pub fn push(&mut self, byte: u8) {
+        if self.len >= ADU_MAX {
+            if self.start == 0 {
+                self.drop_one();
+            }
+            let len = self.len.min(ADU_MAX);
+            let start = self.start.min(len);
+            self.buf.copy_within(start..len, 0);
+            self.overflowed |= self.consumed < start;
+            self.len = len - start;
+            self.consumed = self.consumed.saturating_sub(start);
+            self.start = 0;
+        }
+        if let Some(slot) = self.buf.get_mut(self.len) {
+            *slot = byte;
+            self.len = self.len.saturating_add(1);
+        }
+    }
+
+    fn drop_one(&mut self) {
+        self.start = self.start.saturating_add(1);
+        self.counters.discarded = self.counters.discarded.saturating_add(1);
+    }
+
+    /// The next request for `unit` (or a broadcast) among the waiting bytes, as a
+    /// range for [`bytes`](Self::bytes); `None` until more bytes come. With `silence`
+    /// (no more bytes of this frame will come) an incomplete candidate is dropped.
+    pub fn next(&mut self, unit: u8, silence: bool) -> Option<Range<usize>> {
+        loop {
+            let waiting = self.buf.get(self.start..self.len)?;
+            if waiting.is_empty() {
+                return None;
+            }
+            match classify(waiting, unit) {
+                Class::Need if silence => self.drop_one(),
+                Class::Need => return None,
+                Class::Drop => self.drop_one(),
+                Class::Ours(n) => return Some(self.take(n)),
+                Class::Other(n) => {
+                    self.take(n);
+                }
+            }
+        }
+    }
+
+    fn take(&mut self, n: usize) -> Range<usize> {
+        let range = self.start..self.start.saturating_add(n);
+        self.start = range.end;
+        self.consumed = range.end;
+        self.counters.frames = self.counters.frames.saturating_add(1);
+        range
+    }
+
+    /// The silence: the bytes since the last frame, whole, if they are a frame for
+    /// `unit` with a valid CRC that the length table did not find (an unknown
+    /// function code). Call [`next`](Self::next) with `silence` after it until it
+    /// answers `None`, then [`clear`](Self::clear).
+    pub fn silence(&mut self, unit: u8) -> Option<Range<usize>> {
+        let span = self.consumed..self.len;
+        let bytes = self.buf.get(span.clone())?;
+        let whole = !self.overflowed
+            && bytes.len() >= 4
+            && (bytes[0] == unit || bytes[0] == 0)
+            && crc::valid(bytes);
+        if whole {
+            // The bytes counted as dropped were a frame after all.
+            let n = self.start.saturating_sub(self.consumed) as u32;
+            self.counters.discarded = self.counters.discarded.saturating_sub(n);
+            self.start = span.start;
+            Some(self.take(span.len()))
+        } else {
+            None
+        }
+    }
+
+    /// Empties the buffer (after a silence).
+    pub fn clear(&mut self) {
+        let left = self.len.saturating_sub(self.start) as u32;
+        self.counters.discarded = self.counters.discarded.saturating_add(left);
+        self.len = 0;
+        self.start = 0;
+        self.consumed = 0;
+        self.overflowed = false;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::vec::Vec;
+
+    fn frame(body: &[u8]) -> Vec<u8> {
+        let mut f = body.to_vec();
+        f.extend_from_slice(&crc::crc16(body).to_le_bytes());
+        f
+    }
+
+    fn feed(f: &mut Framer, bytes: &[u8], unit: u8) -> Vec<Vec<u8>> {
+        let mut out = Vec::new();
+        for &b in bytes {
+            f.push(b);
+            while let Some(r) = f.next(unit, false) {
+                out.push(f.bytes(r).to_vec());
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_request_after_garbage_and_another_units_traffic() {
+        let ours = frame(&[1, 3, 0, 0, 0, 16]);
+        let theirs = frame(&[2, 3, 0, 0, 0, 2]);
+        let their_answer = frame(&[2, 3, 4, 0, 1, 0, 2]);
+        let mut bytes = vec![0xFF, 0x01, 0x10, 0x00];
+        bytes.extend(&theirs);
+        bytes.extend(&their_answer);
+        bytes.extend(&ours);
+        let mut f = Framer::new();
+        let got = feed(&mut f, &bytes, 1);
+        assert_eq!(got, vec![ours]);
+        assert_eq!(f.counters().frames, 3);
+    }
+
+    #[test]
+    fn unknown_function_code_found_at_the_silence() {
+        let request = frame(&[1, 0x41, 9, 9, 9]);
+        let mut f = Framer::new();
+        assert!(feed(&mut f, &request, 1).is_empty());
+        let r = f.silence(1).expect("the whole span is a frame");
+        assert_eq!(f.bytes(r), &request[..]);
+        assert_eq!(f.counters().discarded, 0);
+        assert!(f.next(1, true).is_none());
+        f.clear();
+    }
+
+    #[test]
+    fn a_frame_inside_an_incomplete_candidate_is_found_at_the_silence() {
+        // A function-16 header declaring 200 data bytes, then a whole request.
+        let ours = frame(&[1, 4, 0, 0, 0, 1]);
+        let mut bytes = vec![1, 16, 0, 0, 0, 100, 200];
+        bytes.extend(&ours);
+        let mut f = Framer::new();
+        assert!(feed(&mut f, &bytes, 1).is_empty());
+        assert!(f.silence(1).is_none());
+        let r = f
+            .next(1, true)
+            .expect("found once the candidate cannot complete");
+        assert_eq!(f.bytes(r), &ours[..]);
+    }
+
+    #[test]
+    fn a_long_stream_of_garbage_overflows_without_harm() {
+        let mut f = Framer::new();
+        // A function-16 header declaring 246 data bytes holds the buffer full until
+        // its candidate fails; reserved addresses are dropped at once.
+        let mut garbage = vec![1, 16, 0, 0, 0, 123, 246];
+        garbage.extend((0..2000u32).map(|i| if i % 3 == 0 { 0 } else { 0xF8 | i as u8 }));
+        assert!(feed(&mut f, &garbage, 1).is_empty());
+        assert!(f.counters().discarded > 2000);
+        let ours = frame(&[1, 1, 0, 0, 0, 8]);
+        assert_eq!(feed(&mut f, &ours, 1), vec![ours]);
+    }
+}

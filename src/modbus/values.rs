@@ -1,0 +1,353 @@
+//! The map's values: each computed from the monitor when it is read; the codes of
+//! states, event kinds and faults; external sample records decoded; and the decoding
+//! of an event slot for a master written in Rust.
+
+use super::map::{Block, EventField, Field, SampleField};
+use super::{AlarmSet, Core, NONE};
+use crate::Estimator;
+use crate::monitor::{Channel, Event, EventKind, FaultCause, Reading, RiskState, Sample};
+use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
+use core::fmt;
+
+/// The bits of an optional f32: [`NONE`] for none.
+fn opt(x: Option<f32>) -> u32 {
+    x.map_or(NONE, f32::to_bits)
+}
+
+/// The NAMUR NE 107 category in `status` (bits 8-11).
+mod ne107 {
+    pub const GOOD: u32 = 0;
+    pub const MAINTENANCE_REQUIRED: u32 = 1;
+    pub const OUT_OF_SPECIFICATION: u32 = 2;
+    pub const FUNCTION_CHECK: u32 = 3;
+    pub const FAILURE: u32 = 4;
+}
+
+const fn channel_code(c: Channel) -> u16 {
+    match c {
+        Channel::Load => 0,
+        Channel::Angle => 1,
+        Channel::Speed => 2,
+        Channel::AxialForce => 3,
+    }
+}
+
+const CHANNELS: [Channel; 4] = [
+    Channel::Load,
+    Channel::Angle,
+    Channel::Speed,
+    Channel::AxialForce,
+];
+
+const fn kind_code(k: FaultKind) -> u16 {
+    match k {
+        FaultKind::Disconnected => 0,
+        FaultKind::Bus => 1,
+        FaultKind::Saturated => 2,
+        FaultKind::Stuck => 3,
+        FaultKind::Jump => 4,
+        FaultKind::OutOfRange => 5,
+    }
+}
+
+/// The code of an event's fault (the event slot's `fault`): bits 8-15 the cause (0
+/// none, 1 non-finite, 2 out of range, 3 stuck, 4 gap, 5 time backwards, 6 driver, 7
+/// estimator, 8 sensor); bits 0-7 the channel (0 load, 1 angle, 2 speed, 3 axial force),
+/// or for a sensor's fault the sensor in bits 4-7 ([`SensorId::index`]) and the kind in
+/// bits 0-3 (in the order of [`FaultKind::ALL`]).
+pub const fn fault_code(fault: Option<FaultCause>) -> u16 {
+    let (cause, low) = match fault {
+        None => (0, 0),
+        Some(FaultCause::NonFinite(c)) => (1, channel_code(c)),
+        Some(FaultCause::OutOfRange(c)) => (2, channel_code(c)),
+        Some(FaultCause::Stuck(c)) => (3, channel_code(c)),
+        Some(FaultCause::Gap) => (4, 0),
+        Some(FaultCause::TimeBackwards) => (5, 0),
+        Some(FaultCause::Driver(c)) => (6, channel_code(c)),
+        Some(FaultCause::Estimator) => (7, 0),
+        Some(FaultCause::Sensor(s)) => (8, (s.sensor.index() as u16) << 4 | kind_code(s.kind)),
+    };
+    cause << 8 | low
+}
+
+/// The fault of a code [`fault_code`] gave (`Some(None)`: no fault); `None` for a code
+/// it never gives.
+pub fn fault_from_code(code: u16) -> Option<Option<FaultCause>> {
+    let low = code & 0xFF;
+    let channel = || CHANNELS.get(usize::from(low)).copied();
+    let fault = match code >> 8 {
+        0 if low == 0 => None,
+        1 => Some(FaultCause::NonFinite(channel()?)),
+        2 => Some(FaultCause::OutOfRange(channel()?)),
+        3 => Some(FaultCause::Stuck(channel()?)),
+        4 if low == 0 => Some(FaultCause::Gap),
+        5 if low == 0 => Some(FaultCause::TimeBackwards),
+        6 => Some(FaultCause::Driver(channel()?)),
+        7 if low == 0 => Some(FaultCause::Estimator),
+        8 => Some(FaultCause::Sensor(SensorFault {
+            sensor: *SensorId::ALL.get(usize::from(low >> 4))?,
+            kind: *FaultKind::ALL.get(usize::from(low & 15))?,
+        })),
+        _ => return None,
+    };
+    Some(fault)
+}
+
+/// An event slot's `kind`.
+const fn event_kind_code(kind: &EventKind) -> u32 {
+    match kind {
+        EventKind::StateChange { .. } => 1,
+        EventKind::Approaching { .. } => 2,
+        EventKind::Friction { changed: true, .. } => 3,
+        EventKind::Friction { changed: false, .. } => 4,
+    }
+}
+
+/// An event slot's field.
+fn event_value(e: &Event, field: EventField) -> u32 {
+    let r = &e.reading;
+    let (from, to, fault) = match e.kind {
+        EventKind::StateChange { from, to, fault } => {
+            (from.index() as u32, to.index() as u32, fault_code(fault))
+        }
+        _ => (0, 0, 0),
+    };
+    match field {
+        EventField::Seq => e.seq,
+        EventField::TimeMs => e.time_ms,
+        EventField::ElapsedS => u32::try_from(e.elapsed_ms / 1000).unwrap_or(u32::MAX),
+        EventField::ElapsedMs => (e.elapsed_ms % 1000) as u32,
+        EventField::Kind => event_kind_code(&e.kind),
+        EventField::From => from,
+        EventField::To => to,
+        EventField::Fault => u32::from(fault),
+        EventField::Value => match e.kind {
+            EventKind::Approaching { time_to_critical_s } => time_to_critical_s.to_bits(),
+            EventKind::Friction { mu, .. } => mu.to_bits(),
+            EventKind::StateChange { .. } => NONE,
+        },
+        EventField::Load => r.load.to_bits(),
+        EventField::Phi => r.phi.to_bits(),
+        EventField::SlipRatio => r.slip_ratio.to_bits(),
+        EventField::AxialForce => r.axial_force.to_bits(),
+        EventField::CriticalAngle => opt(r.critical_angle),
+        EventField::Margin => opt(r.margin),
+    }
+}
+
+/// Why registers are not an event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum DecodeError {
+    /// Fewer registers than a slot.
+    Short,
+    /// A kind, state or fault code the server never writes.
+    Code,
+}
+
+impl fmt::Display for DecodeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            DecodeError::Short => "fewer registers than an event slot",
+            DecodeError::Code => "a kind, state or fault code the server never writes",
+        })
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for DecodeError {}
+
+/// The event in one event slot's registers (as read, `event_0_seq` first); `Ok(None)`
+/// for an empty slot. What a master written in Rust uses to get the monitor's own
+/// [`Event`] back, bit for bit.
+///
+/// # Errors
+/// [`DecodeError`] for fewer registers than a slot or a code the server never writes.
+pub fn event_from_registers(regs: &[u16]) -> Result<Option<Event>, DecodeError> {
+    let r = regs
+        .get(..usize::from(super::map::EVENT_STRIDE))
+        .ok_or(DecodeError::Short)?;
+    let u32_at = |i: usize| u32::from(r[i]) << 16 | u32::from(r[i + 1]);
+    let f32_at = |i: usize| f32::from_bits(u32_at(i));
+    let opt_at = |i: usize| Some(u32_at(i)).filter(|&b| b != NONE).map(f32::from_bits);
+    let state = |i: usize| {
+        RiskState::ALL
+            .get(usize::from(r[i]))
+            .copied()
+            .ok_or(DecodeError::Code)
+    };
+    let kind = match r[7] {
+        0 => return Ok(None),
+        1 => EventKind::StateChange {
+            from: state(8)?,
+            to: state(9)?,
+            fault: fault_from_code(r[10]).ok_or(DecodeError::Code)?,
+        },
+        2 => EventKind::Approaching {
+            time_to_critical_s: f32_at(11),
+        },
+        3 | 4 => EventKind::Friction {
+            mu: f32_at(11),
+            changed: r[7] == 3,
+        },
+        _ => return Err(DecodeError::Code),
+    };
+    Ok(Some(Event {
+        seq: u32_at(0),
+        time_ms: u32_at(2),
+        elapsed_ms: u64::from(u32_at(4)) * 1000 + u64::from(r[6]),
+        kind,
+        reading: Reading {
+            load: f32_at(13),
+            phi: f32_at(15),
+            slip_ratio: f32_at(17),
+            axial_force: f32_at(19),
+            critical_angle: opt_at(21),
+            margin: opt_at(23),
+        },
+    }))
+}
+
+/// The sample in one record of an external samples block (big-endian register
+/// bytes); `None` for flags with bits other than speed (0) and axial force (1).
+pub(crate) fn sample_from_record(block: &Block, record: &[u8]) -> Option<Sample> {
+    let mut sample = Sample::new(0, 0.0, 0.0);
+    let mut flags = 0u16;
+    let mut speed = None;
+    let mut force = None;
+    for e in block.fields {
+        let at = 2 * usize::from(e.address);
+        let word = |i: usize| -> Option<u32> {
+            let b = record.get(at + 2 * i..at + 2 * i + 2)?;
+            Some(u32::from(u16::from_be_bytes([b[0], b[1]])))
+        };
+        let v = match e.ty.words() {
+            2 => word(0)? << 16 | word(1)?,
+            _ => word(0)?,
+        };
+        let x = f32::from_bits(v);
+        match e.field {
+            Field::Sample(SampleField::Flags) => flags = v as u16,
+            Field::Sample(SampleField::TimeMs) => sample.time_ms = v,
+            Field::Sample(SampleField::Load) => sample.load = x,
+            Field::Sample(SampleField::Phi) => sample.phi = x,
+            Field::Sample(SampleField::Speed) => speed = Some(x),
+            Field::Sample(SampleField::AxialForce) => force = Some(x),
+            _ => return None,
+        }
+    }
+    if flags & !3 != 0 {
+        return None;
+    }
+    sample.speed = speed.filter(|_| flags & 1 != 0);
+    sample.axial_force = force.filter(|_| flags & 2 != 0);
+    Some(sample)
+}
+
+impl<E: Estimator> Core<E> {
+    /// `status`: the risk state, the NE 107 category, the unacknowledged alarms.
+    fn status(&self) -> u32 {
+        let state = self.monitor.state();
+        let a = &self.annunciator;
+        let category = if self.monitor.statistics().samples == 0 {
+            ne107::FUNCTION_CHECK
+        } else {
+            match state {
+                RiskState::SensorFault => ne107::FAILURE,
+                RiskState::GrossSlip => ne107::OUT_OF_SPECIFICATION,
+                RiskState::Microslip => ne107::MAINTENANCE_REQUIRED,
+                _ if a.active().contains(AlarmSet::APPROACHING) => ne107::MAINTENANCE_REQUIRED,
+                _ => ne107::GOOD,
+            }
+        };
+        state.index() as u32 | category << 8 | u32::from(a.unacknowledged().bits()) << 12
+    }
+
+    /// The value of `field` (of record `record` in a block) as the bits on the wire:
+    /// a 16-bit value in the low half.
+    pub(super) fn value(&self, field: Field, record: u16) -> u32 {
+        let m = &self.monitor;
+        let s = m.statistics();
+        let r = m.reading();
+        let a = &self.annunciator;
+        let bit = |set: AlarmSet, which: AlarmSet| u32::from(set.contains(which));
+        let per_state = |i: u8| usize::from(i);
+        match field {
+            Field::Acknowledge | Field::AcknowledgeAlarms | Field::Sample(_) => 0,
+            Field::Latching(w) => bit(a.latching(), w),
+            Field::ExternalSamples | Field::ExternalMode => u32::from(self.external),
+            Field::Indicated(w) => bit(a.indicated(), w),
+            Field::Unacknowledged(w) => bit(a.unacknowledged(), w),
+            Field::Running => u32::from(m.state() != RiskState::Stopped),
+            Field::EventAvailable => u32::from(self.events.unread().next().is_some()),
+            Field::Status => self.status(),
+            Field::Alarms => {
+                u32::from(a.indicated().bits())
+                    | u32::from(a.active().bits()) << 4
+                    | u32::from(a.unacknowledged().bits()) << 8
+                    | u32::from(a.latching().bits()) << 12
+            }
+            Field::LatchingAlarms => u32::from(a.latching().bits()),
+            Field::SlipRatio => opt(r.map(|r| r.slip_ratio)),
+            Field::AxialForce => opt(r.map(|r| r.axial_force)),
+            Field::CriticalAngle => opt(r.and_then(|r| r.critical_angle)),
+            Field::Margin => opt(r.and_then(|r| r.margin)),
+            Field::Load => opt(r.map(|r| r.load)),
+            Field::Misalignment => opt(r.map(|r| r.phi)),
+            Field::TimeToCritical => opt(m.time_to_critical()),
+            Field::Friction => opt(m.friction()),
+            Field::Samples => s.samples as u32,
+            Field::RepeatedTimestamps => s.repeated_timestamps,
+            Field::Spikes => s.spikes,
+            Field::EventsDropped => s.events_dropped.saturating_add(self.events.dropped),
+            Field::EventSeqNext => m.next_event_seq(),
+            Field::Faults(i) => {
+                let f = &s.faults;
+                [
+                    f.non_finite,
+                    f.out_of_range,
+                    f.stuck,
+                    f.gap,
+                    f.time_backwards,
+                    f.driver,
+                    f.estimator,
+                    f.sensor,
+                ]
+                .get(usize::from(i))
+                .copied()
+                .unwrap_or(0)
+            }
+            Field::TimeInState(i) => s
+                .time_in_state_ms
+                .get(per_state(i))
+                .map_or(0, |&ms| u32::try_from(ms / 1000).unwrap_or(u32::MAX)),
+            // The compensated sum rounded to f32 is its running sum.
+            Field::Energy(i) => s.energy.get(per_state(i)).map_or(0, |e| e.sum.to_bits()),
+            Field::MaxSlipRatio => s.max_slip_ratio.to_bits(),
+            Field::MaxAxialForce => s.max_axial_force.to_bits(),
+            Field::MinMargin => opt(s.min_margin),
+            Field::Elapsed => u32::try_from(m.elapsed_ms() / 1000).unwrap_or(u32::MAX),
+            Field::LastSampleTime => self.last_time_ms,
+            Field::ExternalAccepted => self.counters.external_accepted,
+            Field::ExternalRefused => self.counters.external_refused,
+            Field::BusFrames => self.bus(|c| c.framing.frames),
+            Field::BusServerMessages => self.bus(|c| c.server_messages),
+            Field::BusDiscarded => self.bus(|c| c.framing.discarded),
+            Field::BusExceptions => self.bus(|c| c.exceptions),
+            Field::EventFirst => self.events.first(m.next_event_seq()),
+            Field::EventCount => self
+                .events
+                .unread()
+                .take(usize::from(super::map::EVENT_SLOTS))
+                .count() as u32,
+            Field::EventsMissed => self.events.missed(m.next_event_seq()),
+            Field::Event(f) => self.events.slot(record).map_or(0, |e| event_value(e, f)),
+            Field::EventFrom => self.events.from,
+        }
+    }
+
+    /// A bus counter, modulo 2^16 (its register is 16 bits).
+    fn bus(&self, f: impl Fn(&super::Counters) -> u32) -> u32 {
+        f(&self.counters) & 0xFFFF
+    }
+}
