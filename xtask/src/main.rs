@@ -7,6 +7,7 @@ mod firmware;
 mod fit;
 mod fixed_tables;
 mod fuzz;
+mod modbus;
 mod node;
 mod nopanic;
 mod shapes;
@@ -53,6 +54,9 @@ tasks:
                                    stack table (--readme: write it into README.md); fail
                                    on any failure or over budget
     nopanic                        prove the estimator has no panic path (panic-never)
+    modbus [--serve PORT | --trace T.csv --scene S.csv --events OUT.csv [--model f32|fixed]
+           | --registers | --measure] [--target TRIPLE]
+                                   the Modbus node in QEMU against pymodbus (xtask/src/modbus.rs)
 ";
 
 fn root() -> PathBuf {
@@ -126,6 +130,7 @@ fn main() -> ExitCode {
         }
         Some("firmware") => firmware::run(flag("--readme")),
         Some("nopanic") => nopanic::run(),
+        Some("modbus") => modbus::run(&args[1..]),
         _ => {
             eprint!("{USAGE}");
             ExitCode::from(2)
