@@ -158,16 +158,17 @@ impl Uart {
 impl Uart {
     /// The silence that ends a frame, in core clock ticks (SysTick's). Not the 3.5
     /// character times of a real line (1750 us at this baud): in QEMU the line is a
-    /// TCP socket whose bytes QEMU hands over one by one as its I/O thread gets to
-    /// them, and on a loaded host a frame's bytes can arrive milliseconds of virtual
-    /// time apart; a master leaves far more between requests. 100 ms of virtual time.
+    /// TCP socket whose bytes QEMU's I/O thread hands over one by one, and while that
+    /// thread waits for the host's scheduler the guest runs on, so one frame's bytes
+    /// can arrive many milliseconds of virtual time apart (at 100 ms, one request in
+    /// a few thousand lost its frame here on a loaded host); a master leaves far
+    /// more between requests. One second of virtual time.
     pub fn silence_ticks(self) -> u32 {
-        let core_hz = match self {
+        match self {
             // The MPS2 boards' 25 MHz; the nRF51's 16 MHz; the STM32's HSI, 16 MHz.
             Uart::Cmsdk => 25_000_000,
             Uart::Nrf51 | Uart::Stm32 => 16_000_000,
-        };
-        core_hz / 10
+        }
     }
 
     /// Whether a received byte waits.

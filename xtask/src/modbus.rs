@@ -177,6 +177,7 @@ fn boot(
         .env("MISALIGN_QEMU_MACHINE", machine)
         .env("MISALIGN_QEMU_SERIAL_PORT", port.to_string())
         .env("MISALIGN_QEMU_TIMEOUT", "0")
+        .env("MISALIGN_QEMU_PARENT", std::process::id().to_string())
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .process_group(0)
@@ -660,8 +661,33 @@ struct Cost {
     base: (u64, u64, u64),
     /// `modbus_node`: flash, statics, stack.
     node: (u64, u64, u64),
-    /// Instructions: function 3 of 16, function 4 of 16, function 16 of 20 samples.
-    requests: [u64; 3],
+    /// Instructions: function 3 of 16, function 4 of 16, function 16 of 20 samples;
+    /// the framing of functions 3 and 16 (every byte but the last).
+    requests: [u64; 5],
+    /// Bytes of the register map's descriptions found in `modbus_node`'s image.
+    descriptions: u64,
+    /// `size_of` the server (the monitor in it included) and of the monitor.
+    server_bytes: u64,
+    monitor_bytes: u64,
+}
+
+/// Bytes of the map's descriptions (the CSV's last column) that `elf` holds: text the
+/// server never sends, linked because its map entries carry it.
+fn description_bytes(elf: &Path) -> Result<u64, String> {
+    let image = std::fs::read(elf).map_err(|e| format!("{}: {e}", elf.display()))?;
+    let map = registers_text()?;
+    let mut descriptions: Vec<&str> = map
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split_once(",\"")?.1.strip_suffix('"'))
+        .collect();
+    descriptions.sort_unstable();
+    descriptions.dedup();
+    Ok(descriptions
+        .iter()
+        .filter(|d| image.windows(d.len()).any(|w| w == d.as_bytes()))
+        .map(|d| d.len() as u64)
+        .sum())
 }
 
 /// `--measure`: builds `minimal_node` and `modbus_node` (profile `node`) for the
@@ -693,17 +719,31 @@ fn measure() -> Result<(), String> {
             };
             let s = cross::Sections::of(&llvm_size, &elf)?;
             let requests = if name == "modbus_node" {
-                [field("fc3_16")?, field("fc4_16")?, field("fc16_20")?]
+                [
+                    field("fc3_16")?,
+                    field("fc4_16")?,
+                    field("fc16_20")?,
+                    field("fc3_16_framing")?,
+                    field("fc16_20_framing")?,
+                ]
             } else {
-                [0; 3]
+                [0; 5]
             };
-            measured.push(((s.flash(), s.ram(), field("stack_bytes")?), requests));
+            let sizes = if name == "modbus_node" {
+                [field("server_bytes")?, field("monitor_bytes")?]
+            } else {
+                [0; 2]
+            };
+            measured.push(((s.flash(), s.ram(), field("stack_bytes")?), requests, sizes));
         }
         costs.push(Cost {
             cpu,
             base: measured[0].0,
             node: measured[1].0,
             requests: measured[1].1,
+            descriptions: description_bytes(&cross::artifact(&built, "modbus_node")?)?,
+            server_bytes: measured[1].2[0],
+            monitor_bytes: measured[1].2[1],
         });
     }
     let (csv, table, misses) = cost_tables(&costs);
@@ -730,12 +770,14 @@ fn cost_tables(costs: &[Cost]) -> (String, String, Vec<String>) {
     use std::fmt::Write as _;
     let mut csv = String::from(
         "core,node_flash,node_statics,node_stack,node_ram,server_flash,server_statics,\
-         server_stack,fc3_16_instructions,fc4_16_instructions,fc16_20_instructions\n",
+         server_stack,fc3_16_instructions,fc3_16_framing,fc4_16_instructions,\
+         fc16_20_instructions,fc16_20_framing,server_flash_descriptions,server_struct,\
+         monitor_struct\n",
     );
     let mut md = String::from(
-        "| core | node flash | node RAM: statics + stack | the server adds: flash | \
-         statics | stack | function 3, 16 registers | function 4, 16 registers | \
-         function 16, 20 samples |\n|---|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+        "| core | node flash | node RAM: statics + stack | the server adds: flash (descriptions) | \
+         statics | stack | function 3, 16 registers (framing) | function 4, 16 registers | \
+         function 16, 20 samples (framing) |\n|---|--:|--:|--:|--:|--:|--:|--:|--:|\n",
     );
     let mut misses = Vec::new();
     for c in costs {
@@ -762,29 +804,47 @@ fn cost_tables(costs: &[Cost]) -> (String, String, Vec<String>) {
         });
         writeln!(
             csv,
-            "{},{flash},{statics},{stack},{ram},{},{},{},{},{},{}",
+            "{},{flash},{statics},{stack},{ram},{},{},{},{},{},{},{},{},{},{},{}",
             c.cpu.name,
             d(flash, c.base.0),
             d(statics, c.base.1),
             d(stack, c.base.2),
             c.requests[0],
+            c.requests[3],
             c.requests[1],
-            c.requests[2]
+            c.requests[2],
+            c.requests[4],
+            c.descriptions,
+            c.server_bytes,
+            c.monitor_bytes
         )
         .unwrap();
         writeln!(
             md,
-            "| {} | {flash}{} | {statics} + {stack} = {ram}{} | {} | {} | {} | {}{} | {} | {} |",
+            "| {} | {flash}{} | {statics} + {stack} = {ram}{} | {} ({}) | {} | {} | {}{} ({}) | {} | {} ({}) |",
             c.cpu.name,
             marks[0],
             marks[1],
             d(flash, c.base.0),
+            c.descriptions,
             d(statics, c.base.1),
             d(stack, c.base.2),
             c.requests[0],
             marks[2],
+            c.requests[3],
             c.requests[1],
-            c.requests[2]
+            c.requests[2],
+            c.requests[4]
+        )
+        .unwrap();
+    }
+    md.push('\n');
+    for c in costs {
+        writeln!(
+            md,
+            "{}: `Server<E>` takes {} B, of which the monitor {} B; the node keeps one, \
+             built on the stack.",
+            c.cpu.name, c.server_bytes, c.monitor_bytes
         )
         .unwrap();
     }

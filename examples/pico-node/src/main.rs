@@ -1,7 +1,8 @@
 //! The Modbus monitoring node on a Raspberry Pi Pico (RP2040, Cortex-M0+) with an
 //! RS-485 transceiver (a MAX3485 or the like): UART0 on GP0 (TX, to DI) and GP1 (RX,
 //! from RO), 115200 baud 8N1, the transceiver's DE and /RE together on GP2 (high while
-//! the node sends). The defmt log goes over RTT (a debug probe, `probe-rs run`).
+//! the node sends); 3.5 character times of silence (the RP2040's timer) end a frame.
+//! The defmt log goes over RTT (a debug probe, `probe-rs run`).
 //!
 //! The node is the QEMU images' (`examples/firmware`): the same estimator built the
 //! same way (`node.rs`: the fixed-point core, as on every core without an FPU), the

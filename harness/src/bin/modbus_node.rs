@@ -10,9 +10,12 @@
 //! (`Server::receive` for every byte, then `response` and `sent`; the UART's byte time
 //! excluded): function 3 reading 16 holding registers, function 4 reading the 16 input
 //! registers from `status` on, function 16 writing 20 samples (their processing by
-//! the monitor included). It prints `modbus_node fc3_16=... fc4_16=... fc16_20=...
-//! samples=... stack_bytes=...` and exits 0 when every request was answered as the
-//! specification says.
+//! the monitor included), and of functions 3 and 16 the framing alone (every byte but
+//! the last, which completes the frame and gets it answered). It prints `modbus_node
+//! fc3_16=... fc3_16_framing=... fc4_16=... fc16_20=... fc16_20_framing=... samples=...
+//! stack_bytes=... server_bytes=... monitor_bytes=...` (the last two: `size_of` the
+//! server, the monitor in it included, and of the monitor) and exits 0 when every request was answered as the specification
+//! says.
 #![no_std]
 #![no_main]
 
@@ -55,17 +58,22 @@ fn main() -> ! {
     let sp = support::stack::paint();
     let costs = run(core, &counter, &mut uart);
     let stack = support::stack::used(sp);
-    let Some([fc3, fc4, fc16]) = costs else {
+    let Some(costs) = costs else {
         defmt::error!("a request was not answered as specified");
         support::exit(1)
     };
+    let [fc3, fc4, fc16] = costs.requests;
     defmt::println!(
-        "modbus_node fc3_16={=u32} fc4_16={=u32} fc16_20={=u32} samples={=u32} stack_bytes={=usize}",
-        fc3,
-        fc4,
-        fc16,
+        "modbus_node fc3_16={=u32} fc3_16_framing={=u32} fc4_16={=u32} fc16_20={=u32} fc16_20_framing={=u32} samples={=u32} stack_bytes={=usize} server_bytes={=usize} monitor_bytes={=usize}",
+        fc3.0,
+        fc3.1,
+        fc4.0,
+        fc16.0,
+        fc16.1,
         SAMPLES,
-        stack
+        stack,
+        costs.server,
+        costs.monitor
     );
     support::exit(0)
 }
@@ -81,16 +89,24 @@ fn frame(buf: &mut [u8; 256], pdu: &[u8]) -> usize {
 }
 
 /// Feeds `request` to the server under the counter; the instructions, if it answered
-/// with function `function` (not an exception) and a frame of `len` bytes.
+/// with function `function` (not an exception) and a frame of `len` bytes: the whole,
+/// and of them the bytes before the last (framing alone: the last byte completes the
+/// frame, and the server answers it within that byte's `receive`).
 fn measure<E: Estimator>(
     server: &mut Server<E>,
     counter: &Counter,
     request: &[u8],
     function: u8,
     len: usize,
-) -> Option<u32> {
-    let (answered, n) = counter.measure(|| {
-        for &b in request {
+) -> Option<(u32, u32)> {
+    let (head, last) = request.split_at(request.len().saturating_sub(1));
+    let ((), framing) = counter.measure(|| {
+        for &b in head {
+            server.receive(b);
+        }
+    });
+    let (answered, rest) = counter.measure(|| {
+        for &b in last {
             server.receive(b);
         }
         let ok = server
@@ -99,13 +115,13 @@ fn measure<E: Estimator>(
         server.sent();
         ok
     });
-    answered.then_some(n)
+    answered.then_some((framing + rest, framing))
 }
 
 /// The node: the samples through the server, the UART polled after each (as the
 /// node's loop does), then the three requests measured.
 #[inline(never)]
-fn run<E: Estimator>(core: E, counter: &Counter, uart: &mut uart::Uart) -> Option<[u32; 3]> {
+fn run<E: Estimator>(core: E, counter: &Counter, uart: &mut uart::Uart) -> Option<Costs> {
     let monitor = Monitor::new(core, Config::default()).ok()?;
     let config = ServerConfig {
         external_samples: true,
@@ -145,5 +161,17 @@ fn run<E: Estimator>(core: E, counter: &Counter, uart: &mut uart::Uart) -> Optio
     }
     let n = frame(&mut buf, &pdu);
     let fc16 = measure(&mut server, counter, &buf[..n], 16, 8)?;
-    Some([fc3, fc4, fc16])
+    Some(Costs {
+        requests: [fc3, fc4, fc16],
+        server: core::mem::size_of::<Server<E>>(),
+        monitor: core::mem::size_of::<Monitor<E>>(),
+    })
+}
+
+/// What `run` measured: per request the instructions and those of its framing; the
+/// bytes of the server (the monitor in it) and of the monitor alone.
+struct Costs {
+    requests: [(u32, u32); 3],
+    server: usize,
+    monitor: usize,
 }
