@@ -233,6 +233,19 @@ fn exceptions_as_the_specification_orders_them() {
     );
     assert_eq!(exception(&request(&mut s, 5, &be(&[0, 0x1234])), 5), 3);
     assert_eq!(exception(&request(&mut s, 5, &be(&[6, 0xFF00])), 5), 2);
+    // Read-only holding registers: 02 by function 6 and 16, nothing changes.
+    assert_eq!(read(&mut s, 3, 5, 2), vec![1, 1]);
+    assert_eq!(
+        exception(&request(&mut s, 6, &be(&[5, 9])), 6),
+        2,
+        "unit_id"
+    );
+    assert_eq!(
+        exception(&write(&mut s, 4, &[1, 9]), 16),
+        2,
+        "external_mode, unit_id"
+    );
+    assert!(!s.external_samples(), "a refused write applies nothing");
     // A byte count that does not match the quantity: 03.
     let mut data = be(&[2, 1]);
     data.extend([4, 0, 1, 0, 2]);
@@ -242,7 +255,7 @@ fn exceptions_as_the_specification_orders_them() {
         3
     );
     // Every refused request left the state alone and was counted.
-    assert_eq!(s.counters().exceptions, 16);
+    assert_eq!(s.counters().exceptions, 18);
     assert_eq!(s.annunciator().latching(), AlarmSet::NONE);
 }
 
@@ -819,4 +832,71 @@ mod over_embedded_io {
         assert_eq!(uart.tx, answer);
         assert_eq!(s.serve(&mut uart), Ok(false));
     }
+}
+
+#[test]
+fn every_input_register_is_the_monitors_value() {
+    let mut s = server(ServerConfig::default());
+    // A ramp to gross slip, faults of several causes, a stop: every statistic moves.
+    for i in 0..900u32 {
+        let mut x = ramp(i % 450);
+        x.time_ms = i * 1000;
+        match i % 97 {
+            3 => x.load = f32::INFINITY,
+            5 => x.load = 1e9,
+            7 => x.time_ms = 0,
+            _ => {}
+        }
+        if i % 450 > 400 {
+            x = Sample::new(i * 1000, 10.0 + (i % 3) as f32, 0.0).with_speed(0.0);
+        }
+        s.process(x);
+    }
+    let end = TableMap::of(misalign::modbus::map::Table::Input).end();
+    let mut regs = read(&mut s, 4, 0, 125);
+    regs.extend(read(&mut s, 4, 125, end - 125));
+    let m = s.monitor();
+    let st = m.statistics();
+    let u = |name: &str| u32_at(&regs, usize::from(input(name)));
+    let f = |name: &str| f32_at(&regs, usize::from(input(name))).to_bits();
+    let opt = |x: Option<f32>| x.map_or(NONE, f32::to_bits);
+    let r = m.reading();
+    assert_eq!(u16::from(regs[0] as u8), m.state().index() as u16);
+    assert_eq!(f("slip_ratio"), opt(r.map(|r| r.slip_ratio)));
+    assert_eq!(f("time_to_critical"), opt(m.time_to_critical()));
+    assert_eq!(f("friction"), opt(m.friction()));
+    assert_eq!(u("samples"), st.samples as u32);
+    assert_eq!(u("repeated_timestamps"), st.repeated_timestamps);
+    assert_eq!(u("spikes"), st.spikes);
+    assert_eq!(u("event_seq_next"), m.next_event_seq());
+    let faults = [
+        ("faults_non_finite", st.faults.non_finite),
+        ("faults_out_of_range", st.faults.out_of_range),
+        ("faults_stuck", st.faults.stuck),
+        ("faults_gap", st.faults.gap),
+        ("faults_time_backwards", st.faults.time_backwards),
+        ("faults_driver", st.faults.driver),
+        ("faults_estimator", st.faults.estimator),
+        ("faults_sensor", st.faults.sensor),
+    ];
+    for (name, count) in faults {
+        assert_eq!(u(name), count, "{name}");
+    }
+    assert!(st.faults.non_finite > 0 && st.faults.out_of_range > 0 && st.faults.time_backwards > 0);
+    for state in RiskState::ALL {
+        let name = state.as_str();
+        let ms = st.time_in_state_ms[state.index()];
+        assert_eq!(u(&format!("time_{name}")), (ms / 1000) as u32, "{name}");
+        let energy = st.energy[state.index()].sum.to_bits();
+        assert_eq!(f(&format!("energy_{name}")), energy, "{name}");
+    }
+    assert!(st.time_in_state_ms[RiskState::GrossSlip.index()] > 0);
+    assert_eq!(f("max_slip_ratio"), st.max_slip_ratio.to_bits());
+    assert_eq!(f("max_axial_force"), st.max_axial_force.to_bits());
+    assert_eq!(f("min_margin"), opt(st.min_margin));
+    assert_eq!(u("elapsed"), (m.elapsed_ms() / 1000) as u32);
+    assert_eq!(u("last_sample_time"), 899_000);
+    // Reading the registers from the middle of a 32-bit value gives its low word.
+    let samples = st.samples as u16;
+    assert_eq!(read(&mut s, 4, input("samples") + 1, 1), vec![samples]);
 }

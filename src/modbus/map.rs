@@ -145,6 +145,9 @@ pub(crate) enum Field {
     AcknowledgeAlarms,
     LatchingAlarms,
     ExternalMode,
+    UnitId,
+    MapVersion,
+
     /// An external sample's field (the basic or the full record).
     Sample(SampleField),
 }
@@ -314,6 +317,10 @@ pub static DISCRETES: TableMap = TableMap {
     blocks: &[],
 };
 
+/// The register map's version (holding register `map_version`): a change of an
+/// address, a type or a meaning increments it.
+pub const MAP_VERSION: u16 = 1;
+
 /// Where the event window's header starts (input registers).
 pub const EVENT_WINDOW_ADDRESS: u16 = 82;
 /// Where the event window's slots start (input registers).
@@ -469,7 +476,7 @@ static EVENT_FIELDS: [Entry; 15] = [
 ];
 
 /// Where the basic external samples start (holding registers).
-pub const SAMPLES_ADDRESS: u16 = 5;
+pub const SAMPLES_ADDRESS: u16 = 7;
 /// Records of the basic block: the most one function-16 write carries.
 pub const SAMPLES: u16 = 20;
 /// Registers per basic record (time, P, phi).
@@ -520,7 +527,11 @@ pub static HOLDINGS: TableMap = TableMap {
         e!(Holding, 3, "latching", U16, "", Rw, F::LatchingAlarms,
             "the alarms that latch, bits 0-3 as in acknowledge_alarms (the coils latch_* alike)"),
         e!(Holding, 4, "external_mode", U16, "", Rw, F::ExternalMode,
-            "1: external samples are processed, 0: refused (the coil external_samples alike)"),
+                        "1: external samples are processed, 0: refused (the coil external_samples alike)"),
+        e!(Holding, 5, "unit_id", U16, "", R, F::UnitId,
+            "the unit id this node answers (read only)"),
+        e!(Holding, 6, "map_version", U16, "", R, F::MapVersion,
+            "the version of this register map (read only): a change of an address, type or meaning increments it"),
     ],
     blocks: &[
         Block {
@@ -542,6 +553,38 @@ pub static HOLDINGS: TableMap = TableMap {
     ],
 };
 
+/// The index of the single entry that holds each address of `entries` (sorted,
+/// without a hole from 0), formed at compile time: a read finds its first value by one
+/// load, not a search.
+const fn index<const N: usize>(entries: &[Entry]) -> [u8; N] {
+    let mut out = [0u8; N];
+    let mut i = 0;
+    while i < entries.len() {
+        let e = &entries[i];
+        let mut a = e.address as usize;
+        let end = e.end() as usize;
+        while a < end && a < N {
+            out[a] = i as u8;
+            a += 1;
+        }
+        i += 1;
+    }
+    out
+}
+
+/// The address after the last of `entries`.
+const fn entries_end(entries: &[Entry]) -> usize {
+    match entries.last() {
+        Some(e) => e.end() as usize,
+        None => 0,
+    }
+}
+
+static COIL_INDEX: [u8; entries_end(COILS.entries)] = index(COILS.entries);
+static DISCRETE_INDEX: [u8; entries_end(DISCRETES.entries)] = index(DISCRETES.entries);
+static INPUT_INDEX: [u8; entries_end(INPUTS.entries)] = index(INPUTS.entries);
+static HOLDING_INDEX: [u8; entries_end(HOLDINGS.entries)] = index(HOLDINGS.entries);
+
 /// The four tables in the CSV's order.
 pub static MAP: [&TableMap; 4] = [&COILS, &DISCRETES, &INPUTS, &HOLDINGS];
 
@@ -553,6 +596,25 @@ impl TableMap {
             Table::Discrete => &DISCRETES,
             Table::Input => &INPUTS,
             Table::Holding => &HOLDINGS,
+        }
+    }
+
+    /// The single entry that holds `address` (its index) and the word of it, if a
+    /// single entry does.
+    pub(crate) fn single(&self, address: u16) -> Option<(usize, u16)> {
+        let i = usize::from(*self.index().get(usize::from(address))?);
+        let entry = self.entries.get(i)?;
+        Some((i, address.checked_sub(entry.address)?))
+    }
+
+    /// The single entries' index by address.
+    fn index(&self) -> &'static [u8] {
+        match self.entries.first().map(|e| e.table) {
+            Some(Table::Coil) => &COIL_INDEX,
+            Some(Table::Discrete) => &DISCRETE_INDEX,
+            Some(Table::Input) => &INPUT_INDEX,
+            Some(Table::Holding) => &HOLDING_INDEX,
+            None => &[],
         }
     }
 
@@ -570,24 +632,82 @@ impl TableMap {
     /// entry), and the register's word within the value (0 high, 1 low).
     pub(crate) fn locate(&self, address: u16) -> Option<Located> {
         if address < self.entries_end() {
-            let i = self.entries.partition_point(|e| e.end() <= address);
-            let entry = self.entries.get(i)?;
+            let index = usize::from(*self.index().get(usize::from(address))?);
+            let entry = self.entries.get(index)?;
             return Some(Located {
                 entry,
                 record: 0,
                 word: address.checked_sub(entry.address)?,
+                block: None,
+                index,
             });
         }
-        let block = self.blocks.iter().find(|b| address < b.end())?;
+        let b = self.blocks.iter().position(|b| address < b.end())?;
+        let block = self.blocks.get(b)?;
         let offset = address.checked_sub(block.address)?;
         let record = offset.checked_div(block.stride)?;
         let at = offset.checked_rem(block.stride)?;
-        let i = block.fields.partition_point(|e| e.end() <= at);
-        let entry = block.fields.get(i)?;
+        let index = block.fields.partition_point(|e| e.end() <= at);
+        let entry = block.fields.get(index)?;
         Some(Located {
             entry,
             record,
             word: at.checked_sub(entry.address)?,
+            block: Some(b),
+            index,
+        })
+    }
+
+    /// The value after `l` (its first word), in address order.
+    fn after(&self, l: &Located) -> Option<Located> {
+        let first_of = |b: usize, record: u16| {
+            let block = self.blocks.get(b)?;
+            Some(Located {
+                entry: block.fields.first()?,
+                record,
+                word: 0,
+                block: Some(b),
+                index: 0,
+            })
+        };
+        let next = l.index.wrapping_add(1);
+        match l.block {
+            None => match self.entries.get(next) {
+                Some(entry) => Some(Located {
+                    entry,
+                    record: 0,
+                    word: 0,
+                    block: None,
+                    index: next,
+                }),
+                None => first_of(0, 0),
+            },
+            Some(b) => {
+                let block = self.blocks.get(b)?;
+                if let Some(entry) = block.fields.get(next) {
+                    Some(Located {
+                        entry,
+                        index: next,
+                        word: 0,
+                        ..*l
+                    })
+                } else if l.record.wrapping_add(1) < block.count {
+                    first_of(b, l.record.wrapping_add(1))
+                } else {
+                    first_of(b.wrapping_add(1), 0)
+                }
+            }
+        }
+    }
+
+    /// The values from `address` on, in address order, the first from the word that
+    /// holds `address`: one search, then steps.
+    pub(crate) fn walk(&self, address: u16) -> impl Iterator<Item = Located> + '_ {
+        let mut next = self.locate(address);
+        core::iter::from_fn(move || {
+            let current = next?;
+            next = self.after(&current);
+            Some(current)
         })
     }
 }
@@ -598,12 +718,16 @@ pub(crate) struct Located {
     pub entry: &'static Entry,
     pub record: u16,
     pub word: u16,
+    /// The block's index in the table, `None` for a single entry.
+    pub block: Option<usize>,
+    /// The entry's index in the single entries or the block's fields.
+    pub index: usize,
 }
 
 /// Writes the map as CSV with the header
 /// `table,address,name,type,scale,unit,access,description`: one row per value, a
 /// block's records expanded (`event_0_seq`, ...). `docs/modbus/registers.csv` is this
-/// output (`cargo run --example modbus_registers > docs/modbus/registers.csv`).
+/// output (`cargo run --example modbus_registers --features modbus > docs/modbus/registers.csv`).
 pub fn registers_csv(out: &mut impl fmt::Write) -> fmt::Result {
     writeln!(out, "table,address,name,type,scale,unit,access,description")?;
     let row = |out: &mut dyn fmt::Write, e: &Entry, address: u16, prefix: Option<(&str, u16)>| {
@@ -682,6 +806,17 @@ mod tests {
                 assert!(l.word < l.entry.ty.words());
             }
             assert!(t.locate(t.end()).is_none());
+            // The walk from 0 steps through every value, as locating each does.
+            let mut at = 0;
+            for l in t.walk(0) {
+                let found = t.locate(at).unwrap();
+                assert_eq!(
+                    (l.entry.name, l.record, l.word),
+                    (found.entry.name, found.record, 0)
+                );
+                at += l.entry.ty.words();
+            }
+            assert_eq!(at, t.end());
         }
         let l = INPUTS
             .locate(EVENT_SLOTS_ADDRESS + EVENT_STRIDE + 12)

@@ -28,9 +28,19 @@
 //! [`Server::idle`]; without a clock the framer still finds every frame of a known
 //! function code from its length and CRC, resynchronising after garbage, and answers
 //! a function code it does not know (exception 01) only at a silence. The node's own
-//! sensors' samples go through [`Server::process`], so that the map follows them. With the feature
-//! `embedded-io`, [`Server::poll`] and [`Server::serve`] do the byte loop over any
-//! UART implementing the `embedded-io` 0.7 traits.
+//! sensors' samples go through [`Server::process`], so that the map follows them. With
+//! the feature `embedded-io`, `Server::poll` (without blocking) and `Server::serve`
+//! (blocking, one request) do the byte loop over any UART implementing the
+//! `embedded-io` 0.7 traits.
+//!
+//! The whole API: [`Server::new`] (or [`Server::with_friction`] for an f32 scene, mu
+//! tracked from a measured axial force) with a [`ServerConfig`] (unit id,
+//! [`Identification`], external samples on or off, the latching [`AlarmSet`]);
+//! `receive`, `idle`, `response`, `sent` for the bus; `process` for samples;
+//! `monitor`, `annunciator`, `acknowledge`, `external_samples`, `unit_id`,
+//! `counters`, `into_monitor`. Beside it: [`registers_csv`], [`silence_us`], the map's
+//! addresses in [`map`], and for a master written in Rust [`event_from_registers`]
+//! and [`fault_from_code`].
 //!
 //! **External samples** written by a master over the bus (holding blocks `sample_*`,
 //! up to 20 in one function-16 write, and `sample_full_*` with speed and axial force)
@@ -43,7 +53,7 @@
 //!
 //! **The map** ([`map`]) is one table in code: the server reads and writes through it,
 //! and [`registers_csv`] writes it as `docs/modbus/registers.csv`
-//! (`cargo run --example modbus_registers > docs/modbus/registers.csv`). 32-bit
+//! (`cargo run --example modbus_registers --features modbus > docs/modbus/registers.csv`). 32-bit
 //! values take two registers, high word first; a value with none reads as the quiet
 //! NaN `0x7FC0_0000` ([`NONE`]). `docs/modbus.md` is the integrator's page.
 //!
@@ -174,17 +184,21 @@ type Step<E> = fn(&mut Monitor<E>, Sample) -> RiskState;
 
 /// The Modbus RTU server: the monitor, the register map's state, the framer.
 #[derive(Debug, Clone)]
+#[repr(C)]
 pub struct Server<E> {
     framer: Framer,
     core: Core<E>,
 }
 
 /// Everything but the framer (whose buffer holds the request being answered).
+/// `repr(C)`: what every request touches first, the buffers and the monitor after.
 #[derive(Debug, Clone)]
+#[repr(C)]
 struct Core<E> {
-    monitor: Monitor<E>,
-    step: Step<E>,
+    /// The response's length; 0: none due.
+    response_len: usize,
     unit: u8,
+    step: Step<E>,
     ident: Identification,
     model_name: &'static str,
     annunciator: Annunciator,
@@ -194,8 +208,7 @@ struct Core<E> {
     last_time_ms: u32,
     counters: Counters,
     response: [u8; ADU_MAX],
-    /// The response's length; 0: none due.
-    response_len: usize,
+    monitor: Monitor<E>,
 }
 
 impl<E: Estimator> Server<E> {
@@ -247,6 +260,9 @@ impl<E: Estimator> Server<E> {
     /// Takes one received byte; a request it completes is answered at once (see
     /// [`response`](Self::response)).
     pub fn receive(&mut self, byte: u8) {
+        if self.framer.push_waiting(byte) {
+            return;
+        }
         self.framer.push(byte);
         while let Some(range) = self.framer.next(self.core.unit, false) {
             self.core.counters.framing = self.framer.counters();

@@ -141,15 +141,6 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    /// The response PDU's buffer: `[function, ...]`, 253 bytes.
-    fn out(&mut self, function: u8) -> &mut [u8] {
-        let out = self.response.get_mut(1..254).unwrap_or(&mut []);
-        if let Some(f) = out.first_mut() {
-            *f = function;
-        }
-        out
-    }
-
     fn read_bits(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
         let (start, quantity) = head(pdu)?;
         if quantity == 0 || quantity > READ_BITS_MAX {
@@ -157,26 +148,20 @@ impl<E: Estimator> Core<E> {
         }
         let map = TableMap::of(table_of(function));
         in_map(map, start, quantity)?;
-        // At most 2000 bits: 250 bytes.
+        // At most 2000 bits: 250 bytes, from response[3].
         let bytes = usize::from(quantity.div_ceil(8)).min(250);
-        let mut packed = [0u8; 250];
-        for i in 0..quantity {
-            let l = map
-                .locate(start.wrapping_add(i))
-                .ok_or(Exception::IllegalDataAddress)?;
-            if self.value(l.entry.field, l.record) & 1 != 0
-                && let Some(b) = packed.get_mut(usize::from(i / 8))
-            {
+        self.response[1] = function;
+        self.response[2] = bytes as u8;
+        if let Some(packed) = self.response.get_mut(3..3 + bytes) {
+            packed.fill(0);
+        }
+        // Inside the map (checked above): one value a bit, packed into the response as
+        // it is computed.
+        for (i, l) in (0..quantity).zip(map.walk(start)) {
+            let on = self.value(l.entry.field, l.record) & 1 != 0;
+            if on && let Some(b) = self.response.get_mut(3 + usize::from(i / 8)) {
                 *b |= 1 << (i % 8);
             }
-        }
-        let out = self.out(function);
-        let dest = out
-            .get_mut(1..2 + bytes)
-            .ok_or(Exception::ServerDeviceFailure)?;
-        dest[0] = bytes as u8;
-        for (d, s) in dest[1..].iter_mut().zip(&packed) {
-            *d = *s;
         }
         Ok(2 + bytes)
     }
@@ -188,35 +173,78 @@ impl<E: Estimator> Core<E> {
         }
         let map = TableMap::of(table_of(function));
         in_map(map, start, quantity)?;
-        let mut words = [0u16; READ_REGISTERS_MAX as usize];
-        let words = words.get_mut(..usize::from(quantity)).unwrap_or(&mut []);
-        let mut i = 0usize;
-        while i < words.len() {
-            let l = map
-                .locate(start.wrapping_add(i as u16))
-                .ok_or(Exception::IllegalDataAddress)?;
-            let v = self.value(l.entry.field, l.record);
-            let n = l.entry.ty.words();
-            for w in l.word..n {
-                let Some(slot) = words.get_mut(i) else { break };
-                *slot = if n == 2 && w == 0 {
-                    (v >> 16) as u16
-                } else {
-                    v as u16
-                };
-                i += 1;
-            }
-        }
-        let bytes = 2 * words.len();
-        let out = self.out(function);
-        let dest = out
-            .get_mut(1..2 + bytes)
-            .ok_or(Exception::ServerDeviceFailure)?;
-        dest[0] = bytes as u8;
-        for (d, w) in dest[1..].chunks_exact_mut(2).zip(words.iter()) {
-            d.copy_from_slice(&w.to_be_bytes());
+        // At most 125 registers: 250 bytes, from response[3].
+        let bytes = 2 * usize::from(quantity).min(125);
+        self.response[1] = function;
+        self.response[2] = bytes as u8;
+        // Each table's values from a function of its own (small enough to inline).
+        if function == 3 {
+            self.fill(map, start, 3 + bytes, Self::value_holding);
+        } else {
+            self.fill(map, start, 3 + bytes, Self::value);
         }
         Ok(2 + bytes)
+    }
+
+    /// The response from byte 3 to `end` with the words of `map` from `start`, each
+    /// value computed once by `value`: inside the map (checked), from the word that
+    /// holds `start`; the single entries one after the other, the blocks' records
+    /// field by field.
+    #[inline(always)]
+    fn fill(
+        &mut self,
+        map: &TableMap,
+        start: u16,
+        end: usize,
+        value: impl Fn(&Self, Field, u16) -> u32,
+    ) {
+        let mut at = 3;
+        let mut address = start;
+        if let Some((mut i, mut word)) = map.single(start) {
+            while at < end {
+                let Some(e) = map.entries.get(i) else { break };
+                let v = value(self, e.field, 0);
+                self.put(&mut at, end, v, e.ty.words(), word);
+                address = e.end();
+                (i, word) = (i + 1, 0);
+            }
+        }
+        if at < end
+            && let Some(l) = map.locate(address)
+            && let Some(mut b) = l.block
+        {
+            let (mut record, mut i, mut word) = (l.record, l.index, l.word);
+            'blocks: while let Some(block) = map.blocks.get(b) {
+                while record < block.count {
+                    while let Some(e) = block.fields.get(i) {
+                        let v = value(self, e.field, record);
+                        self.put(&mut at, end, v, e.ty.words(), word);
+                        if at >= end {
+                            break 'blocks;
+                        }
+                        (i, word) = (i + 1, 0);
+                    }
+                    (record, i) = (record + 1, 0);
+                }
+                (b, record) = (b + 1, 0);
+            }
+        }
+    }
+
+    /// Writes the words `from..n` of the `n`-word value `v` at `*at` (below `end`),
+    /// high word first.
+    fn put(&mut self, at: &mut usize, end: usize, v: u32, n: u16, from: u16) {
+        for w in from..n {
+            if *at >= end {
+                return;
+            }
+            let word = if n == 2 && w == 0 { v >> 16 } else { v } as u16;
+            if let Some(slot) = self.response.get_mut(*at..*at + 2) {
+                slot[0] = (word >> 8) as u8;
+                slot[1] = word as u8;
+            }
+            *at += 2;
+        }
     }
 
     /// Echoes the request's address and value (functions 5 and 6) or address and

@@ -77,8 +77,8 @@ fn response_len(b: &[u8]) -> Len {
 /// What the candidate at the start of the waiting bytes is.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum Class {
-    /// Not decided before more bytes come.
-    Need,
+    /// Not decided before this many bytes wait (the candidate's included).
+    Need(usize),
     /// Not a frame: drop its first byte.
     Drop,
     /// A request for this unit (or a broadcast) of this length.
@@ -90,21 +90,22 @@ enum Class {
 /// The candidate at the start of `b` for unit `unit`.
 fn classify(b: &[u8], unit: u8) -> Class {
     let Some(&address) = b.first() else {
-        return Class::Need;
+        return Class::Need(1);
     };
     if address > ADDRESS_MAX {
         return Class::Drop;
     }
     if b.len() < 2 {
-        return Class::Need;
+        return Class::Need(2);
     }
+    let more = b.len().saturating_add(1);
     let complete_with_crc = |n: usize| n <= b.len() && b.get(..n).is_some_and(crc::valid);
     if address == unit || address == 0 {
         return match request_len(b) {
-            Len::NeedMore => Class::Need,
+            Len::NeedMore => Class::Need(more),
             Len::Known(n) if n <= ADU_MAX => {
                 if n > b.len() {
-                    Class::Need
+                    Class::Need(n)
                 } else if complete_with_crc(n) {
                     Class::Ours(n)
                 } else {
@@ -115,21 +116,26 @@ fn classify(b: &[u8], unit: u8) -> Class {
         };
     }
     // Another unit's request or another server's response: whichever length fits.
-    let mut waiting = false;
+    // The fewest waiting bytes at which one of them can be decided.
+    let mut need = usize::MAX;
     for len in [request_len(b), response_len(b)] {
         match len {
             Len::Known(n) if n <= ADU_MAX => {
                 if n > b.len() {
-                    waiting = true;
+                    need = need.min(n);
                 } else if complete_with_crc(n) {
                     return Class::Other(n);
                 }
             }
-            Len::NeedMore => waiting = true,
+            Len::NeedMore => need = need.min(more),
             Len::Known(_) | Len::Unknown => {}
         }
     }
-    if waiting { Class::Need } else { Class::Drop }
+    if need == usize::MAX {
+        Class::Drop
+    } else {
+        Class::Need(need)
+    }
 }
 
 /// Counters of the framing.
@@ -143,10 +149,11 @@ pub struct FramingCounters {
     pub discarded: u32,
 }
 
-/// The byte-fed framer.
+/// The byte-fed framer. `repr(C)`, the buffer last: the per-byte fields stay within
+/// the short load and store offsets of a Cortex-M0.
 #[derive(Debug, Clone)]
+#[repr(C)]
 pub struct Framer {
-    buf: [u8; ADU_MAX],
     len: usize,
     /// The candidate's first byte.
     start: usize,
@@ -155,7 +162,11 @@ pub struct Framer {
     /// Bytes since the last frame were moved out of the buffer to make room: the span
     /// since the last frame is no longer whole.
     overflowed: bool,
+    /// Waiting bytes below which the candidate stays undecided: a byte that does not
+    /// reach it costs no classification.
+    need: usize,
     counters: FramingCounters,
+    buf: [u8; ADU_MAX],
 }
 
 impl Default for Framer {
@@ -173,6 +184,7 @@ impl Framer {
             start: 0,
             consumed: 0,
             overflowed: false,
+            need: 0,
             counters: FramingCounters {
                 frames: 0,
                 discarded: 0,
@@ -188,6 +200,24 @@ impl Framer {
     /// The bytes of a range [`next`](Self::next) or [`silence`](Self::silence) gave.
     pub fn bytes(&self, range: Range<usize>) -> &[u8] {
         self.buf.get(range).unwrap_or(&[])
+    }
+
+    /// Appends one received byte when it cannot decide the candidate (fewer bytes wait
+    /// than it needs) and the buffer has room: the usual byte of a frame, at the cost
+    /// of a compare and a store. Returns whether it did; if not, call
+    /// [`push`](Self::push) and [`next`](Self::next).
+    #[inline]
+    pub fn push_waiting(&mut self, byte: u8) -> bool {
+        let len = self.len;
+        let waiting = len.wrapping_sub(self.start).wrapping_add(1);
+        match self.buf.get_mut(len) {
+            Some(slot) if waiting < self.need => {
+                *slot = byte;
+                self.len = len + 1;
+                true
+            }
+            _ => false,
+        }
     }
 
     /// Appends one received byte. A full buffer first drops the bytes before the
@@ -213,6 +243,7 @@ impl Framer {
 
     fn drop_one(&mut self) {
         self.start = self.start.saturating_add(1);
+        self.need = 0;
         self.counters.discarded = self.counters.discarded.saturating_add(1);
     }
 
@@ -222,12 +253,15 @@ impl Framer {
     pub fn next(&mut self, unit: u8, silence: bool) -> Option<Range<usize>> {
         loop {
             let waiting = self.buf.get(self.start..self.len)?;
-            if waiting.is_empty() {
+            if waiting.is_empty() || (!silence && waiting.len() < self.need) {
                 return None;
             }
             match classify(waiting, unit) {
-                Class::Need if silence => self.drop_one(),
-                Class::Need => return None,
+                Class::Need(_) if silence => self.drop_one(),
+                Class::Need(n) => {
+                    self.need = n;
+                    return None;
+                }
                 Class::Drop => self.drop_one(),
                 Class::Ours(n) => return Some(self.take(n)),
                 Class::Other(n) => {
@@ -241,6 +275,7 @@ impl Framer {
         let range = self.start..self.start.saturating_add(n);
         self.start = range.end;
         self.consumed = range.end;
+        self.need = 0;
         self.counters.frames = self.counters.frames.saturating_add(1);
         range
     }
@@ -275,6 +310,7 @@ impl Framer {
         self.start = 0;
         self.consumed = 0;
         self.overflowed = false;
+        self.need = 0;
     }
 }
 

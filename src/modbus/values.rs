@@ -264,11 +264,46 @@ impl<E: Estimator> Core<E> {
     }
 
     /// The value of `field` (of record `record` in a block) as the bits on the wire:
-    /// a 16-bit value in the low half.
+    /// a 16-bit value in the low half. The values of every poll (the first 16 input
+    /// registers) here, small enough to stay cheap; the others out of line.
+    #[inline]
     pub(super) fn value(&self, field: Field, record: u16) -> u32 {
+        let reading =
+            |f: fn(&Reading) -> Option<f32>| opt(self.monitor.reading().as_ref().and_then(f));
+        match field {
+            Field::Status => self.status(),
+            Field::SlipRatio => reading(|r| Some(r.slip_ratio)),
+            Field::AxialForce => reading(|r| Some(r.axial_force)),
+            Field::CriticalAngle => reading(|r| r.critical_angle),
+            Field::Margin => reading(|r| r.margin),
+            Field::Load => reading(|r| Some(r.load)),
+            Field::Misalignment => reading(|r| Some(r.phi)),
+            Field::TimeToCritical => opt(self.monitor.time_to_critical()),
+            _ => self.value_other(field, record),
+        }
+    }
+
+    /// [`value`](Self::value) of a holding register, as cheap as the poll's.
+    #[inline]
+    pub(super) fn value_holding(&self, field: Field, record: u16) -> u32 {
+        match field {
+            Field::Sample(_) | Field::AcknowledgeAlarms => 0,
+            Field::EventFrom => self.events.from,
+            Field::LatchingAlarms => u32::from(self.annunciator.latching().bits()),
+            Field::ExternalMode => u32::from(self.external),
+            Field::UnitId => u32::from(self.unit),
+            Field::MapVersion => u32::from(super::map::MAP_VERSION),
+            _ => self.value_other(field, record),
+        }
+    }
+
+    /// [`value`](Self::value) of the other fields.
+    #[inline(never)]
+    fn value_other(&self, field: Field, record: u16) -> u32 {
         let m = &self.monitor;
         let s = m.statistics();
-        let r = m.reading();
+        // The reading's values, copied only where one is read.
+        let r = || m.reading();
         let a = &self.annunciator;
         let bit = |set: AlarmSet, which: AlarmSet| u32::from(set.contains(which));
         let per_state = |i: u8| usize::from(i);
@@ -288,12 +323,12 @@ impl<E: Estimator> Core<E> {
                     | u32::from(a.latching().bits()) << 12
             }
             Field::LatchingAlarms => u32::from(a.latching().bits()),
-            Field::SlipRatio => opt(r.map(|r| r.slip_ratio)),
-            Field::AxialForce => opt(r.map(|r| r.axial_force)),
-            Field::CriticalAngle => opt(r.and_then(|r| r.critical_angle)),
-            Field::Margin => opt(r.and_then(|r| r.margin)),
-            Field::Load => opt(r.map(|r| r.load)),
-            Field::Misalignment => opt(r.map(|r| r.phi)),
+            Field::SlipRatio => opt(r().map(|r| r.slip_ratio)),
+            Field::AxialForce => opt(r().map(|r| r.axial_force)),
+            Field::CriticalAngle => opt(r().and_then(|r| r.critical_angle)),
+            Field::Margin => opt(r().and_then(|r| r.margin)),
+            Field::Load => opt(r().map(|r| r.load)),
+            Field::Misalignment => opt(r().map(|r| r.phi)),
             Field::TimeToCritical => opt(m.time_to_critical()),
             Field::Friction => opt(m.friction()),
             Field::Samples => s.samples as u32,
@@ -343,6 +378,8 @@ impl<E: Estimator> Core<E> {
             Field::EventsMissed => self.events.missed(m.next_event_seq()),
             Field::Event(f) => self.events.slot(record).map_or(0, |e| event_value(e, f)),
             Field::EventFrom => self.events.from,
+            Field::UnitId => u32::from(self.unit),
+            Field::MapVersion => u32::from(super::map::MAP_VERSION),
         }
     }
 

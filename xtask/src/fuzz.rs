@@ -10,7 +10,13 @@ use std::path::Path;
 use std::process::Command;
 
 /// The targets, as named in fuzz/Cargo.toml.
-pub const TARGETS: [&str; 4] = ["estimator_csv", "reference", "float_core", "fixed_core"];
+pub const TARGETS: [&str; 5] = [
+    "estimator_csv",
+    "reference",
+    "float_core",
+    "fixed_core",
+    "modbus",
+];
 
 fn have(cmd: &mut Command) -> bool {
     cmd.output().map(|o| o.status.success()).unwrap_or(false)
