@@ -669,6 +669,9 @@ struct Cost {
     /// `size_of` the server (the monitor in it included) and of the monitor.
     server_bytes: u64,
     monitor_bytes: u64,
+    /// The deepest stack use once the server was built, once the samples were processed.
+    stack_built: u64,
+    stack_samples: u64,
 }
 
 /// Bytes of the map's descriptions (the CSV's last column) that `elf` holds: text the
@@ -730,9 +733,14 @@ fn measure() -> Result<(), String> {
                 [0; 5]
             };
             let sizes = if name == "modbus_node" {
-                [field("server_bytes")?, field("monitor_bytes")?]
+                [
+                    field("server_bytes")?,
+                    field("monitor_bytes")?,
+                    field("stack_built")?,
+                    field("stack_samples")?,
+                ]
             } else {
-                [0; 2]
+                [0; 4]
             };
             measured.push(((s.flash(), s.ram(), field("stack_bytes")?), requests, sizes));
         }
@@ -744,6 +752,8 @@ fn measure() -> Result<(), String> {
             descriptions: description_bytes(&cross::artifact(&built, "modbus_node")?)?,
             server_bytes: measured[1].2[0],
             monitor_bytes: measured[1].2[1],
+            stack_built: measured[1].2[2],
+            stack_samples: measured[1].2[3],
         });
     }
     let (csv, table, misses) = cost_tables(&costs);
@@ -843,8 +853,9 @@ fn cost_tables(costs: &[Cost]) -> (String, String, Vec<String>) {
         writeln!(
             md,
             "{}: `Server<E>` takes {} B, of which the monitor {} B; the node keeps one, \
-             built on the stack.",
-            c.cpu.name, c.server_bytes, c.monitor_bytes
+             built on the stack. The deepest stack use is {} B once it is built, {} B once \
+             the samples are processed, {} B after the requests.",
+            c.cpu.name, c.server_bytes, c.monitor_bytes, c.stack_built, c.stack_samples, c.node.2
         )
         .unwrap();
     }

@@ -14,7 +14,9 @@
 //! the last, which completes the frame and gets it answered). It prints `modbus_node
 //! fc3_16=... fc3_16_framing=... fc4_16=... fc16_20=... fc16_20_framing=... samples=...
 //! stack_bytes=... server_bytes=... monitor_bytes=...` (the last two: `size_of` the
-//! server, the monitor in it included, and of the monitor) and exits 0 when every request was answered as the specification
+//! server, the monitor in it included, and of the monitor; `stack_built=...
+//! stack_samples=...`, the deepest stack use once the server was built and once the
+//! samples were processed) and exits 0 when every request was answered as the specification
 //! says.
 #![no_std]
 #![no_main]
@@ -56,7 +58,7 @@ fn main() -> ! {
     };
     let mut uart = uart::Uart::for_this_board(&peripherals.CPUID);
     let sp = support::stack::paint();
-    let costs = run(core, &counter, &mut uart);
+    let costs = run(core, &counter, &mut uart, sp);
     let stack = support::stack::used(sp);
     let Some(costs) = costs else {
         defmt::error!("a request was not answered as specified");
@@ -64,7 +66,7 @@ fn main() -> ! {
     };
     let [fc3, fc4, fc16] = costs.requests;
     defmt::println!(
-        "modbus_node fc3_16={=u32} fc3_16_framing={=u32} fc4_16={=u32} fc16_20={=u32} fc16_20_framing={=u32} samples={=u32} stack_bytes={=usize} server_bytes={=usize} monitor_bytes={=usize}",
+        "modbus_node fc3_16={=u32} fc3_16_framing={=u32} fc4_16={=u32} fc16_20={=u32} fc16_20_framing={=u32} samples={=u32} stack_bytes={=usize} server_bytes={=usize} monitor_bytes={=usize} stack_built={=usize} stack_samples={=usize}",
         fc3.0,
         fc3.1,
         fc4.0,
@@ -73,7 +75,9 @@ fn main() -> ! {
         SAMPLES,
         stack,
         costs.server,
-        costs.monitor
+        costs.monitor,
+        costs.stack_built,
+        costs.stack_samples
     );
     support::exit(0)
 }
@@ -121,13 +125,19 @@ fn measure<E: Estimator>(
 /// The node: the samples through the server, the UART polled after each (as the
 /// node's loop does), then the three requests measured.
 #[inline(never)]
-fn run<E: Estimator>(core: E, counter: &Counter, uart: &mut uart::Uart) -> Option<Costs> {
+fn run<E: Estimator>(
+    core: E,
+    counter: &Counter,
+    uart: &mut uart::Uart,
+    sp: usize,
+) -> Option<Costs> {
     let monitor = Monitor::new(core, Config::default()).ok()?;
     let config = ServerConfig {
         external_samples: true,
         ..ServerConfig::default()
     };
     let mut server = Server::new(monitor, config).ok()?;
+    let stack_built = support::stack::used(sp);
     let mut time_ms = 0;
     for i in 0..SAMPLES {
         let load = io::read(&LOADS[(i % 8) as usize]);
@@ -137,6 +147,7 @@ fn run<E: Estimator>(core: E, counter: &Counter, uart: &mut uart::Uart) -> Optio
         // The UART as the node's loop polls it (nothing arrives here).
         let _ = server.poll(uart);
     }
+    let stack_samples = support::stack::used(sp);
     let mut buf = [0u8; 256];
     // Function 3: holding registers 0-15. Answer: unit, function, count, 32 bytes, CRC.
     let n = frame(&mut buf, &[3, 0, 0, 0, 16]);
@@ -167,6 +178,8 @@ fn run<E: Estimator>(core: E, counter: &Counter, uart: &mut uart::Uart) -> Optio
         requests: [fc3, fc4, fc16],
         server: core::mem::size_of::<Server<E>>(),
         monitor: core::mem::size_of::<Monitor<E>>(),
+        stack_built,
+        stack_samples,
     })
 }
 
@@ -176,4 +189,8 @@ struct Costs {
     requests: [(u32, u32); 3],
     server: usize,
     monitor: usize,
+    /// The deepest stack use once the server was built, and once the samples were
+    /// processed (the requests come after).
+    stack_built: usize,
+    stack_samples: usize,
 }
