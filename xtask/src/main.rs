@@ -54,8 +54,8 @@ tasks:
                                    stack table (--readme: write it into README.md); fail
                                    on any failure or over budget
     nopanic                        prove the estimator has no panic path (panic-never)
-    modbus [--serve PORT | --trace T.csv --scene S.csv --events OUT.csv [--model f32|fixed]
-           | --registers | --measure] [--target TRIPLE]
+    modbus [--boards | --serve PORT | --trace T.csv --scene S.csv --events OUT.csv
+           [--model f32|fixed] | --registers | --measure] [--target TRIPLE]
                                    the Modbus node in QEMU against pymodbus (xtask/src/modbus.rs)
 ";
 

@@ -9,6 +9,8 @@
 //!   through `misalign::modbus::Server`), then the node on a master's samples (every
 //!   event read back across the event window's wrap). pymodbus and pytest, pinned, in
 //!   a virtual environment under `target/modbus-venv`.
+//!   With `--boards`, the node on its own samples also on the Cortex-M7 and M3 (MPS2,
+//!   CMSDK UART0) and the STM32F405 (`netduinoplus2`, USART1).
 //! - `--serve PORT [--target TRIPLE]`: boots the node and serves until killed.
 //! - `--trace T.csv --scene S.csv --events OUT.csv [--model f32|fixed] [--target
 //!   TRIPLE]`: feeds a trace to the node over Modbus, reads its events back, writes
@@ -35,8 +37,36 @@ const REGISTERS_CSV: &str = "docs/modbus/registers.csv";
 /// A node image: a core, its target and QEMU machine, its sample source.
 struct Node {
     cpu: &'static cross::Cpu,
+    /// The QEMU machine, and the memory layout its image needs (`MISALIGN_MEMORY_X`)
+    /// if not the target's default.
+    machine: &'static str,
+    memory_x: Option<&'static str>,
     external: bool,
 }
+
+impl Node {
+    /// The node on `cpu`'s own board.
+    fn on(cpu: &'static cross::Cpu, external: bool) -> Self {
+        Node {
+            cpu,
+            machine: cpu.machine,
+            memory_x: None,
+            external,
+        }
+    }
+}
+
+/// With `--boards`, the node on its own samples on the other boards too: the
+/// Cortex-M7 and M3 (CMSDK UART0) and the STM32F405 (USART1, its own memory layout).
+const OTHER_BOARDS: [(&str, &str, Option<&str>); 3] = [
+    ("cortex-m7", "mps2-an500", None),
+    ("cortex-m3", "mps2-an385", None),
+    (
+        "cortex-m4f",
+        "netduinoplus2",
+        Some("harness/boards/stm32f4.x"),
+    ),
+];
 
 fn cpu(id: &str) -> &'static cross::Cpu {
     cross::CPUS
@@ -81,7 +111,7 @@ pub fn run(args: &[String]) -> ExitCode {
             value("--target"),
         )
     } else {
-        tests()
+        tests(args.iter().any(|a| a == "--boards"))
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -126,10 +156,15 @@ fn build(node: &Node) -> Result<PathBuf, String> {
     } else {
         cmd.env_remove("MISALIGN_MODBUS_EXTERNAL");
     }
+    match node.memory_x {
+        Some(layout) => cmd.env("MISALIGN_MEMORY_X", layout),
+        None => cmd.env_remove("MISALIGN_MEMORY_X"),
+    };
     let built = cross::build(&mut cmd)?;
     let elf = cross::artifact(&built, "firmware")?;
     let kept = elf.with_file_name(format!(
-        "firmware-modbus-{}",
+        "firmware-modbus-{}-{}",
+        node.machine,
         if node.external { "external" } else { "own" }
     ));
     std::fs::copy(&elf, &kept).map_err(|e| format!("{}: {e}", kept.display()))?;
@@ -254,7 +289,7 @@ fn venv() -> Result<PathBuf, String> {
 }
 
 /// The whole test: both cores, both sample sources.
-fn tests() -> Result<(), String> {
+fn tests(boards: bool) -> Result<(), String> {
     let start = Instant::now();
     crate::firmware::preflight()?;
     let python = venv()?;
@@ -263,26 +298,34 @@ fn tests() -> Result<(), String> {
     let registers = dir.join("registers.csv");
     std::fs::write(&registers, registers_text()?).map_err(|e| e.to_string())?;
     let mut failures = Vec::new();
-    for id in ["cortex-m4f", "cortex-m0"] {
-        for external in [false, true] {
-            let node = Node {
-                cpu: cpu(id),
-                external,
-            };
-            let what = format!(
-                "{} ({}), samples from {}",
-                node.cpu.name,
-                node.cpu.machine,
-                if external { "the master" } else { "the node" }
-            );
-            println!("\n=== {what} ({}s)", start.elapsed().as_secs());
-            if let Err(e) = test_node(&node, &python, &dir, &registers) {
-                failures.push(format!("{what}: {e}"));
-            }
+    let mut nodes: Vec<Node> = ["cortex-m4f", "cortex-m0"]
+        .iter()
+        .flat_map(|id| [false, true].map(|external| Node::on(cpu(id), external)))
+        .collect();
+    if boards {
+        nodes.extend(OTHER_BOARDS.map(|(id, machine, memory_x)| Node {
+            machine,
+            memory_x,
+            ..Node::on(cpu(id), false)
+        }));
+    }
+    for node in &nodes {
+        let source = if node.external {
+            "the master"
+        } else {
+            "the node"
+        };
+        let what = format!(
+            "{} ({}), samples from {source}",
+            node.cpu.name, node.machine
+        );
+        println!("\n=== {what} ({}s)", start.elapsed().as_secs());
+        if let Err(e) = test_node(node, &python, &dir, &registers) {
+            failures.push(format!("{what}: {e}"));
         }
     }
     if failures.is_empty() {
-        println!("modbus: every test passed on the Cortex-M4F and the Cortex-M0");
+        println!("modbus: every test passed on every node");
         return Ok(());
     }
     Err(failures.join("\n"))
@@ -306,13 +349,7 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         ("tests/modbus/test_node.py", expected)
     };
     let port = free_port()?;
-    let booted = boot(
-        node.cpu.machine,
-        &elf,
-        port,
-        Duration::from_secs(300),
-        false,
-    )?;
+    let booted = boot(node.machine, &elf, port, Duration::from_secs(300), false)?;
     let status = Command::new(python)
         .current_dir(crate::root())
         .args(["-m", "pytest", "-q", "-p", "no:cacheprovider", tests])
@@ -349,10 +386,7 @@ fn serve(port: &str, target: Option<&str>) -> Result<(), String> {
         .map_err(|_| format!("--serve {port}: not a TCP port"))?;
     crate::firmware::preflight()?;
     let cpu = cpu_for_target(target.unwrap_or("thumbv7em-none-eabihf"))?;
-    let elf = build(&Node {
-        cpu,
-        external: false,
-    })?;
+    let elf = build(&Node::on(cpu, false))?;
     let mut booted = boot(cpu.machine, &elf, port, Duration::from_secs(600), true)?;
     println!("serving on 127.0.0.1:{port}");
     // The node's log goes on to stderr; QEMU runs until it is killed (with us).
@@ -411,10 +445,7 @@ fn trace(
     std::fs::write(&registers, registers_text()?).map_err(|e| e.to_string())?;
     let samples_csv = dir.join("trace-samples.csv");
     host::write_samples(&samples_csv, &samples)?;
-    let elf = build(&Node {
-        cpu,
-        external: true,
-    })?;
+    let elf = build(&Node::on(cpu, true))?;
     let port = free_port()?;
     let booted = boot(cpu.machine, &elf, port, Duration::from_secs(300), false)?;
     let raw = dir.join("trace-events-raw.csv");
