@@ -5,4 +5,5 @@
 //! host benchmark and the fuzz targets call the same functions in-process.
 
 pub mod estimate;
+pub mod monitor_events;
 pub mod monitor_input;

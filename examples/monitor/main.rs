@@ -8,6 +8,7 @@
 
 mod plot;
 
+use misalign_cli::monitor_events as events;
 use misalign_cli::monitor_input as input;
 
 use clap::{Parser, ValueEnum};
@@ -118,53 +119,6 @@ fn event_line(e: &Event) -> String {
         r.phi * 1e3,
         mrad(r.critical_angle),
         mrad(r.margin),
-    )
-}
-
-fn event_row(e: &Event) -> String {
-    let opt = |x: Option<f32>| x.map_or(String::new(), |x| x.to_string());
-    let (state, from, kind, fault, ttc) = match e.kind {
-        EventKind::StateChange { from, to, fault } => (
-            to.as_str(),
-            from.as_str(),
-            "state",
-            fault.map_or(String::new(), |f| format!("{f:?}")),
-            String::new(),
-        ),
-        EventKind::Approaching { time_to_critical_s } => (
-            "",
-            "",
-            "approaching",
-            String::new(),
-            time_to_critical_s.to_string(),
-        ),
-        // The filtered mu in the state column.
-        EventKind::Friction { mu, changed } => {
-            let kind = if changed {
-                "friction_changed"
-            } else {
-                "friction_cleared"
-            };
-            return format!(
-                "{},{},mu={mu},,{kind},,,,,,,,,{}",
-                e.elapsed_ms as f64 / 1e3,
-                e.seq,
-                e.time_ms
-            );
-        }
-    };
-    let r = &e.reading;
-    format!(
-        "{},{},{state},{from},{kind},{fault},{},{},{},{},{},{},{ttc},{}",
-        e.elapsed_ms as f64 / 1e3,
-        e.seq,
-        r.load,
-        r.phi,
-        r.slip_ratio,
-        r.axial_force,
-        opt(r.critical_angle),
-        opt(r.margin),
-        e.time_ms,
     )
 }
 
@@ -411,11 +365,9 @@ fn run<E: Estimator>(
     let r = replay(monitor, step, samples.into_iter(), total);
     summary(&r.monitor);
     if let Some(path) = &args.events {
-        let mut out = String::from(
-            "t,seq,state,from,kind,fault,P,phi,s,F,phi0,margin,time_to_critical,time_ms\n",
-        );
+        let mut out = String::from(events::HEADER);
         for e in &r.events {
-            out += &event_row(e);
+            out += &events::event_row(e);
             out.push('\n');
         }
         std::fs::write(path, out)?;

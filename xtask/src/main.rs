@@ -11,6 +11,7 @@ mod fixed_tables;
 mod fuzz;
 mod log;
 mod measurements;
+mod modbus;
 mod node;
 mod nopanic;
 mod records;
@@ -115,6 +116,10 @@ enum Task {
         #[arg(long)]
         check: bool,
     },
+    /// The Modbus node in QEMU (Cortex-M4F and M0) against pymodbus, every register
+    /// compared with the host's replay; or serve, feed a trace, write the register map,
+    /// measure the server's cost.
+    Modbus(modbus::Args),
 }
 
 fn root() -> PathBuf {
@@ -145,6 +150,7 @@ fn main() -> ExitCode {
         Task::Accuracy => accuracy::run(),
         Task::Nopanic => nopanic::run(),
         Task::Measurements { check } => measurements::run(check),
+        Task::Modbus(args) => modbus::run(&args),
     }
 }
 

@@ -177,16 +177,19 @@ fn scene_and_model() -> Result<(Scene, ModelChoice), String> {
     Ok((scene, choice))
 }
 
-/// The host's replay of the scenario, on the f32 core (`fpu`) or the fixed-point one,
-/// straight or through the simulated sensors: what the node must log.
-pub fn host_replay(fpu: bool, through_sensors: bool) -> Result<Log, String> {
+/// The node's estimator: the f32 core where there is an FPU, else the fixed-point one.
+pub enum Core {
+    F32(Auto),
+    Fixed(FixedAuto),
+}
+
+/// The node's estimator for the scenario, built as the node builds it: the f32 core
+/// (`fpu`) or the fixed-point one.
+pub fn core(fpu: bool) -> Result<Core, String> {
     let (scene, choice) = scene_and_model()?;
     let err = |e: misalign::Error| e.to_string();
     if fpu {
-        replay(
-            Auto::with_choice(&scene, choice).map_err(err)?,
-            through_sensors,
-        )
+        Ok(Core::F32(Auto::with_choice(&scene, choice).map_err(err)?))
     } else {
         // As `examples/monitor --model fixed`: 10 mN a count, the finest angle LSB the
         // tables allow, at least 0.1 nrad.
@@ -195,7 +198,16 @@ pub fn host_replay(fpu: bool, through_sensors: bool) -> Result<Log, String> {
             _ => 1e-10,
         };
         let core = FixedAuto::with_choice(&scene, 1e-2, angle_lsb, choice).map_err(err)?;
-        replay(core, through_sensors)
+        Ok(Core::Fixed(core))
+    }
+}
+
+/// The host's replay of the scenario, on the f32 core (`fpu`) or the fixed-point one,
+/// straight or through the simulated sensors: what the node must log.
+pub fn host_replay(fpu: bool, through_sensors: bool) -> Result<Log, String> {
+    match core(fpu)? {
+        Core::F32(core) => replay(core, through_sensors),
+        Core::Fixed(core) => replay(core, through_sensors),
     }
 }
 

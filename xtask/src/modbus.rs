@@ -1,0 +1,925 @@
+//! `cargo xtask modbus`: the Modbus node (`examples/firmware` with the library's
+//! feature `modbus`) in QEMU, driven by pymodbus, a client nobody here wrote.
+//!
+//! - no option: on the Cortex-M4F (f32 core, mps2-an386) and the Cortex-M0
+//!   (fixed-point core, microbit), boots the node with serial0 on a loopback TCP port
+//!   (`tools/qemu-run`, `MISALIGN_QEMU_SERIAL_PORT`) and runs the pytest tests of
+//!   `tests/modbus/` against it: the node on its own samples (the built-in scenario;
+//!   every register equal, word for word, to this host's replay of the same samples
+//!   through `misalign::modbus::Server`), then the node on a master's samples (every
+//!   event read back across the event window's wrap). pymodbus and pytest, pinned, in
+//!   a virtual environment under `target/modbus-venv`.
+//!   With `--boards`, the node on its own samples also on the Cortex-M7 and M3 (MPS2,
+//!   CMSDK UART0) and the STM32F405 (`netduinoplus2`, USART1).
+//! - `--serve PORT [--target TRIPLE]`: boots the node and serves until killed.
+//! - `--trace T.csv --scene S.csv --events OUT.csv [--model f32|fixed] [--target
+//!   TRIPLE]`: feeds a trace to the node over Modbus, reads its events back, writes
+//!   them as `examples/monitor --events` does and compares them with the host replay.
+//! - `--registers`: writes `docs/modbus/registers.csv` from the library.
+//! - `--measure`: what the server costs on the Cortex-M0 and the Cortex-M4F (flash,
+//!   RAM, instructions per request; harness images `modbus_node` against
+//!   `minimal_node`), into `docs/modbus-cost.csv` and `docs/measurements-modbus.md`.
+
+use crate::cross;
+use std::io::{BufRead, BufReader};
+use std::net::TcpListener;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitCode, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+/// The Python packages of the tests, pinned.
+const PYTHON_PACKAGES: [&str; 2] = ["pymodbus==3.16.1", "pytest==8.4.2"];
+
+/// The register map's export, relative to the repository root.
+const REGISTERS_CSV: &str = "docs/modbus/registers.csv";
+
+/// A node image: a core, its target and QEMU machine, its sample source.
+struct Node {
+    cpu: &'static cross::Cpu,
+    /// The QEMU machine, and the memory layout its image needs (`MISALIGN_MEMORY_X`)
+    /// if not the target's default.
+    machine: &'static str,
+    memory_x: Option<&'static str>,
+    external: bool,
+}
+
+impl Node {
+    /// The node on `cpu`'s own board.
+    fn on(cpu: &'static cross::Cpu, external: bool) -> Self {
+        Node {
+            cpu,
+            machine: cpu.machine,
+            memory_x: None,
+            external,
+        }
+    }
+}
+
+/// With `--boards`, the node on its own samples on the other boards too: the
+/// Cortex-M7 and M3 (CMSDK UART0) and the STM32F405 (USART1, its own memory layout).
+const OTHER_BOARDS: [(&str, &str, Option<&str>); 3] = [
+    ("cortex-m7", "mps2-an500", None),
+    ("cortex-m3", "mps2-an385", None),
+    (
+        "cortex-m4f",
+        "netduinoplus2",
+        Some("harness/boards/stm32f4.x"),
+    ),
+];
+
+fn cpu(id: &str) -> &'static cross::Cpu {
+    cross::CPUS
+        .iter()
+        .find(|c| c.id == id)
+        .expect("a known core")
+}
+
+fn cpu_for_target(target: &str) -> Result<&'static cross::Cpu, String> {
+    // The first core of the target: the Cortex-M4F for thumbv7em (not the M7).
+    cross::CPUS
+        .iter()
+        .rev()
+        .find(|c| c.target == target && c.sizes)
+        .ok_or_else(|| {
+            format!(
+                "no QEMU board for {target}: one of thumbv6m-none-eabi, thumbv7m-none-eabi, \
+                 thumbv7em-none-eabihf"
+            )
+        })
+}
+
+/// `cargo xtask modbus`'s arguments.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Also run the node on its own samples on the Cortex-M7, M3 and the STM32F405.
+    #[arg(long)]
+    boards: bool,
+    /// Boot the node and serve on 127.0.0.1:PORT until killed.
+    #[arg(long, value_name = "PORT", conflicts_with_all = ["boards", "trace", "registers", "measure"])]
+    serve: Option<String>,
+    /// Feed this trace (the monitor example's --trace format) over Modbus and compare
+    /// the events read back with the host replay.
+    #[arg(long, value_name = "T.csv", requires_all = ["scene", "events"], conflicts_with_all = ["boards", "registers", "measure"])]
+    trace: Option<String>,
+    /// The trace's scene (the monitor example's --scene format).
+    #[arg(long, value_name = "S.csv")]
+    scene: Option<String>,
+    /// Where to write the events read back (the monitor example's --events format).
+    #[arg(long, value_name = "OUT.csv")]
+    events: Option<String>,
+    /// The core of --trace (f32 or fixed); must match the target's.
+    #[arg(long, value_name = "f32|fixed")]
+    model: Option<String>,
+    /// The node's target for --serve and --trace.
+    #[arg(long, value_name = "TRIPLE")]
+    target: Option<String>,
+    /// Write docs/modbus/registers.csv from the library's register map.
+    #[arg(long, conflicts_with_all = ["boards", "measure"])]
+    registers: bool,
+    /// Measure flash, RAM and instructions per request; write docs/modbus-cost.csv and
+    /// its table.
+    #[arg(long, conflicts_with = "boards")]
+    measure: bool,
+}
+
+/// `cargo xtask modbus`.
+pub fn run(args: &Args) -> ExitCode {
+    let result = if args.registers {
+        registers()
+    } else if args.measure {
+        measure()
+    } else if let Some(port) = &args.serve {
+        serve(port, args.target.as_deref())
+    } else if args.trace.is_some() {
+        trace(
+            args.trace.as_deref(),
+            args.scene.as_deref(),
+            args.events.as_deref(),
+            args.model.as_deref(),
+            args.target.as_deref(),
+        )
+    } else {
+        tests(args.boards)
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask modbus: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `--registers`: the register map as the library exports it.
+fn registers() -> Result<(), String> {
+    let text = registers_text()?;
+    let path = crate::root().join(REGISTERS_CSV);
+    std::fs::create_dir_all(path.parent().unwrap()).map_err(|e| e.to_string())?;
+    std::fs::write(&path, text).map_err(|e| format!("{REGISTERS_CSV}: {e}"))?;
+    println!("wrote {REGISTERS_CSV}");
+    Ok(())
+}
+
+fn registers_text() -> Result<String, String> {
+    let mut text = String::new();
+    misalign::modbus::registers_csv(&mut text).map_err(|e| e.to_string())?;
+    Ok(text)
+}
+
+/// Builds the node for `node`'s core (profile `firmware`) and returns its ELF, kept
+/// under a name of its own (the two sample sources build the same file).
+fn build(node: &Node) -> Result<PathBuf, String> {
+    let mut cmd = cross::cargo();
+    cmd.args([
+        "build",
+        "--profile",
+        "firmware",
+        "--target",
+        node.cpu.target,
+    ])
+    .args(["--features", "modbus-node", "--example", "firmware"])
+    .arg("--message-format=json-render-diagnostics");
+    if node.external {
+        cmd.env("MISALIGN_MODBUS_EXTERNAL", "1");
+    } else {
+        cmd.env_remove("MISALIGN_MODBUS_EXTERNAL");
+    }
+    match node.memory_x {
+        Some(layout) => cmd.env("MISALIGN_MEMORY_X", layout),
+        None => cmd.env_remove("MISALIGN_MEMORY_X"),
+    };
+    let built = cross::build(&mut cmd)?;
+    let elf = cross::artifact(&built, "firmware")?;
+    let kept = elf.with_file_name(format!(
+        "firmware-modbus-{}-{}",
+        node.machine,
+        if node.external { "external" } else { "own" }
+    ));
+    std::fs::copy(&elf, &kept).map_err(|e| format!("{}: {e}", kept.display()))?;
+    Ok(kept)
+}
+
+/// A free loopback port (bound, then released for QEMU).
+fn free_port() -> Result<u16, String> {
+    let listener = TcpListener::bind("127.0.0.1:0").map_err(|e| e.to_string())?;
+    Ok(listener.local_addr().map_err(|e| e.to_string())?.port())
+}
+
+/// A node running in QEMU; killed (its whole process group) when dropped.
+struct Booted {
+    child: Child,
+    port: u16,
+    log: mpsc::Receiver<String>,
+}
+
+impl Drop for Booted {
+    fn drop(&mut self) {
+        // qemu-run's process group: the script, timeout, QEMU and defmt-print.
+        let _ = Command::new("kill")
+            .args(["-TERM", "--", &format!("-{}", self.child.id())])
+            .status();
+        let _ = self.child.wait();
+    }
+}
+
+/// Boots `elf` on `machine` with serial0 on 127.0.0.1:`port`; returns once the node
+/// logs that it serves. Its log goes to stderr, prefixed: every line with `all`, else
+/// its Modbus lines, warnings and errors (the self-test's lines are `cargo xtask
+/// firmware`'s business).
+fn boot(
+    machine: &str,
+    elf: &Path,
+    port: u16,
+    timeout: Duration,
+    all: bool,
+) -> Result<Booted, String> {
+    use std::os::unix::process::CommandExt;
+    let mut child = Command::new(crate::root().join("tools/qemu-run"))
+        .arg(machine)
+        .arg(elf)
+        .env("MISALIGN_QEMU_MACHINE", machine)
+        .env("MISALIGN_QEMU_SERIAL_PORT", port.to_string())
+        .env("MISALIGN_QEMU_TIMEOUT", "0")
+        .env("MISALIGN_QEMU_PARENT", std::process::id().to_string())
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .process_group(0)
+        .spawn()
+        .map_err(|e| format!("cannot run tools/qemu-run: {e}"))?;
+    let stdout = child.stdout.take().unwrap();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            let notable = ["modbus", "ERROR", "WARN", "panick", "qemu"];
+            if all || notable.iter().any(|n| line.contains(n)) {
+                eprintln!("  node| {line}");
+            }
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let booted = Booted {
+        child,
+        port,
+        log: rx,
+    };
+    let start = Instant::now();
+    loop {
+        match booted.log.recv_timeout(Duration::from_millis(200)) {
+            Ok(line) if line.contains("modbus: serving") => return Ok(booted),
+            Ok(_) => {}
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(format!("{machine}: the node stopped before it served"));
+            }
+            Err(mpsc::RecvTimeoutError::Timeout) if start.elapsed() > timeout => {
+                return Err(format!(
+                    "{machine}: the node did not serve within {} s",
+                    timeout.as_secs()
+                ));
+            }
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+        }
+    }
+}
+
+/// The virtual environment with the pinned packages; its python.
+fn venv() -> Result<PathBuf, String> {
+    let dir = crate::root().join("target/modbus-venv");
+    let python = dir.join("bin/python");
+    let stamp = dir.join("installed.txt");
+    let want = PYTHON_PACKAGES.join("\n");
+    if std::fs::read_to_string(&stamp).ok().as_deref() == Some(want.as_str()) {
+        return Ok(python);
+    }
+    let run = |cmd: &mut Command| -> Result<(), String> {
+        let status = cmd
+            .stdout(std::io::stderr())
+            .status()
+            .map_err(|e| format!("{cmd:?}: {e}"))?;
+        status
+            .success()
+            .then_some(())
+            .ok_or_else(|| format!("{cmd:?}: {status}"))
+    };
+    run(Command::new("python3").args(["-m", "venv"]).arg(&dir))?;
+    run(Command::new(&python)
+        .args([
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+        ])
+        .args(PYTHON_PACKAGES))?;
+    std::fs::write(&stamp, want).map_err(|e| e.to_string())?;
+    Ok(python)
+}
+
+/// The whole test: both cores, both sample sources.
+fn tests(boards: bool) -> Result<(), String> {
+    let start = Instant::now();
+    crate::tools::preflight()?;
+    let python = venv()?;
+    let dir = crate::root().join("target/modbus");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let registers = dir.join("registers.csv");
+    std::fs::write(&registers, registers_text()?).map_err(|e| e.to_string())?;
+    let mut failures = Vec::new();
+    let mut nodes: Vec<Node> = ["cortex-m4f", "cortex-m0"]
+        .iter()
+        .flat_map(|id| [false, true].map(|external| Node::on(cpu(id), external)))
+        .collect();
+    if boards {
+        nodes.extend(OTHER_BOARDS.map(|(id, machine, memory_x)| Node {
+            machine,
+            memory_x,
+            ..Node::on(cpu(id), false)
+        }));
+    }
+    for node in &nodes {
+        let source = if node.external {
+            "the master"
+        } else {
+            "the node"
+        };
+        let what = format!(
+            "{} ({}), samples from {source}",
+            node.cpu.name, node.machine
+        );
+        println!("\n=== {what} ({}s)", start.elapsed().as_secs());
+        if let Err(e) = test_node(node, &python, &dir, &registers) {
+            failures.push(format!("{what}: {e}"));
+        }
+    }
+    if failures.is_empty() {
+        println!("modbus: every test passed on every node");
+        return Ok(());
+    }
+    Err(failures.join("\n"))
+}
+
+fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result<(), String> {
+    let elf = build(node)?;
+    let fpu = node.cpu.has_fpu();
+    let id = node.cpu.id;
+    // The node on its own samples: every register as the host's replay reads it. On a
+    // master's samples: every event the master reads back, compared below.
+    let (tests, file) = if node.external {
+        host::write_samples(&dir.join("samples.csv"), &host::scenario())?;
+        (
+            "tests/modbus/test_external.py",
+            dir.join(format!("events-{id}.csv")),
+        )
+    } else {
+        let expected = dir.join(format!("expected-{id}.csv"));
+        host::write_registers(fpu, &expected)?;
+        ("tests/modbus/test_node.py", expected)
+    };
+    let port = free_port()?;
+    let booted = boot(node.machine, &elf, port, Duration::from_secs(300), false)?;
+    let status = Command::new(python)
+        .current_dir(crate::root())
+        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider", tests])
+        .env("MODBUS_PORT", booted.port.to_string())
+        .env("MODBUS_REGISTERS", registers)
+        .env("MODBUS_CORE", if fpu { "f32" } else { "fixed" })
+        .env("MODBUS_EXPECTED", &file)
+        .env("MODBUS_SAMPLES", dir.join("samples.csv"))
+        .env("MODBUS_EVENTS_OUT", &file)
+        .env(
+            "MODBUS_EVENT_WINDOW",
+            misalign::modbus::EVENT_WINDOW.to_string(),
+        )
+        .status()
+        .map_err(|e| format!("pytest: {e}"))?;
+    drop(booted);
+    if !status.success() {
+        return Err(format!("pytest {tests}: {status}"));
+    }
+    if node.external {
+        let compared = host::compare_events(fpu, &host::scenario(), &file)?;
+        println!(
+            "  the {} events read over Modbus are the host replay's, bit for bit",
+            compared.events
+        );
+    }
+    Ok(())
+}
+
+/// `--serve PORT [--target TRIPLE]`: the node on its own samples until killed.
+fn serve(port: &str, target: Option<&str>) -> Result<(), String> {
+    let port: u16 = port
+        .parse()
+        .map_err(|_| format!("--serve {port}: not a TCP port"))?;
+    crate::tools::preflight()?;
+    let cpu = cpu_for_target(target.unwrap_or("thumbv7em-none-eabihf"))?;
+    let elf = build(&Node::on(cpu, false))?;
+    let mut booted = boot(cpu.machine, &elf, port, Duration::from_secs(600), true)?;
+    println!("serving on 127.0.0.1:{port}");
+    // The node's log goes on to stderr; QEMU runs until it is killed (with us).
+    let status = booted.child.wait().map_err(|e| e.to_string())?;
+    Err(format!("the node stopped: {status}"))
+}
+
+/// `--trace T.csv --scene S.csv --events OUT.csv [--model f32|fixed] [--target T]`.
+fn trace(
+    trace: Option<&str>,
+    scene: Option<&str>,
+    events: Option<&str>,
+    model: Option<&str>,
+    target: Option<&str>,
+) -> Result<(), String> {
+    let (Some(trace), Some(scene), Some(events)) = (trace, scene, events) else {
+        return Err("--trace T.csv needs --scene S.csv and --events OUT.csv".into());
+    };
+    let open = |p: &str| std::fs::File::open(p).map_err(|e| format!("{p}: {e}"));
+    let scene = misalign_cli::monitor_input::read_scene(open(scene)?)
+        .map_err(|e| format!("{scene}: {e}"))?;
+    if scene != host::node_scene()? {
+        return Err(
+            "the scene differs from the node's build-time scene (the built-in scenario's), and \
+             the node cannot yet be commissioned over the bus: refused"
+                .into(),
+        );
+    }
+    let samples = misalign_cli::monitor_input::read_trace(open(trace)?)
+        .map_err(|e| format!("{trace}: {e}"))?;
+    let cpu = match (model, target) {
+        (_, Some(t)) => cpu_for_target(t)?,
+        (Some("fixed"), None) => cpu("cortex-m0"),
+        (Some("f32") | None, None) => cpu("cortex-m4f"),
+        (Some(m), None) => return Err(format!("--model {m}: f32 or fixed")),
+    };
+    let fpu = cpu.has_fpu();
+    match model {
+        Some("f32") if !fpu => {
+            return Err(format!("--model f32 needs an FPU; {} has none", cpu.target));
+        }
+        Some("fixed") if fpu => {
+            return Err(format!(
+                "the node on {} runs the f32 core; --model fixed runs on thumbv6m-none-eabi or \
+                 thumbv7m-none-eabi",
+                cpu.target
+            ));
+        }
+        _ => {}
+    }
+    crate::tools::preflight()?;
+    let python = venv()?;
+    let dir = crate::root().join("target/modbus");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let registers = dir.join("registers.csv");
+    std::fs::write(&registers, registers_text()?).map_err(|e| e.to_string())?;
+    let samples_csv = dir.join("trace-samples.csv");
+    host::write_samples(&samples_csv, &samples)?;
+    let elf = build(&Node::on(cpu, true))?;
+    let port = free_port()?;
+    let booted = boot(cpu.machine, &elf, port, Duration::from_secs(300), false)?;
+    let raw = dir.join("trace-events-raw.csv");
+    let status = Command::new(&python)
+        .arg(crate::root().join("tests/modbus/master.py"))
+        .args(["--port", &booted.port.to_string()])
+        .arg("--registers")
+        .arg(&registers)
+        .arg("--samples")
+        .arg(&samples_csv)
+        .arg("--events")
+        .arg(&raw)
+        .status()
+        .map_err(|e| format!("master.py: {e}"))?;
+    drop(booted);
+    if !status.success() {
+        return Err(format!("the master failed: {status}"));
+    }
+    let compared = host::compare_events(fpu, &samples, &raw)?;
+    std::fs::write(events, &compared.csv).map_err(|e| format!("{events}: {e}"))?;
+    println!(
+        "{} samples fed over Modbus to the {} node, {} events read back: the host replay's, \
+         bit for bit; wrote {events}",
+        samples.len(),
+        cpu.name,
+        compared.events
+    );
+    Ok(())
+}
+
+/// The host's side: what the node must answer, from the same samples through the same
+/// library (`misalign::modbus::Server`, `misalign::monitor::Monitor`) and the same
+/// estimator as the node's (`node::core`).
+mod host {
+    use crate::node::{self, Core};
+    use misalign::Estimator;
+    use misalign::modbus::map::{Table, TableMap};
+    use misalign::modbus::{Server, ServerConfig, crc16, event_from_registers};
+    use misalign::monitor::scenario::{self, Scenario};
+    use misalign::monitor::{Config, Event, Monitor, Sample};
+    use misalign_cli::monitor_events::event_row;
+    use std::fmt::Write as _;
+    use std::path::Path;
+
+    /// The node's build-time scene: the built-in scenario's.
+    pub fn node_scene() -> Result<misalign::Scene, String> {
+        let [r1, r2, g, nu, mu] = scenario::SCENE;
+        misalign::Scene::new(r1, r2, g, nu, mu).map_err(|e| e.to_string())
+    }
+
+    /// The tables in the order the test reads them, with the function that reads each.
+    const TABLES: [(Table, u8, &str); 4] = [
+        (Table::Coil, 1, "coil"),
+        (Table::Discrete, 2, "discrete"),
+        (Table::Input, 4, "input"),
+        (Table::Holding, 3, "holding"),
+    ];
+    /// The most registers (or bits) one read of the test asks for.
+    const READ_MAX: u16 = 120;
+
+    /// One request through `server`: its answer.
+    fn request<E: Estimator>(server: &mut Server<E>, pdu: &[u8]) -> Vec<u8> {
+        let mut frame = vec![1];
+        frame.extend_from_slice(pdu);
+        let crc = crc16(&frame);
+        frame.extend_from_slice(&crc.to_le_bytes());
+        for b in frame {
+            server.receive(b);
+        }
+        let answer = server.response().map(<[u8]>::to_vec).unwrap_or_default();
+        server.sent();
+        answer
+    }
+
+    /// Every value of the map, read as the test reads the node: table by table, in
+    /// reads of at most [`READ_MAX`] from address 0 up; `read,table,address,value`.
+    /// The server counts the reads (`bus_*`), and so does the node's: the same reads
+    /// in the same order leave the same counts.
+    fn dump<E: Estimator>(core: E) -> Result<String, String> {
+        let monitor = Monitor::new(core, Config::default()).map_err(|e| e.to_string())?;
+        let mut server =
+            Server::new(monitor, ServerConfig::default()).map_err(|e| e.to_string())?;
+        for sample in Scenario::new() {
+            server.process(sample);
+        }
+        let mut out = String::from("read,table,address,value\n");
+        let mut read = 0;
+        for (table, function, name) in TABLES {
+            let end = TableMap::of(table).end();
+            let mut start = 0;
+            while start < end {
+                let n = READ_MAX.min(end - start);
+                let [a, b] = start.to_be_bytes();
+                let [c, d] = n.to_be_bytes();
+                let answer = request(&mut server, &[function, a, b, c, d]);
+                if answer.get(1) != Some(&function) {
+                    return Err(format!(
+                        "{name} {start}+{n}: the host's server answered {answer:02x?}"
+                    ));
+                }
+                let data = &answer[3..answer.len() - 2];
+                for k in 0..n {
+                    let value = if function <= 2 {
+                        u16::from(data[usize::from(k / 8)] >> (k % 8) & 1)
+                    } else {
+                        let i = usize::from(k) * 2;
+                        u16::from_be_bytes([data[i], data[i + 1]])
+                    };
+                    writeln!(out, "{read},{name},{},{value}", start + k).unwrap();
+                }
+                read += 1;
+                start += n;
+            }
+        }
+        Ok(out)
+    }
+
+    /// The expected registers of the node on its own samples (`fpu`: the f32 core).
+    pub fn write_registers(fpu: bool, out: &Path) -> Result<(), String> {
+        let text = match node::core(fpu)? {
+            Core::F32(core) => dump(core)?,
+            Core::Fixed(core) => dump(core)?,
+        };
+        std::fs::write(out, text).map_err(|e| format!("{}: {e}", out.display()))
+    }
+
+    /// Samples as `tests/modbus/master.py` reads them: the timestamp, every f32 as its
+    /// bit pattern, an empty cell for a channel not measured.
+    pub fn write_samples(out: &Path, samples: &[Sample]) -> Result<(), String> {
+        let mut text = String::from("time_ms,load,phi,speed,axial_force\n");
+        let bits = |x: Option<f32>| x.map_or(String::new(), |x| x.to_bits().to_string());
+        for s in samples {
+            writeln!(
+                text,
+                "{},{},{},{},{}",
+                s.time_ms,
+                s.load.to_bits(),
+                s.phi.to_bits(),
+                bits(s.speed),
+                bits(s.axial_force)
+            )
+            .unwrap();
+        }
+        std::fs::write(out, text).map_err(|e| format!("{}: {e}", out.display()))
+    }
+
+    /// The scenario's samples (what the tests feed the node on a master's samples).
+    pub fn scenario() -> Vec<Sample> {
+        Scenario::new().collect()
+    }
+
+    /// What a comparison found: the node's events in `examples/monitor --events`'s
+    /// format, and how many.
+    pub struct Compared {
+        pub csv: String,
+        pub events: usize,
+    }
+
+    /// Compares the events the master read from the node (`raw`: master.py's output)
+    /// with the host's replay of `samples` through the node's estimator; every field
+    /// bit for bit, or an error naming the first differences.
+    pub fn compare_events(fpu: bool, samples: &[Sample], raw: &Path) -> Result<Compared, String> {
+        let host = match node::core(fpu)? {
+            Core::F32(core) => replay(core, samples)?,
+            Core::Fixed(core) => replay(core, samples)?,
+        };
+        let text = std::fs::read_to_string(raw).map_err(|e| format!("{}: {e}", raw.display()))?;
+        let mut got = Vec::new();
+        for (i, line) in text.lines().enumerate().skip(1) {
+            let words: Vec<u16> = line
+                .split(',')
+                .skip(1)
+                .map(|w| {
+                    w.parse()
+                        .map_err(|_| format!("{}:{}: {w}", raw.display(), i + 1))
+                })
+                .collect::<Result<_, _>>()?;
+            match event_from_registers(&words) {
+                Ok(Some(event)) => got.push(event),
+                Ok(None) => return Err(format!("{}:{}: an empty slot", raw.display(), i + 1)),
+                Err(e) => return Err(format!("{}:{}: {e:?}", raw.display(), i + 1)),
+            }
+        }
+        let (got, host): (Vec<String>, Vec<String>) = (
+            got.iter().map(event_row).collect(),
+            host.iter().map(event_row).collect(),
+        );
+        let mut differences: Vec<String> = got
+            .iter()
+            .zip(&host)
+            .enumerate()
+            .filter(|(_, (g, h))| g != h)
+            .take(5)
+            .map(|(i, (g, h))| format!("event {i}:\n    node {g}\n    host {h}"))
+            .collect();
+        if got.len() != host.len() {
+            differences.push(format!(
+                "the node gave {} events, the host replay {}",
+                got.len(),
+                host.len()
+            ));
+        }
+        if !differences.is_empty() {
+            return Err(format!(
+                "the node's events differ from the host replay:\n  {}",
+                differences.join("\n  ")
+            ));
+        }
+        let mut csv = String::from(misalign_cli::monitor_events::HEADER);
+        for row in &got {
+            csv += row;
+            csv.push('\n');
+        }
+        Ok(Compared {
+            csv,
+            events: got.len(),
+        })
+    }
+
+    /// The monitor as the node's server runs it (`Monitor::process`), over `samples`.
+    fn replay<E: Estimator>(core: E, samples: &[Sample]) -> Result<Vec<Event>, String> {
+        let mut monitor = Monitor::new(core, Config::default()).map_err(|e| e.to_string())?;
+        let mut events = Vec::new();
+        for &s in samples {
+            monitor.process(s);
+            while let Some(e) = monitor.pop_event() {
+                events.push(e);
+            }
+        }
+        Ok(events)
+    }
+}
+
+/// The whole Cortex-M0 node's targets (the STM32G030 class): flash and RAM (statics and
+/// stack), bytes; and a function-3 read of 16 registers, instructions.
+pub const M0_FLASH_TARGET: u64 = 32 * 1024;
+pub const M0_RAM_TARGET: u64 = 8 * 1024;
+pub const M0_FC3_TARGET: u64 = 1500;
+
+/// What one core measured.
+struct Cost {
+    cpu: &'static cross::Cpu,
+    /// `minimal_node`: flash, statics, stack.
+    base: (u64, u64, u64),
+    /// `modbus_node`: flash, statics, stack.
+    node: (u64, u64, u64),
+    /// Instructions: function 3 of 16, function 4 of 16, function 16 of 20 samples;
+    /// the framing of functions 3 and 16 (every byte but the last).
+    requests: [u64; 5],
+    /// Bytes of the register map's descriptions found in `modbus_node`'s image.
+    descriptions: u64,
+    /// `size_of` the server (the monitor in it included) and of the monitor.
+    server_bytes: u64,
+    monitor_bytes: u64,
+    /// The deepest stack use once the server was built, once the samples were processed.
+    stack_built: u64,
+    stack_samples: u64,
+}
+
+/// Bytes of the map's descriptions (the CSV's last column) that `elf` holds: text the
+/// server never sends, linked because its map entries carry it.
+fn description_bytes(elf: &Path) -> Result<u64, String> {
+    let image = std::fs::read(elf).map_err(|e| format!("{}: {e}", elf.display()))?;
+    let map = registers_text()?;
+    let mut descriptions: Vec<&str> = map
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split_once(",\"")?.1.strip_suffix('"'))
+        .collect();
+    descriptions.sort_unstable();
+    descriptions.dedup();
+    Ok(descriptions
+        .iter()
+        .filter(|d| image.windows(d.len()).any(|w| w == d.as_bytes()))
+        .map(|d| d.len() as u64)
+        .sum())
+}
+
+/// `--measure`: builds `minimal_node` and `modbus_node` (profile `node`) for the
+/// Cortex-M0 and M4F, runs them in QEMU, writes the CSV and the markdown table.
+fn measure() -> Result<(), String> {
+    crate::tools::preflight()?;
+    let llvm_size = crate::tools::llvm_tool("llvm-size")?;
+    let mut costs = Vec::new();
+    for id in ["cortex-m0", "cortex-m4f"] {
+        let cpu = cpu(id);
+        let built = cross::build(cross::harness_build_with(cpu.target, "node").args([
+            "--bin",
+            "minimal_node",
+            "--bin",
+            "modbus_node",
+        ]))?;
+        let mut measured = Vec::new();
+        for name in ["minimal_node", "modbus_node"] {
+            let elf = cross::artifact(&built, name)?;
+            let (status, log) = cross::qemu(cpu.machine, &elf)?;
+            if status != Some(0) {
+                return Err(format!("{name} on {}: exit {status:?}\n{log}", cpu.machine));
+            }
+            // Every `key=value` of the whole log (the fields stand on several lines).
+            let fields =
+                crate::log::Fields::of(&log, "").ok_or_else(|| format!("{name}: no log"))?;
+            let field = |key: &str| -> Result<u64, String> {
+                fields
+                    .num(key)
+                    .map_err(|e| format!("{name}: {e} in its log:\n{log}"))
+            };
+            let s = cross::Sections::of(&llvm_size, &elf)?;
+            let requests = if name == "modbus_node" {
+                [
+                    field("fc3_16")?,
+                    field("fc4_16")?,
+                    field("fc16_20")?,
+                    field("fc3_16_framing")?,
+                    field("fc16_20_framing")?,
+                ]
+            } else {
+                [0; 5]
+            };
+            let sizes = if name == "modbus_node" {
+                [
+                    field("server_bytes")?,
+                    field("monitor_bytes")?,
+                    field("stack_built")?,
+                    field("stack_samples")?,
+                ]
+            } else {
+                [0; 4]
+            };
+            measured.push(((s.flash(), s.ram(), field("stack_bytes")?), requests, sizes));
+        }
+        costs.push(Cost {
+            cpu,
+            base: measured[0].0,
+            node: measured[1].0,
+            requests: measured[1].1,
+            descriptions: description_bytes(&cross::artifact(&built, "modbus_node")?)?,
+            server_bytes: measured[1].2[0],
+            monitor_bytes: measured[1].2[1],
+            stack_built: measured[1].2[2],
+            stack_samples: measured[1].2[3],
+        });
+    }
+    let (csv, table, misses) = cost_tables(&costs);
+    let docs = crate::root().join("docs");
+    std::fs::write(docs.join("modbus-cost.csv"), &csv).map_err(|e| e.to_string())?;
+    let page = docs.join("measurements-modbus.md");
+    let text = std::fs::read_to_string(&page).map_err(|e| format!("{}: {e}", page.display()))?;
+    let (begin, end) = ("<!-- modbus:begin -->", "<!-- modbus:end -->");
+    let (Some(a), Some(b)) = (text.find(begin), text.find(end)) else {
+        return Err(format!("{} has no modbus markers", page.display()));
+    };
+    let new = format!("{}{begin}\n{table}{}", &text[..a], &text[b..]);
+    std::fs::write(&page, new).map_err(|e| e.to_string())?;
+    print!("{table}");
+    println!("wrote docs/modbus-cost.csv and docs/measurements-modbus.md");
+    for m in &misses {
+        println!("over target: {m}");
+    }
+    Ok(())
+}
+
+/// The CSV, the markdown table, and the Cortex-M0 targets missed.
+fn cost_tables(costs: &[Cost]) -> (String, String, Vec<String>) {
+    use std::fmt::Write as _;
+    let mut csv = String::from(
+        "core,node_flash,node_statics,node_stack,node_ram,server_flash,server_statics,\
+         server_stack,fc3_16_instructions,fc3_16_framing,fc4_16_instructions,\
+         fc16_20_instructions,fc16_20_framing,server_flash_descriptions,server_struct,\
+         monitor_struct\n",
+    );
+    let mut md = String::from(
+        "| core | node flash | node RAM: statics + stack | the server adds: flash (descriptions) | \
+         statics | stack | function 3, 16 registers (framing) | function 4, 16 registers | \
+         function 16, 20 samples (framing) |\n|---|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+    );
+    let mut misses = Vec::new();
+    for c in costs {
+        let (flash, statics, stack) = c.node;
+        let ram = statics + stack;
+        let d = |a: u64, b: u64| a as i64 - b as i64;
+        let m0 = c.cpu.id == "cortex-m0";
+        let checks = [
+            (flash, M0_FLASH_TARGET, "node flash (B)"),
+            (ram, M0_RAM_TARGET, "node RAM (B)"),
+            (
+                c.requests[0],
+                M0_FC3_TARGET,
+                "function 3 of 16 registers (instructions)",
+            ),
+        ];
+        let marks = checks.map(|(value, target, what)| {
+            if m0 && value > target {
+                misses.push(format!("{} {what}: {value} > {target}", c.cpu.name));
+                " **over target**"
+            } else {
+                ""
+            }
+        });
+        writeln!(
+            csv,
+            "{},{flash},{statics},{stack},{ram},{},{},{},{},{},{},{},{},{},{},{}",
+            c.cpu.name,
+            d(flash, c.base.0),
+            d(statics, c.base.1),
+            d(stack, c.base.2),
+            c.requests[0],
+            c.requests[3],
+            c.requests[1],
+            c.requests[2],
+            c.requests[4],
+            c.descriptions,
+            c.server_bytes,
+            c.monitor_bytes
+        )
+        .unwrap();
+        writeln!(
+            md,
+            "| {} | {flash}{} | {statics} + {stack} = {ram}{} | {} ({}) | {} | {} | {}{} ({}) | {} | {} ({}) |",
+            c.cpu.name,
+            marks[0],
+            marks[1],
+            d(flash, c.base.0),
+            c.descriptions,
+            d(statics, c.base.1),
+            d(stack, c.base.2),
+            c.requests[0],
+            marks[2],
+            c.requests[3],
+            c.requests[1],
+            c.requests[2],
+            c.requests[4]
+        )
+        .unwrap();
+    }
+    md.push('\n');
+    for c in costs {
+        writeln!(
+            md,
+            "{}: `Server<E>` takes {} B, of which the monitor {} B; the node keeps one, \
+             built on the stack. The deepest stack use is {} B once it is built, {} B once \
+             the samples are processed, {} B after the requests.",
+            c.cpu.name, c.server_bytes, c.monitor_bytes, c.stack_built, c.stack_samples, c.node.2
+        )
+        .unwrap();
+    }
+    (csv, md, misses)
+}
