@@ -158,14 +158,14 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
     let s = m.statistics();
     defmt::println!(
         "summary samples={=u64} repeated={=u32} spikes={=u32} faults={=u64} dropped={=u32} max_s={=f32} max_F={=f32} min_margin={} final={=str} ttc={}",
-        s.samples,
-        s.repeated_timestamps,
-        s.spikes,
-        s.faults.total(),
-        s.events_dropped,
-        s.max_slip_ratio,
-        s.max_axial_force,
-        s.min_margin,
+        s.samples(),
+        s.repeated_timestamps(),
+        s.spikes(),
+        s.faults().total(),
+        s.events_dropped(),
+        s.max_slip_ratio(),
+        s.max_axial_force(),
+        s.min_margin(),
         m.state().as_str(),
         m.time_to_critical()
     );
@@ -173,8 +173,8 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         defmt::println!(
             "summary state={=str} time_ms={=u64} energy_j={=f64}",
             state.as_str(),
-            s.time_in_state_ms[state.index()],
-            s.energy[state.index()].total()
+            s.time_in_state_ms(state),
+            s.energy_j(state)
         );
     }
 }

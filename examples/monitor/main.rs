@@ -240,7 +240,10 @@ fn hms(ms: u64) -> String {
 
 fn summary<E: Estimator>(m: &Monitor<E>) {
     let s = m.statistics();
-    let total_ms: u64 = s.time_in_state_ms.iter().sum();
+    let total_ms: u64 = RiskState::ALL
+        .iter()
+        .map(|&st| s.time_in_state_ms(st))
+        .sum();
     say!(
         "\n{:<14} {:>10} {:>7} {:>14}",
         "state",
@@ -249,13 +252,13 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         "energy (J)"
     );
     for state in RiskState::ALL {
-        let ms = s.time_in_state_ms[state.index()];
+        let ms = s.time_in_state_ms(state);
         say!(
             "{:<14} {:>10} {:>6.1}% {:>14.3}",
             state.as_str(),
             hms(ms),
             100.0 * ms as f64 / total_ms.max(1) as f64,
-            s.energy[state.index()].total()
+            s.energy_j(state)
         );
     }
     say!(
@@ -265,13 +268,13 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         "",
         s.total_energy()
     );
-    let f = &s.faults;
+    let f = s.faults();
     say!(
         "\nsamples {}  repeated timestamps {}  spikes rejected {}  events dropped {}",
-        s.samples,
-        s.repeated_timestamps,
-        s.spikes,
-        s.events_dropped
+        s.samples(),
+        s.repeated_timestamps(),
+        s.spikes(),
+        s.events_dropped()
     );
     say!(
         "faults {}: non-finite {}, out of range {}, stuck {}, gap {}, time backwards {}, driver {}, estimator {}, sensors {}",
@@ -287,9 +290,9 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
     );
     say!(
         "max d/b {:.3}  max |F| {:.1} N  min margin {}",
-        s.max_slip_ratio,
-        s.max_axial_force,
-        s.min_margin
+        s.max_slip_ratio(),
+        s.max_axial_force(),
+        s.min_margin()
             .map_or("-".into(), |m| format!("{:.3} mrad", m * 1e3))
     );
     // Only with a measured F on the f32 core.
@@ -299,9 +302,9 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
             "friction mu {mu:.4}  baseline {}  {} estimates used, {} ill-posed{}",
             m.friction_baseline()
                 .map_or("- (not captured yet)".into(), |b| format!("{b:.4}")),
-            fs.accepted,
-            fs.rejected,
-            if fs.changed { "  CHANGED" } else { "" }
+            fs.accepted(),
+            fs.rejected(),
+            if fs.changed() { "  CHANGED" } else { "" }
         );
     }
     say!(

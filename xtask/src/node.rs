@@ -267,23 +267,23 @@ fn replay<E: Estimator>(core: E, through_sensors: bool) -> Result<Log, String> {
     let s = monitor.statistics();
     out.summary = Summary {
         counts: [
-            s.samples,
-            s.repeated_timestamps.into(),
-            s.spikes.into(),
-            s.faults.total(),
-            s.events_dropped.into(),
+            s.samples(),
+            s.repeated_timestamps().into(),
+            s.spikes().into(),
+            s.faults().total(),
+            s.events_dropped().into(),
         ],
         final_state: monitor.state().as_str().into(),
-        max_slip_ratio: s.max_slip_ratio.into(),
-        max_force: s.max_axial_force.into(),
-        min_margin: s.min_margin.map(f64::from),
+        max_slip_ratio: s.max_slip_ratio().into(),
+        max_force: s.max_axial_force().into(),
+        min_margin: s.min_margin().map(f64::from),
         states: RiskState::ALL
             .iter()
             .map(|st| {
                 (
                     st.as_str().to_string(),
-                    s.time_in_state_ms[st.index()],
-                    s.energy[st.index()].total(),
+                    s.time_in_state_ms(*st),
+                    s.energy_j(*st),
                 )
             })
             .collect(),
