@@ -4,8 +4,6 @@
 //! state: the step's energy until that state is known.
 
 use super::order::{finite, positive};
-use super::risk::RiskState;
-use super::statistics::Statistics;
 
 /// A compensated sum in f32: the running sum and what its rounding has lost so far.
 /// Each term is added together with the lost part, by an error-free transformation
@@ -72,14 +70,17 @@ impl Energy {
         self.step_j = dissipated_power(force, phi, speed) * dt_s;
     }
 
-    /// Adds the step's energy to `state`'s in `stats` (never `Stopped`: a running
-    /// sample leaves it).
+    /// The step's energy (J) to add to the state reported after the sample (never
+    /// `Stopped`: a running sample leaves it), if above zero; then none is left.
     #[inline(always)]
-    pub(crate) fn settle(&mut self, state: RiskState, stats: &mut Statistics) {
+    pub(crate) fn take(&mut self) -> Option<f32> {
         // Above zero (by its bits: a soft-float comparison costs more).
         if positive(self.step_j) {
-            stats.add_energy(state, self.step_j);
+            let j = self.step_j;
             self.step_j = 0.0;
+            Some(j)
+        } else {
+            None
         }
     }
 }

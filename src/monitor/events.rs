@@ -6,7 +6,6 @@
 use super::config::TrendConfig;
 use super::order::ge;
 use super::risk::RiskState;
-use super::statistics::Statistics;
 use crate::sensor_fault::SensorFault;
 use core::fmt;
 use heapless::Deque;
@@ -188,16 +187,15 @@ impl Events {
     }
 
     /// Appends the event `kind` of the sample stamped `time_ms` at monotonic time
-    /// `elapsed_ms`, with the latest reading; full, the queue drops its oldest, counted
-    /// in `stats`.
+    /// `elapsed_ms`, with the latest reading; full, the queue drops its oldest.
+    /// Returns whether it dropped one.
     pub(crate) fn emit(
         &mut self,
         kind: EventKind,
         time_ms: u32,
         elapsed_ms: u64,
         reading: Option<Reading>,
-        stats: &mut Statistics,
-    ) {
+    ) -> bool {
         let event = Event {
             seq: self.next_seq,
             time_ms,
@@ -206,11 +204,12 @@ impl Events {
             reading: reading.unwrap_or_default(),
         };
         self.next_seq = self.next_seq.wrapping_add(1);
-        if self.queue.is_full() {
+        let dropped = self.queue.is_full();
+        if dropped {
             self.queue.pop_front();
-            stats.count_dropped_event();
         }
         // Not full after the pop above.
         let _ = self.queue.push_back(event);
+        dropped
     }
 }

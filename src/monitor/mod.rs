@@ -12,20 +12,23 @@
 //!    median, load and angle smoothed with a weight that follows the real time step;
 //! 4. **estimate** (`estimate.rs`): the [`Estimator`]'s d/b, F, phi0 and margin, the
 //!    [`Reading`];
-//! 5. **risk** (`risk.rs`): thresholds with deadband, on- and off-delays and the
+//! 5. **energy** (`energy.rs`): the dissipated power F phi V (section 7) over the step;
+//! 6. **trend** (`trend.rs`): the margin's trend gives the time to critical;
+//! 7. **risk** (`risk.rs`): thresholds with deadband, on- and off-delays and the
 //!    start-up inhibit decide the [`RiskState`];
-//! 6. **energy** (`energy.rs`): the dissipated power F phi V (section 7) integrated
-//!    per state;
-//! 7. **trend** (`trend.rs`): the margin's trend gives the time to critical and the
-//!    `Approaching` warning;
-//! 8. **friction** (`friction.rs`, [`Monitor::process_with_friction`] only): mu from a
+//! 8. **statistics** (`statistics.rs`): the step's energy added to the state reported
+//!    after it;
+//! 9. **friction** (`friction.rs`, [`Monitor::process_with_friction`] only): mu from a
 //!    measured axial force;
-//! 9. **events** (`events.rs`): state changes, `Approaching` and friction changes go
-//!    to a fixed queue that a consumer drains ([`Monitor::pop_event`]).
+//! 10. **events** (`events.rs`): state changes, the `Approaching` warning (the time
+//!     to critical below the horizon) and friction changes go to a fixed queue that a
+//!     consumer drains ([`Monitor::pop_event`]).
 //!
-//! The stages count what they see into the [`Statistics`] (`statistics.rs`); they
-//! compare values through `order.rs` (order and finiteness by the bits where floats
-//! are soft), which imports nothing from the monitor.
+//! Conditioning, estimate, energy and trend see only a valid running sample. The
+//! stages count what they see into the [`Statistics`] (time per state, spikes,
+//! extremes, faults, dropped events); they compare values through `order.rs` (order
+//! and finiteness by the bits where floats are soft), which imports nothing from the
+//! monitor.
 //!
 //! **Model choice (section 9).** The elliptic and the line-contact solutions differ
 //! by up to 22 % in d/b where the ellipse reaches the rollers' ends; switching per
@@ -255,8 +258,9 @@ impl<E: Estimator> Monitor<E> {
 
     fn emit(&mut self, kind: EventKind, time_ms: u32) {
         let elapsed_ms = self.clock.elapsed_ms;
-        self.events
-            .emit(kind, time_ms, elapsed_ms, self.reading, &mut self.stats);
+        if self.events.emit(kind, time_ms, elapsed_ms, self.reading) {
+            self.stats.count_dropped_event();
+        }
     }
 
     /// The filtered friction coefficient mu, `None` before the first well-posed
@@ -358,7 +362,9 @@ impl<E: Estimator> Monitor<E> {
                         }
                         estimated = Some(at);
                         // Risk: the level of the reading.
-                        self.alarm.level(&self.config, &self.levels, &r, now)
+                        let margin = r.margin;
+                        self.alarm
+                            .level(&self.config, &self.levels, r.slip_ratio, margin, now)
                     }
                     Err(f) => {
                         fault = Some(f);
@@ -375,6 +381,10 @@ impl<E: Estimator> Monitor<E> {
         }
         let changed = self.alarm.offer(&self.config, candidate, now);
         let state = self.alarm.state;
+        // Statistics: the step's energy for the state reported after it.
+        if let Some(j) = self.energy.take() {
+            self.stats.add_energy(state, j);
+        }
         // Friction.
         let friction = match (
             friction,
@@ -406,8 +416,6 @@ impl<E: Estimator> Monitor<E> {
         if let Some((mu, changed)) = friction {
             self.emit(EventKind::Friction { mu, changed }, sample.time_ms);
         }
-        // Statistics: the step's energy for the state reported after it.
-        self.energy.settle(state, &mut self.stats);
         state
     }
 
@@ -433,6 +441,92 @@ impl<E: Estimator> Monitor<E> {
     }
 }
 
+impl<E: Estimator> Monitor<E> {
+    /// The whole state as a plain value.
+    pub fn snapshot(&self) -> MonitorState {
+        let [load_window, angle_window] = &self.conditioning.windows;
+        MonitorState {
+            clock: self.clock,
+            alarm: self.alarm,
+            smoothed: self.conditioning.smoothed,
+            checks: self.checks,
+            trend_interval: self.trend.interval,
+            time_to_critical_s: self.trend.time_to_critical_s,
+            approaching_armed: self.events.approaching_armed,
+            next_seq: self.events.next_seq,
+            reading: self.reading,
+            energy: self.energy,
+            stats: self.stats,
+            friction: self.friction,
+            load_window: state::Saved::from_iter(0.0, load_window.iter()),
+            angle_window: state::Saved::from_iter(0.0, angle_window.iter()),
+            trend: state::Saved::from_iter(
+                TrendPoint::default(),
+                self.trend.points.iter().copied(),
+            ),
+            events: state::Saved::from_iter(state::NO_EVENT, self.events.queue.iter().copied()),
+        }
+    }
+
+    /// A monitor over `estimator` and `config` that goes on from `state`.
+    ///
+    /// # Errors
+    /// The [`ConfigError`] of an inconsistent configuration.
+    pub fn restore(
+        estimator: E,
+        config: Config,
+        state: &MonitorState,
+    ) -> Result<Self, ConfigError> {
+        let mut m = Monitor::new(estimator, config)?;
+        m.resume(state);
+        Ok(m)
+    }
+
+    /// Goes on from `state` (a snapshot of a monitor with this configuration) in
+    /// place of whatever this monitor held: [`restore`](Self::restore) without a
+    /// second monitor on the stack. With `storage::Store::restore_into` (feature
+    /// `sequential-storage`) a node restores its state at start-up holding one monitor
+    /// and one state.
+    pub fn resume(&mut self, state: &MonitorState) {
+        self.clock = state.clock;
+        self.alarm = state.alarm;
+        self.conditioning.smoothed = state.smoothed;
+        self.checks = state.checks;
+        self.trend.interval = state.trend_interval;
+        self.trend.time_to_critical_s = state.time_to_critical_s;
+        self.events.approaching_armed = state.approaching_armed;
+        self.events.next_seq = state.next_seq;
+        self.reading = state.reading;
+        self.energy = state.energy;
+        self.stats = state.stats;
+        self.friction = state.friction;
+        // The buffers were filled from at most their own capacity: the pushes fit.
+        let n = self
+            .config
+            .spikes
+            .map_or(SPIKE_WINDOW_CAPACITY, |s| usize::from(s.window));
+        for (window, saved) in self
+            .conditioning
+            .windows
+            .iter_mut()
+            .zip([&state.load_window, &state.angle_window])
+        {
+            window.clear();
+            for x in saved.iter() {
+                window.push_back(x, n);
+            }
+        }
+        self.trend.points.clear();
+        for p in state.trend.iter() {
+            let _ = self.trend.points.push_back(p);
+        }
+        self.events.queue.clear();
+        for e in state.events.iter() {
+            let _ = self.events.queue.push_back(e);
+        }
+    }
+}
+
 impl<E: Estimator + FrictionInverse> Monitor<E> {
     /// [`process`](Self::process), and with a measured axial force F on a sample that
     /// was estimated, the friction coefficient mu from it: the
@@ -453,5 +547,27 @@ impl<E: Estimator + FrictionInverse> Monitor<E> {
             sample,
             Some(|e: &E, load, phi, force| e.friction_from_axial_force(load, phi, force).ok()),
         )
+    }
+}
+
+// The live monitor without its estimator and its configuration fits the state's RAM
+// budget too, on every target.
+const _: () =
+    assert!(core::mem::size_of::<Monitor<()>>() - CONFIGURATION_BYTES <= STATE_BUDGET_BYTES);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The two sizes the budget bounds (`cargo test --lib monitor::tests --
+    /// --nocapture`).
+    #[test]
+    fn state_fits_its_budget() {
+        let snapshot = core::mem::size_of::<MonitorState>();
+        let live = core::mem::size_of::<Monitor<()>>() - CONFIGURATION_BYTES;
+        std::println!(
+            "snapshot {snapshot} bytes, live monitor {live} bytes besides its configuration"
+        );
+        assert!(snapshot <= STATE_BUDGET_BYTES && live <= STATE_BUDGET_BYTES);
     }
 }

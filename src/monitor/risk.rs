@@ -4,7 +4,6 @@
 //! state machine ([`Alarm`]).
 
 use super::config::{Config, Thresholds};
-use super::events::Reading;
 use super::order::ge;
 
 /// The roller pair's state as the monitor reports it.
@@ -172,20 +171,22 @@ impl Alarm {
         }
     }
 
-    /// The level a valid running sample's `reading` asks for at `now_ms`: its slip
-    /// level from the reported state, `Normal` during the start-up inhibit.
+    /// The level a valid running sample with d/b `slip_ratio` and margin `margin`
+    /// (rad) asks for at `now_ms`: its slip level from the reported state, `Normal`
+    /// during the start-up inhibit.
     #[inline(always)]
     pub(crate) fn level(
         &self,
         config: &Config,
         levels: &Levels,
-        reading: &Reading,
+        slip_ratio: f32,
+        margin: Option<f32>,
         now_ms: u64,
     ) -> RiskState {
         if self.inhibited(config, now_ms) {
             RiskState::Normal
         } else {
-            slip_level(levels, reading.slip_ratio, reading.margin, self.state)
+            slip_level(levels, slip_ratio, margin, self.state)
         }
     }
 
