@@ -11,13 +11,12 @@ mod plot;
 use misalign_cli::monitor_input as input;
 
 use clap::{Parser, ValueEnum};
-use misalign::fixed::{FixedAuto, FixedEllipticScene};
+use misalign::Estimator;
+use misalign::fixed::FixedAuto;
 use misalign::float::Auto;
 use misalign::monitor::{
-    Config, Event, EventKind, Monitor, RiskState, Sample, Thresholds, model_for_range, scenario,
+    Config, Event, EventKind, Monitor, RiskState, Sample, Thresholds, scenario,
 };
-use misalign::reference::ModelChoice;
-use misalign::{Estimator, Scene};
 use std::error::Error;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -467,10 +466,7 @@ fn main() -> std::process::ExitCode {
     let result = (|| -> Res<()> {
         let scene = match &args.scene {
             Some(path) => input::read_scene(std::fs::File::open(path)?)?,
-            None => {
-                let [r1, r2, g, nu, mu] = scenario::SCENE;
-                Scene::new(r1, r2, g, nu, mu)?
-            }
+            None => scenario::scene()?,
         };
         let (samples, builtin) = match &args.trace {
             Some(path) => (input::read_trace(std::fs::File::open(path)?)?, false),
@@ -481,25 +477,23 @@ fn main() -> std::process::ExitCode {
             .map(|s| f64::from(s.load))
             .filter(|l| l.is_finite())
             .fold(scenario::LOAD_MAX, f64::max);
-        // One model for the trace's operating range (section 9, decided once).
-        let choice = model_for_range(&scene, load_max, scenario::ANGLE_MIN)?;
+        // One model for the trace's operating range (section 9, decided once), as the
+        // node builds it for the built-in scenario.
         match args.model {
             Model::F32 => run(
-                Auto::with_choice(&scene, choice)?,
+                scenario::estimator_for::<Auto>(&scene, load_max)?,
                 Monitor::process_with_friction,
                 &args,
                 samples,
                 builtin,
             ),
-            Model::Fixed => {
-                // 10 mN per count; the finest angle LSB the tables allow, at least 0.1 nrad.
-                let angle_lsb = match choice {
-                    ModelChoice::Elliptic => FixedEllipticScene::min_angle_lsb(&scene).max(1e-10),
-                    _ => 1e-10,
-                };
-                let core = FixedAuto::with_choice(&scene, 1e-2, angle_lsb, choice)?;
-                run(core, Monitor::process, &args, samples, builtin)
-            }
+            Model::Fixed => run(
+                scenario::estimator_for::<FixedAuto>(&scene, load_max)?,
+                Monitor::process,
+                &args,
+                samples,
+                builtin,
+            ),
         }
     })();
     match result {

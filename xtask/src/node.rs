@@ -23,12 +23,11 @@
 //! frozen codes instead of the monitor's 2 minutes: that comparison would have to be
 //! loose, this one need not be.)
 
-use misalign::fixed::{FixedAuto, FixedEllipticScene};
+use misalign::Estimator;
+use misalign::fixed::FixedAuto;
 use misalign::float::Auto;
 use misalign::monitor::scenario::{self, Scenario};
-use misalign::monitor::{Config, EventKind, Monitor, RiskState, Sample, model_for_range};
-use misalign::reference::ModelChoice;
-use misalign::{Estimator, Scene};
+use misalign::monitor::{Config, EventKind, Monitor, RiskState, Sample};
 
 #[allow(dead_code)] // Shared with the firmware, which uses it all.
 #[path = "../../examples/firmware/sensors.rs"]
@@ -207,39 +206,17 @@ pub fn parse_measured(log: &str) -> Result<Measured, String> {
     })
 }
 
-/// The scenario's scene and one model for its range, as `examples/monitor` chooses
-/// them (the highest load of the samples, at least `scenario::LOAD_MAX`).
-fn scene_and_model() -> Result<(Scene, ModelChoice), String> {
-    let [r1, r2, g, nu, mu] = scenario::SCENE;
-    let scene = Scene::new(r1, r2, g, nu, mu).map_err(|e| e.to_string())?;
-    let load_max = Scenario::new()
-        .map(|s| f64::from(s.load))
-        .filter(|l| l.is_finite())
-        .fold(scenario::LOAD_MAX, f64::max);
-    let choice =
-        model_for_range(&scene, load_max, scenario::ANGLE_MIN).map_err(|e| e.to_string())?;
-    Ok((scene, choice))
-}
-
 /// The host's replay of the scenario, on the f32 core (`fpu`) or the fixed-point one,
 /// straight or through the simulated sensors: what the node must log.
 pub fn host_replay(fpu: bool, through_sensors: bool) -> Result<Log, String> {
-    let (scene, choice) = scene_and_model()?;
     let err = |e: misalign::Error| e.to_string();
     if fpu {
+        replay(scenario::estimator::<Auto>().map_err(err)?, through_sensors)
+    } else {
         replay(
-            Auto::with_choice(&scene, choice).map_err(err)?,
+            scenario::estimator::<FixedAuto>().map_err(err)?,
             through_sensors,
         )
-    } else {
-        // As `examples/monitor --model fixed`: 10 mN a count, the finest angle LSB the
-        // tables allow, at least 0.1 nrad.
-        let angle_lsb = match choice {
-            ModelChoice::Elliptic => FixedEllipticScene::min_angle_lsb(&scene).max(1e-10),
-            _ => 1e-10,
-        };
-        let core = FixedAuto::with_choice(&scene, 1e-2, angle_lsb, choice).map_err(err)?;
-        replay(core, through_sensors)
     }
 }
 
