@@ -554,20 +554,3 @@ impl<E: Estimator + FrictionInverse> Monitor<E> {
 // budget too, on every target.
 const _: () =
     assert!(core::mem::size_of::<Monitor<()>>() - CONFIGURATION_BYTES <= STATE_BUDGET_BYTES);
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The two sizes the budget bounds (`cargo test --lib monitor::tests --
-    /// --nocapture`).
-    #[test]
-    fn state_fits_its_budget() {
-        let snapshot = core::mem::size_of::<MonitorState>();
-        let live = core::mem::size_of::<Monitor<()>>() - CONFIGURATION_BYTES;
-        std::println!(
-            "snapshot {snapshot} bytes, live monitor {live} bytes besides its configuration"
-        );
-        assert!(snapshot <= STATE_BUDGET_BYTES && live <= STATE_BUDGET_BYTES);
-    }
-}

@@ -184,3 +184,21 @@ impl Default for MonitorState {
 /// both fit, on every target (checked when the crate compiles).
 pub const STATE_BUDGET_BYTES: usize = 1024;
 const _: () = assert!(core::mem::size_of::<MonitorState>() <= STATE_BUDGET_BYTES);
+
+#[cfg(test)]
+mod tests {
+    use super::super::{CONFIGURATION_BYTES, Monitor};
+    use super::*;
+
+    /// The two sizes the budget bounds (`cargo test --lib monitor::state --
+    /// --nocapture`).
+    #[test]
+    fn state_fits_its_budget() {
+        let snapshot = core::mem::size_of::<MonitorState>();
+        let live = core::mem::size_of::<Monitor<()>>() - CONFIGURATION_BYTES;
+        std::println!(
+            "snapshot {snapshot} bytes, live monitor {live} bytes besides its configuration"
+        );
+        assert!(snapshot <= STATE_BUDGET_BYTES && live <= STATE_BUDGET_BYTES);
+    }
+}
