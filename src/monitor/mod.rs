@@ -16,13 +16,13 @@
 //! 6. **trend** (`trend.rs`): the margin's trend gives the time to critical;
 //! 7. **risk** (`risk.rs`): thresholds with deadband, on- and off-delays and the
 //!    start-up inhibit decide the [`RiskState`];
-//! 8. **statistics** (`statistics.rs`): the step's energy added to the state reported
-//!    after it;
-//! 9. **friction** (`friction.rs`, [`Monitor::process_with_friction`] only): mu from a
+//! 8. **friction** (`friction.rs`, [`Monitor::process_with_friction`] only): mu from a
 //!    measured axial force;
-//! 10. **events** (`events.rs`): state changes, the `Approaching` warning (the time
-//!     to critical below the horizon) and friction changes go to a fixed queue that a
-//!     consumer drains ([`Monitor::pop_event`]).
+//! 9. **events** (`events.rs`): state changes, the `Approaching` warning (the time to
+//!    critical below the horizon) and friction changes go to a fixed queue that a
+//!    consumer drains ([`Monitor::pop_event`]);
+//! 10. **statistics** (`statistics.rs`): the step's energy added to the state
+//!     reported after it.
 //!
 //! Conditioning, estimate, energy and trend see only a valid running sample. The
 //! stages count what they see into the [`Statistics`] (time per state, spikes,
@@ -381,10 +381,6 @@ impl<E: Estimator> Monitor<E> {
         }
         let changed = self.alarm.offer(&self.config, candidate, now);
         let state = self.alarm.state;
-        // Statistics: the step's energy for the state reported after it.
-        if let Some(j) = self.energy.take() {
-            self.stats.add_energy(state, j);
-        }
         // Friction.
         let friction = match (
             friction,
@@ -415,6 +411,10 @@ impl<E: Estimator> Monitor<E> {
         }
         if let Some((mu, changed)) = friction {
             self.emit(EventKind::Friction { mu, changed }, sample.time_ms);
+        }
+        // Statistics: the step's energy for the state reported after it.
+        if let Some(j) = self.energy.take() {
+            self.stats.add_energy(state, j);
         }
         state
     }
