@@ -537,7 +537,7 @@ fn external_samples_are_processed_as_the_monitors_own() {
     // Off: refused with 01, counted, nothing processed.
     let records = basic_records(&[(0, 1e3, 1e-4)]);
     assert_eq!(exception(&write(&mut s, SAMPLES_ADDRESS, &records), 16), 1);
-    assert_eq!(s.monitor().statistics().samples, 0);
+    assert_eq!(s.monitor().statistics().samples(), 0);
     // On by the register; 20 a write.
     assert_eq!(request(&mut s, 6, &be(&[4, 1])), vec![6, 0, 4, 0, 1]);
     for chunk in samples.chunks(usize::from(SAMPLES)) {
@@ -602,7 +602,7 @@ fn external_samples_are_processed_as_the_monitors_own() {
         exception(&request(&mut s, 6, &be(&[SAMPLES_ADDRESS, 0])), 6),
         2
     );
-    assert_eq!(s.monitor().statistics().samples, 11);
+    assert_eq!(s.monitor().statistics().samples(), 11);
     assert_eq!(s.counters().external_refused, 3);
     // The block reads as 0.
     assert_eq!(read(&mut s, 3, SAMPLES_ADDRESS, 6), vec![0; 6]);
@@ -624,10 +624,10 @@ fn bad_external_samples_are_counted_never_lost() {
     ]);
     assert_eq!(write(&mut s, SAMPLES_ADDRESS, &r)[0], 16);
     let st = s.monitor().statistics();
-    assert_eq!(st.samples, 6);
-    assert_eq!(st.faults.non_finite, 3);
-    assert_eq!(st.repeated_timestamps, 1);
-    assert_eq!(st.faults.time_backwards, 1);
+    assert_eq!(st.samples(), 6);
+    assert_eq!(st.faults().non_finite, 3);
+    assert_eq!(st.repeated_timestamps(), 1);
+    assert_eq!(st.faults().time_backwards, 1);
     let regs = read(&mut s, 4, input("faults_non_finite"), 10);
     assert_eq!(u32_at(&regs, 0), 3);
     assert_eq!(u32_at(&regs, 8), 1);
@@ -865,38 +865,42 @@ fn every_input_register_is_the_monitors_value() {
     assert_eq!(f("slip_ratio"), opt(r.map(|r| r.slip_ratio)));
     assert_eq!(f("time_to_critical"), opt(m.time_to_critical()));
     assert_eq!(f("friction"), opt(m.friction()));
-    assert_eq!(u("samples"), st.samples as u32);
-    assert_eq!(u("repeated_timestamps"), st.repeated_timestamps);
-    assert_eq!(u("spikes"), st.spikes);
+    assert_eq!(u("samples"), st.samples() as u32);
+    assert_eq!(u("repeated_timestamps"), st.repeated_timestamps());
+    assert_eq!(u("spikes"), st.spikes());
     assert_eq!(u("event_seq_next"), m.next_event_seq());
     let faults = [
-        ("faults_non_finite", st.faults.non_finite),
-        ("faults_out_of_range", st.faults.out_of_range),
-        ("faults_stuck", st.faults.stuck),
-        ("faults_gap", st.faults.gap),
-        ("faults_time_backwards", st.faults.time_backwards),
-        ("faults_driver", st.faults.driver),
-        ("faults_estimator", st.faults.estimator),
-        ("faults_sensor", st.faults.sensor),
+        ("faults_non_finite", st.faults().non_finite),
+        ("faults_out_of_range", st.faults().out_of_range),
+        ("faults_stuck", st.faults().stuck),
+        ("faults_gap", st.faults().gap),
+        ("faults_time_backwards", st.faults().time_backwards),
+        ("faults_driver", st.faults().driver),
+        ("faults_estimator", st.faults().estimator),
+        ("faults_sensor", st.faults().sensor),
     ];
     for (name, count) in faults {
         assert_eq!(u(name), count, "{name}");
     }
-    assert!(st.faults.non_finite > 0 && st.faults.out_of_range > 0 && st.faults.time_backwards > 0);
+    assert!(
+        st.faults().non_finite > 0
+            && st.faults().out_of_range > 0
+            && st.faults().time_backwards > 0
+    );
     for state in RiskState::ALL {
         let name = state.as_str();
-        let ms = st.time_in_state_ms[state.index()];
+        let ms = st.time_in_state_ms(state);
         assert_eq!(u(&format!("time_{name}")), (ms / 1000) as u32, "{name}");
-        let energy = st.energy[state.index()].sum.to_bits();
+        let energy = (st.energy_j(state) as f32).to_bits();
         assert_eq!(f(&format!("energy_{name}")), energy, "{name}");
     }
-    assert!(st.time_in_state_ms[RiskState::GrossSlip.index()] > 0);
-    assert_eq!(f("max_slip_ratio"), st.max_slip_ratio.to_bits());
-    assert_eq!(f("max_axial_force"), st.max_axial_force.to_bits());
-    assert_eq!(f("min_margin"), opt(st.min_margin));
+    assert!(st.time_in_state_ms(RiskState::GrossSlip) > 0);
+    assert_eq!(f("max_slip_ratio"), st.max_slip_ratio().to_bits());
+    assert_eq!(f("max_axial_force"), st.max_axial_force().to_bits());
+    assert_eq!(f("min_margin"), opt(st.min_margin()));
     assert_eq!(u("elapsed"), (m.elapsed_ms() / 1000) as u32);
     assert_eq!(u("last_sample_time"), 899_000);
     // Reading the registers from the middle of a 32-bit value gives its low word.
-    let samples = st.samples as u16;
+    let samples = st.samples() as u16;
     assert_eq!(read(&mut s, 4, input("samples") + 1, 1), vec![samples]);
 }

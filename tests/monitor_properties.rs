@@ -165,17 +165,23 @@ fn check<E: Estimator>(core: E, config: Config, samples: &[Sample]) -> Result<()
         prop_assert_eq!(changed, before != after, "every change has its event");
     }
     let st = m.statistics();
-    prop_assert_eq!(st.events_dropped, 0);
+    prop_assert_eq!(st.events_dropped(), 0);
     prop_assert!(
-        no_nan(st.max_slip_ratio) && no_nan(st.max_axial_force) && st.min_margin.is_none_or(no_nan)
+        no_nan(st.max_slip_ratio())
+            && no_nan(st.max_axial_force())
+            && st.min_margin().is_none_or(no_nan)
     );
     prop_assert!(
-        st.energy
+        RiskState::ALL
             .iter()
-            .all(|e| e.total().is_finite() && e.total() >= 0.0)
+            .all(|&state| st.energy_j(state).is_finite() && st.energy_j(state) >= 0.0)
     );
     prop_assert!(m.time_to_critical().is_none_or(|t| t >= 0.0));
-    prop_assert_eq!(st.time_in_state_ms.iter().sum::<u64>(), m.elapsed_ms());
+    let time: u64 = RiskState::ALL
+        .iter()
+        .map(|&state| st.time_in_state_ms(state))
+        .sum();
+    prop_assert_eq!(time, m.elapsed_ms());
     Ok(())
 }
 
@@ -229,7 +235,8 @@ proptest! {
             }
         }
         let pending = m.pending_events() as u64;
-        let emitted = m.snapshot().status.next_seq as u64;
-        prop_assert_eq!(delivered + pending + u64::from(m.statistics().events_dropped), emitted);
+        let emitted = u64::from(m.next_event_seq());
+        prop_assert_eq!(m.snapshot().next_event_seq(), m.next_event_seq());
+        prop_assert_eq!(delivered + pending + u64::from(m.statistics().events_dropped()), emitted);
     }
 }

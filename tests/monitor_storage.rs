@@ -68,9 +68,9 @@ fn a_restored_state_goes_on_identically() {
     let (mut original, rest) = mid_scenario();
     let state = original.snapshot();
     // The state is a real one: every part is in use.
-    assert!(state.status.friction.baseline_captured);
-    assert!(state.trend.len > 0 && state.events.len > 0);
-    assert!(state.status.stats.faults.total() > 0);
+    assert!(state.friction_status().baseline().is_some());
+    assert!(!state.trend_points().is_empty() && !state.events().is_empty());
+    assert!(state.statistics().faults().total() > 0);
     let mut record = vec![0u8; codec::record_len(MonitorState::SIZE)];
     let n = codec::encode(&state, 41, &mut record).unwrap();
     let decoded = codec::decode::<MonitorState>(&record[..n]).unwrap();
@@ -86,7 +86,7 @@ fn a_restored_state_goes_on_identically() {
         assert_eq!(original.pop_event(), restored.pop_event());
     }
     assert_eq!(original.snapshot(), restored.snapshot());
-    assert_eq!(original.statistics().samples, 8 * 3600 - 180);
+    assert_eq!(original.statistics().samples(), 8 * 3600 - 180);
 }
 
 /// A version-1 record of a monitor's state, written once by the version-1 encoder
@@ -128,22 +128,25 @@ fn newer_firmware_reads_the_version_1_record() {
     let decoded = codec::decode::<MonitorState>(&record).unwrap();
     assert_eq!((decoded.sequence, decoded.version), (7, 1));
     let s = decoded.value;
-    assert_eq!(s.status.clock.elapsed_ms, 341_000);
-    assert_eq!(s.status.clock.last_time_ms, Some(342_000));
-    assert_eq!(s.status.alarm.state, RiskState::Normal);
-    assert_eq!(s.status.stats.samples, 342);
+    assert_eq!(s.elapsed_ms(), 341_000);
+    assert_eq!(s.last_time_ms(), Some(342_000));
+    assert_eq!(s.state(), RiskState::Normal);
+    assert_eq!(s.statistics().samples(), 342);
     assert_eq!(
-        (s.status.stats.faults.driver, s.status.stats.faults.sensor),
+        (
+            s.statistics().faults().driver,
+            s.statistics().faults().sensor
+        ),
         (1, 1)
     );
-    let f = s.status.friction;
-    assert!(f.baseline_captured && f.changed);
-    assert_eq!((f.accepted, f.rejected), (340, 0));
-    assert_eq!((f.baseline, f.mu), (0.30003038, 0.20358427));
-    let kinds: Vec<EventKind> = s.events.items[..usize::from(s.events.len)]
-        .iter()
-        .map(|e| e.kind)
-        .collect();
+    let f = s.friction_status();
+    assert!(f.changed());
+    assert_eq!((f.accepted(), f.rejected()), (340, 0));
+    assert_eq!(
+        (f.baseline(), f.filtered()),
+        (Some(0.30003038), Some(0.20358427))
+    );
+    let kinds: Vec<EventKind> = s.events().iter().map(|e| e.kind).collect();
     let change = |from, to, fault| EventKind::StateChange { from, to, fault };
     let probe2 = SensorFault {
         sensor: SensorId::Probe2,
@@ -356,7 +359,7 @@ fn state_configuration_and_calibration_through_the_mock_flash() {
     // one that never stopped.
     assert_eq!(m.snapshot(), last);
     let mut again = Monitor::restore(core(0.3), config, &last).unwrap();
-    let next = last.status.clock.last_time_ms.unwrap().wrapping_add(1000);
+    let next = last.last_time_ms().unwrap().wrapping_add(1000);
     let sample = Sample::new(next, 2000.0, 2e-4).with_speed(2.0);
     assert_eq!(again.process(sample), m.process(sample));
     assert_eq!(again.snapshot(), m.snapshot());

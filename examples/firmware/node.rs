@@ -2,23 +2,20 @@
 //! scenario (`misalign::monitor::scenario`: one 8 h shift of a press roller pair, one
 //! sample a second), every event logged as it is drained, a summary at the end.
 //!
-//! The estimator is built exactly as the PC example (`examples/monitor`) builds it, so
-//! that the node's events are the host replay's: the demo scene of the scenario, one
-//! contact model for the scenario's operating range (`model_for_range` from the highest
-//! load of the samples and `scenario::ANGLE_MIN`), the f32 core `Auto` where there is
-//! an FPU, else the fixed-point `FixedAuto` with 10 mN a count and the finest angle LSB
-//! the tables allow, at least 0.1 nrad. `cargo xtask firmware` parses the `event` and
+//! The estimator is the scenario's (`misalign::monitor::scenario::estimator`), as the PC
+//! example (`examples/monitor`) and the host replay build it, so that the node's events
+//! are the host replay's: the f32 core `Auto` where there is an FPU, else the
+//! fixed-point `FixedAuto`. `cargo xtask firmware` parses the `event` and
 //! `summary` lines below and compares them with the host's replay.
 //!
 //! With the feature `sim-sensors` the samples come through simulated sensors (`sensors.rs`)
 //! instead of straight from the scenario.
 
-use misalign::fixed::{FixedAuto, FixedEllipticScene};
+use misalign::fixed::FixedAuto;
 use misalign::float::Auto;
 use misalign::monitor::scenario::{self, Scenario};
-use misalign::monitor::{Config, Event, EventKind, Monitor, RiskState, model_for_range};
-use misalign::reference::ModelChoice;
-use misalign::{Error, Estimator, Scene};
+use misalign::monitor::{Config, Event, EventKind, Monitor, RiskState};
+use misalign::{Error, Estimator};
 
 /// What the node measured.
 pub struct Measured {
@@ -30,32 +27,14 @@ pub struct Measured {
     pub instructions_max: u32,
 }
 
-/// The scenario's scene and the model for its operating range (as the PC example).
-fn scene_and_model() -> Result<(Scene, ModelChoice), Error> {
-    let [r1, r2, g, nu, mu] = scenario::SCENE;
-    let scene = Scene::new(r1, r2, g, nu, mu)?;
-    let load_max = Scenario::new()
-        .map(|s| f64::from(s.load))
-        .filter(|l| l.is_finite())
-        .fold(scenario::LOAD_MAX, f64::max);
-    let choice = model_for_range(&scene, load_max, scenario::ANGLE_MIN)?;
-    Ok((scene, choice))
-}
-
 /// The f32 core, as `examples/monitor --model f32`.
 pub fn f32_core() -> Result<Auto, Error> {
-    let (scene, choice) = scene_and_model()?;
-    Auto::with_choice(&scene, choice)
+    scenario::estimator()
 }
 
 /// The fixed-point core, as `examples/monitor --model fixed`.
 pub fn fixed_core() -> Result<FixedAuto, Error> {
-    let (scene, choice) = scene_and_model()?;
-    let angle_lsb = match choice {
-        ModelChoice::Elliptic => FixedEllipticScene::min_angle_lsb(&scene).max(1e-10),
-        _ => 1e-10,
-    };
-    FixedAuto::with_choice(&scene, 1e-2, angle_lsb, choice)
+    scenario::estimator()
 }
 
 /// An instruction counter (the harness's SysTick counter in the QEMU images): what a
@@ -163,14 +142,14 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
     let s = m.statistics();
     defmt::println!(
         "summary samples={=u64} repeated={=u32} spikes={=u32} faults={=u64} dropped={=u32} max_s={=f32} max_F={=f32} min_margin={} final={=str} ttc={}",
-        s.samples,
-        s.repeated_timestamps,
-        s.spikes,
-        s.faults.total(),
-        s.events_dropped,
-        s.max_slip_ratio,
-        s.max_axial_force,
-        s.min_margin,
+        s.samples(),
+        s.repeated_timestamps(),
+        s.spikes(),
+        s.faults().total(),
+        s.events_dropped(),
+        s.max_slip_ratio(),
+        s.max_axial_force(),
+        s.min_margin(),
         m.state().as_str(),
         m.time_to_critical()
     );
@@ -178,8 +157,8 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         defmt::println!(
             "summary state={=str} time_ms={=u64} energy_j={=f64}",
             state.as_str(),
-            s.time_in_state_ms[state.index()],
-            s.energy[state.index()].total()
+            s.time_in_state_ms(state),
+            s.energy_j(state)
         );
     }
 }

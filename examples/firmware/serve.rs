@@ -74,7 +74,7 @@ pub fn node<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32>(
         } else {
             "the built-in scenario"
         },
-        server.monitor().statistics().samples
+        server.monitor().statistics().samples()
     );
     // When the last byte came, and whether a frame may be waiting for the silence that
     // ends it (garbage, a truncated frame, a function the server does not know: the

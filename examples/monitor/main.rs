@@ -12,13 +12,12 @@ use misalign_cli::monitor_events as events;
 use misalign_cli::monitor_input as input;
 
 use clap::{Parser, ValueEnum};
-use misalign::fixed::{FixedAuto, FixedEllipticScene};
+use misalign::Estimator;
+use misalign::fixed::FixedAuto;
 use misalign::float::Auto;
 use misalign::monitor::{
-    Config, Event, EventKind, Monitor, RiskState, Sample, Thresholds, model_for_range, scenario,
+    Config, Event, EventKind, Monitor, RiskState, Sample, Thresholds, scenario,
 };
-use misalign::reference::ModelChoice;
-use misalign::{Estimator, Scene};
 use std::error::Error;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -194,7 +193,10 @@ fn hms(ms: u64) -> String {
 
 fn summary<E: Estimator>(m: &Monitor<E>) {
     let s = m.statistics();
-    let total_ms: u64 = s.time_in_state_ms.iter().sum();
+    let total_ms: u64 = RiskState::ALL
+        .iter()
+        .map(|&st| s.time_in_state_ms(st))
+        .sum();
     say!(
         "\n{:<14} {:>10} {:>7} {:>14}",
         "state",
@@ -203,13 +205,13 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         "energy (J)"
     );
     for state in RiskState::ALL {
-        let ms = s.time_in_state_ms[state.index()];
+        let ms = s.time_in_state_ms(state);
         say!(
             "{:<14} {:>10} {:>6.1}% {:>14.3}",
             state.as_str(),
             hms(ms),
             100.0 * ms as f64 / total_ms.max(1) as f64,
-            s.energy[state.index()].total()
+            s.energy_j(state)
         );
     }
     say!(
@@ -219,13 +221,13 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
         "",
         s.total_energy()
     );
-    let f = &s.faults;
+    let f = s.faults();
     say!(
         "\nsamples {}  repeated timestamps {}  spikes rejected {}  events dropped {}",
-        s.samples,
-        s.repeated_timestamps,
-        s.spikes,
-        s.events_dropped
+        s.samples(),
+        s.repeated_timestamps(),
+        s.spikes(),
+        s.events_dropped()
     );
     say!(
         "faults {}: non-finite {}, out of range {}, stuck {}, gap {}, time backwards {}, driver {}, estimator {}, sensors {}",
@@ -241,9 +243,9 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
     );
     say!(
         "max d/b {:.3}  max |F| {:.1} N  min margin {}",
-        s.max_slip_ratio,
-        s.max_axial_force,
-        s.min_margin
+        s.max_slip_ratio(),
+        s.max_axial_force(),
+        s.min_margin()
             .map_or("-".into(), |m| format!("{:.3} mrad", m * 1e3))
     );
     // Only with a measured F on the f32 core.
@@ -253,9 +255,9 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
             "friction mu {mu:.4}  baseline {}  {} estimates used, {} ill-posed{}",
             m.friction_baseline()
                 .map_or("- (not captured yet)".into(), |b| format!("{b:.4}")),
-            fs.accepted,
-            fs.rejected,
-            if fs.changed { "  CHANGED" } else { "" }
+            fs.accepted(),
+            fs.rejected(),
+            if fs.changed() { "  CHANGED" } else { "" }
         );
     }
     say!(
@@ -416,10 +418,7 @@ fn main() -> std::process::ExitCode {
     let result = (|| -> Res<()> {
         let scene = match &args.scene {
             Some(path) => input::read_scene(std::fs::File::open(path)?)?,
-            None => {
-                let [r1, r2, g, nu, mu] = scenario::SCENE;
-                Scene::new(r1, r2, g, nu, mu)?
-            }
+            None => scenario::scene()?,
         };
         let (samples, builtin) = match &args.trace {
             Some(path) => (input::read_trace(std::fs::File::open(path)?)?, false),
@@ -430,25 +429,23 @@ fn main() -> std::process::ExitCode {
             .map(|s| f64::from(s.load))
             .filter(|l| l.is_finite())
             .fold(scenario::LOAD_MAX, f64::max);
-        // One model for the trace's operating range (section 9, decided once).
-        let choice = model_for_range(&scene, load_max, scenario::ANGLE_MIN)?;
+        // One model for the trace's operating range (section 9, decided once), as the
+        // node builds it for the built-in scenario.
         match args.model {
             Model::F32 => run(
-                Auto::with_choice(&scene, choice)?,
+                scenario::estimator_for::<Auto>(&scene, load_max)?,
                 Monitor::process_with_friction,
                 &args,
                 samples,
                 builtin,
             ),
-            Model::Fixed => {
-                // 10 mN per count; the finest angle LSB the tables allow, at least 0.1 nrad.
-                let angle_lsb = match choice {
-                    ModelChoice::Elliptic => FixedEllipticScene::min_angle_lsb(&scene).max(1e-10),
-                    _ => 1e-10,
-                };
-                let core = FixedAuto::with_choice(&scene, 1e-2, angle_lsb, choice)?;
-                run(core, Monitor::process, &args, samples, builtin)
-            }
+            Model::Fixed => run(
+                scenario::estimator_for::<FixedAuto>(&scene, load_max)?,
+                Monitor::process,
+                &args,
+                samples,
+                builtin,
+            ),
         }
     })();
     match result {

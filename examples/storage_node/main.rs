@@ -246,7 +246,7 @@ mod node {
 
     /// Samples a monitor has processed (each of the scenario's is processed once).
     fn done<E: Estimator>(m: &Monitor<E>) -> usize {
-        m.statistics().samples as usize
+        m.statistics().samples() as usize
     }
 
     /// Feeds samples to `m` until it has processed `until`, checkpointing at the

@@ -759,21 +759,20 @@ fn summary<'py, E: Estimator>(py: Python<'py>, m: &Monitor<E>) -> PyResult<Bound
     let s = m.statistics();
     let d = PyDict::new(py);
     let states: Vec<&str> = RiskState::ALL.iter().map(|r| r.as_str()).collect();
-    let time_s: Vec<f64> = s
-        .time_in_state_ms
+    let time_s: Vec<f64> = RiskState::ALL
         .iter()
-        .map(|&ms| ms as f64 / 1e3)
+        .map(|&r| s.time_in_state_ms(r) as f64 / 1e3)
         .collect();
-    let energy: Vec<f64> = s.energy.iter().map(|e| e.total()).collect();
+    let energy: Vec<f64> = RiskState::ALL.iter().map(|&r| s.energy_j(r)).collect();
     d.set_item("states", states)?;
     d.set_item("time_s", time_s)?;
     d.set_item("energy_J", energy)?;
     d.set_item("total_energy_J", s.total_energy())?;
-    d.set_item("samples", s.samples)?;
-    d.set_item("repeated_timestamps", s.repeated_timestamps)?;
-    d.set_item("spikes", s.spikes)?;
-    d.set_item("events_dropped", s.events_dropped)?;
-    let f = &s.faults;
+    d.set_item("samples", s.samples())?;
+    d.set_item("repeated_timestamps", s.repeated_timestamps())?;
+    d.set_item("spikes", s.spikes())?;
+    d.set_item("events_dropped", s.events_dropped())?;
+    let f = s.faults();
     let faults = PyDict::new(py);
     for (name, n) in [
         ("non_finite", f.non_finite),
@@ -788,9 +787,9 @@ fn summary<'py, E: Estimator>(py: Python<'py>, m: &Monitor<E>) -> PyResult<Bound
         faults.set_item(name, n)?;
     }
     d.set_item("faults", faults)?;
-    d.set_item("max_slip_ratio", s.max_slip_ratio)?;
-    d.set_item("max_axial_force_N", s.max_axial_force)?;
-    d.set_item("min_margin_rad", s.min_margin)?;
+    d.set_item("max_slip_ratio", s.max_slip_ratio())?;
+    d.set_item("max_axial_force_N", s.max_axial_force())?;
+    d.set_item("min_margin_rad", s.min_margin())?;
     d.set_item("friction", m.friction())?;
     d.set_item("friction_baseline", m.friction_baseline())?;
     d.set_item("final_state", m.state().as_str())?;

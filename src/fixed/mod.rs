@@ -300,6 +300,7 @@ impl Units {
 
     /// A fixed-point answer in SI f32 (a margin saturated at the i32 range of counts
     /// stays saturated: choose the angle LSB so that the margins of interest fit).
+    #[inline]
     pub(crate) fn estimate(&self, e: &FixedEstimate) -> crate::Estimate {
         let force = e.axial_force.to_f32();
         crate::Estimate {

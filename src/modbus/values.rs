@@ -305,7 +305,7 @@ impl<E: Estimator> Core<E> {
         let r = || m.reading();
         let a = &self.annunciator;
         let bit = |set: AlarmSet, which: AlarmSet| u32::from(set.contains(which));
-        let per_state = |i: u8| usize::from(i);
+        let per_state = |i: u8| RiskState::ALL.get(usize::from(i)).copied();
         match field {
             Field::Acknowledge | Field::AcknowledgeAlarms | Field::Sample(_) => 0,
             Field::Latching(w) => bit(a.latching(), w),
@@ -330,13 +330,13 @@ impl<E: Estimator> Core<E> {
             Field::Misalignment => opt(r().map(|r| r.phi)),
             Field::TimeToCritical => opt(m.time_to_critical()),
             Field::Friction => opt(m.friction()),
-            Field::Samples => s.samples as u32,
-            Field::RepeatedTimestamps => s.repeated_timestamps,
-            Field::Spikes => s.spikes,
-            Field::EventsDropped => s.events_dropped.saturating_add(self.events.dropped),
+            Field::Samples => s.samples() as u32,
+            Field::RepeatedTimestamps => s.repeated_timestamps(),
+            Field::Spikes => s.spikes(),
+            Field::EventsDropped => s.events_dropped().saturating_add(self.events.dropped),
             Field::EventSeqNext => m.next_event_seq(),
             Field::Faults(i) => {
-                let f = &s.faults;
+                let f = s.faults();
                 [
                     f.non_finite,
                     f.out_of_range,
@@ -351,15 +351,16 @@ impl<E: Estimator> Core<E> {
                 .copied()
                 .unwrap_or(0)
             }
-            Field::TimeInState(i) => s
-                .time_in_state_ms
-                .get(per_state(i))
-                .map_or(0, |&ms| u32::try_from(ms / 1000).unwrap_or(u32::MAX)),
-            // The compensated sum rounded to f32 is its running sum.
-            Field::Energy(i) => s.energy.get(per_state(i)).map_or(0, |e| e.sum.to_bits()),
-            Field::MaxSlipRatio => s.max_slip_ratio.to_bits(),
-            Field::MaxAxialForce => s.max_axial_force.to_bits(),
-            Field::MinMargin => opt(s.min_margin),
+            Field::TimeInState(i) => per_state(i).map_or(0, |state| {
+                u32::try_from(s.time_in_state_ms(state) / 1000).unwrap_or(u32::MAX)
+            }),
+            // The compensated sum (f64) rounded to f32.
+            Field::Energy(i) => {
+                per_state(i).map_or(0, |state| (s.energy_j(state) as f32).to_bits())
+            }
+            Field::MaxSlipRatio => s.max_slip_ratio().to_bits(),
+            Field::MaxAxialForce => s.max_axial_force().to_bits(),
+            Field::MinMargin => opt(s.min_margin()),
             Field::Elapsed => u32::try_from(m.elapsed_ms() / 1000).unwrap_or(u32::MAX),
             Field::LastSampleTime => self.last_time_ms,
             Field::ExternalAccepted => self.counters.external_accepted,

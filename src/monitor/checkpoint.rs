@@ -10,12 +10,17 @@
 //! configuration that fails [`Config::validate`]. So a restored state is one the
 //! monitor could have reached, never a wrong value.
 
+use super::checks::{Checks, StuckTracker};
+use super::clock::Clock;
 use super::config::{SPIKE_WINDOW_CAPACITY, TREND_CAPACITY};
+use super::energy::{Energy, EnergySum};
 use super::events::EVENT_CAPACITY;
+use super::risk::Alarm;
+use super::state::Saved;
+use super::trend::TrendInterval;
 use super::{
-    Alarm, Channel, Clock, Config, EnergySum, Event, EventKind, FaultCause, FaultCounts,
-    FrictionConfig, FrictionStatus, MonitorState, Reading, RiskState, Saved, SpikeFilter,
-    Statistics, Status, StuckTracker, Thresholds, TrendConfig, TrendInterval, TrendPoint,
+    Channel, Config, Event, EventKind, FaultCause, FaultCounts, FrictionConfig, FrictionStatus,
+    MonitorState, Reading, RiskState, SpikeFilter, Statistics, Thresholds, TrendConfig, TrendPoint,
 };
 use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 use crate::storage::{Checkpoint, CodecError, Reader, Writer, kind};
@@ -301,7 +306,8 @@ const STATUS_SIZE: usize = CLOCK_SIZE
     + STATS_SIZE
     + FRICTION_SIZE;
 
-fn put_status(w: &mut Writer<'_>, s: &Status) -> Result<(), CodecError> {
+/// The stages' states but the buffers, in the record's order (version 1).
+fn put_status(w: &mut Writer<'_>, s: &MonitorState) -> Result<(), CodecError> {
     put_option(w, s.clock.last_time_ms, 0, |w, t| w.u32(t))?;
     w.u64(s.clock.elapsed_ms)?;
     let a = &s.alarm;
@@ -313,7 +319,7 @@ fn put_status(w: &mut Writer<'_>, s: &Status) -> Result<(), CodecError> {
     })?;
     put_opt_u64(w, a.started_ms)?;
     put_option(w, s.smoothed, [0.0; 2], |w, x| w.each(&x, |w, v| w.f32(*v)))?;
-    w.each(&s.stuck, |w, t| {
+    w.each(&s.checks.stuck, |w, t| {
         w.u32(t.bits)?;
         w.u64(t.since_ms)
     })?;
@@ -325,7 +331,7 @@ fn put_status(w: &mut Writer<'_>, s: &Status) -> Result<(), CodecError> {
     w.bool(s.approaching_armed)?;
     w.u32(s.next_seq)?;
     put_option(w, s.reading, Reading::default(), |w, r| put_reading(w, &r))?;
-    w.f32(s.energy_step)?;
+    w.f32(s.energy.step_j)?;
     put_stats(w, &s.stats)?;
     let f = &s.friction;
     w.f32(f.mu)?;
@@ -337,7 +343,8 @@ fn put_status(w: &mut Writer<'_>, s: &Status) -> Result<(), CodecError> {
     w.bool(f.changed)
 }
 
-fn get_status(r: &mut Reader<'_>) -> Result<Status, CodecError> {
+/// Reads what [`put_status`] wrote into `s`.
+fn get_status(r: &mut Reader<'_>, s: &mut MonitorState) -> Result<(), CodecError> {
     let clock = Clock {
         last_time_ms: get_option::<_, 4>(r, |r| r.u32())?,
         elapsed_ms: r.u64()?,
@@ -379,20 +386,21 @@ fn get_status(r: &mut Reader<'_>) -> Result<Status, CodecError> {
     if friction.baseline_captured && friction.baseline <= 0.0 {
         return Err(INVALID);
     }
-    Ok(Status {
-        clock,
-        alarm,
-        smoothed,
-        stuck,
-        trend_interval,
-        time_to_critical_s,
-        approaching_armed,
-        next_seq,
-        reading,
-        energy_step,
-        stats,
-        friction,
-    })
+    s.clock = clock;
+    s.alarm = alarm;
+    s.smoothed = smoothed;
+    s.checks = Checks { stuck };
+    s.trend_interval = trend_interval;
+    s.time_to_critical_s = time_to_critical_s;
+    s.approaching_armed = approaching_armed;
+    s.next_seq = next_seq;
+    s.reading = reading;
+    s.energy = Energy {
+        step_j: energy_step,
+    };
+    s.stats = stats;
+    s.friction = friction;
+    Ok(())
 }
 
 fn put_stats(w: &mut Writer<'_>, s: &Statistics) -> Result<(), CodecError> {
@@ -476,7 +484,7 @@ impl Checkpoint for MonitorState {
         + (EVENT_CAPACITY * EVENT_SIZE + 1);
 
     fn encode(&self, w: &mut Writer<'_>) -> Result<(), CodecError> {
-        put_status(w, &self.status)?;
+        put_status(w, self)?;
         put_saved(w, &self.load_window, |w, x| w.f32(*x))?;
         put_saved(w, &self.angle_window, |w, x| w.f32(*x))?;
         put_saved(w, &self.trend, |w, p| {
@@ -494,7 +502,7 @@ impl Checkpoint for MonitorState {
 
     /// Field by field into `self`: a restore holds one state, not three.
     fn decode_into(&mut self, r: &mut Reader<'_>) -> Result<(), CodecError> {
-        self.status = get_status(r)?;
+        get_status(r, self)?;
         get_saved(r, &mut self.load_window, finite)?;
         get_saved(r, &mut self.angle_window, finite)?;
         get_saved(r, &mut self.trend, |r| {

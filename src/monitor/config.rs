@@ -1,6 +1,6 @@
-//! The monitor's configuration: one value, validated when the monitor is built.
+//! The monitor's configuration: one value, validated when the monitor is built. Every
+//! stage reads it; it imports nothing from the monitor.
 
-use super::friction::FrictionConfig;
 use core::fmt;
 
 /// Capacity of the spike filter's window (samples).
@@ -116,6 +116,66 @@ pub struct Config {
     /// [`Monitor::process_with_friction`](super::Monitor::process_with_friction));
     /// `None`: off.
     pub friction: Option<FrictionConfig>,
+}
+
+/// How mu is tracked: which answers count, the filter, the baseline and the band.
+/// Times in ms or s as named; mu is dimensionless.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FrictionConfig {
+    /// An exact mu counts only when its sensitivity `d ln mu / d ln F` is at most this
+    /// (> 0): near the no-slip limit a small error in F is a large one in mu. (Lower
+    /// bounds, where F saturates in gross slip, and inconsistent answers never count.)
+    pub sensitivity_max: f32,
+    /// Time constant (s, > 0) of the exponential filter of mu, whose weight
+    /// `1 - exp(-dt / tau)` follows the time step of the sample, like the smoothing of
+    /// load and angle.
+    pub tau_s: f32,
+    /// The baseline is captured once the machine has run this long (ms, from its start,
+    /// as the start-up inhibit) ...
+    pub baseline_after_ms: u32,
+    /// ... and at least this many estimates were accepted (>= 1).
+    pub baseline_after_estimates: u32,
+    /// The relative band around the baseline (> 0): a change is raised when
+    /// `|mu / baseline - 1| > band`.
+    pub band: f32,
+    /// The change clears when `|mu / baseline - 1| < band - deadband` (0 <= deadband <
+    /// band).
+    pub deadband: f32,
+    /// Raising and clearing wait until the filtered mu has stayed on the other side for
+    /// this long (ms), counted over the accepted samples' time steps.
+    pub delay_ms: u32,
+}
+
+impl Default for FrictionConfig {
+    /// For the demo scene sampled about once a second: exact answers with a
+    /// sensitivity up to 10, a 60 s filter, the baseline after 10 minutes of running
+    /// and 100 accepted estimates, a band of 20 % with 5 % deadband, 60 s delay.
+    fn default() -> Self {
+        FrictionConfig {
+            sensitivity_max: 10.0,
+            tau_s: 60.0,
+            baseline_after_ms: 600_000,
+            baseline_after_estimates: 100,
+            band: 0.2,
+            deadband: 0.05,
+            delay_ms: 60_000,
+        }
+    }
+}
+
+impl FrictionConfig {
+    /// Whether the values are consistent (see the fields).
+    pub(crate) fn is_valid(&self) -> bool {
+        let positive = |x: f32| x.is_finite() && x > 0.0;
+        positive(self.sensitivity_max)
+            && positive(self.tau_s)
+            && self.baseline_after_estimates >= 1
+            && positive(self.band)
+            && self.deadband.is_finite()
+            && self.deadband >= 0.0
+            && self.deadband < self.band
+    }
 }
 
 impl Default for Config {

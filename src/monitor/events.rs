@@ -1,6 +1,10 @@
-//! Events: every state change and every `Approaching` warning, numbered, in a
-//! fixed-capacity queue that drops the oldest when full and counts what it dropped.
+//! The events stage: every state change, `Approaching` warning and friction change,
+//! numbered, in a fixed-capacity queue that drops the oldest when full and counts what
+//! it dropped. Its state: the queue, the next sequence number, whether the
+//! `Approaching` warning is armed.
 
+use super::config::TrendConfig;
+use super::order::ge;
 use super::risk::RiskState;
 use crate::sensor_fault::SensorFault;
 use core::fmt;
@@ -124,13 +128,88 @@ pub struct Event {
 /// holds now; the sequence gap and the counter say what was lost).
 pub(crate) type EventQueue = Deque<Event, EVENT_CAPACITY>;
 
-/// Appends `event`, dropping the oldest when full; returns whether one was dropped.
-pub(crate) fn push(queue: &mut EventQueue, event: Event) -> bool {
-    let dropped = queue.is_full();
-    if dropped {
-        queue.pop_front();
+/// The stage's state.
+#[derive(Debug, Clone)]
+pub(crate) struct Events {
+    /// Undelivered events, oldest first.
+    pub(crate) queue: EventQueue,
+    /// The next event's sequence number.
+    pub(crate) next_seq: u32,
+    /// Whether the next fall of the time to critical below the horizon raises an
+    /// `Approaching` event.
+    pub(crate) approaching_armed: bool,
+}
+
+impl Events {
+    pub(crate) const fn new() -> Self {
+        Events {
+            queue: EventQueue::new(),
+            next_seq: 0,
+            approaching_armed: true,
+        }
     }
-    // Not full after the pop above.
-    let _ = queue.push_back(event);
-    dropped
+
+    /// Whether the `Approaching` warning is due, at the time to critical
+    /// `time_to_critical_s` (s) of the trend `trend` with the state `state` reported:
+    /// once when it falls below the horizon while the contact still sticks; re-armed
+    /// above 1.5 horizons. Returns the time to critical to report.
+    #[inline(always)]
+    pub(crate) fn approaching(
+        &mut self,
+        trend: Option<TrendConfig>,
+        time_to_critical_s: Option<f32>,
+        state: RiskState,
+    ) -> Option<f32> {
+        if time_to_critical_s.is_none() && self.approaching_armed {
+            return None;
+        }
+        self.approaching_check(trend?, time_to_critical_s, state)
+    }
+
+    fn approaching_check(
+        &mut self,
+        tc: TrendConfig,
+        time_to_critical_s: Option<f32>,
+        state: RiskState,
+    ) -> Option<f32> {
+        match time_to_critical_s {
+            Some(t) if !ge(t, tc.horizon_s) => {
+                let live = matches!(state, RiskState::Normal | RiskState::Microslip);
+                if self.approaching_armed && live {
+                    self.approaching_armed = false;
+                    return Some(t);
+                }
+            }
+            Some(t) if !ge(t, 1.5 * tc.horizon_s) => {}
+            _ => self.approaching_armed = true,
+        }
+        None
+    }
+
+    /// Appends the event `kind` of the sample stamped `time_ms` at monotonic time
+    /// `elapsed_ms`, with the latest reading; full, the queue drops its oldest.
+    /// Returns whether it dropped one.
+    pub(crate) fn emit(
+        &mut self,
+        kind: EventKind,
+        time_ms: u32,
+        elapsed_ms: u64,
+        reading: Option<Reading>,
+    ) -> bool {
+        let event = Event {
+            seq: self.next_seq,
+            time_ms,
+            elapsed_ms,
+            kind,
+            reading: reading.unwrap_or_default(),
+        };
+        self.next_seq = self.next_seq.wrapping_add(1);
+        let dropped = self.queue.is_full();
+        if dropped {
+            self.queue.pop_front();
+        }
+        // Not full after the pop above.
+        let _ = self.queue.push_back(event);
+        dropped
+    }
 }

@@ -2,92 +2,33 @@
 //! coefficient mu per sample from the inverse of eqs (16, 21) (ellipse) or (23, 27)
 //! (line contact), used only where it is well-posed, filtered over time, compared with
 //! a baseline captured at commissioning. A falling or rising mu is a lubrication or
-//! contamination warning.
+//! contamination warning. The stage's state: [`FrictionStatus`].
 
-use super::condition::smoothing_weight;
+use super::conditioning::smoothing_weight;
+use super::config::FrictionConfig;
 use crate::reference::inverse::Inverse;
 
-/// How mu is tracked: which answers count, the filter, the baseline and the band.
-/// Times in ms or s as named; mu is dimensionless.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct FrictionConfig {
-    /// An exact mu counts only when its sensitivity `d ln mu / d ln F` is at most this
-    /// (> 0): near the no-slip limit a small error in F is a large one in mu. (Lower
-    /// bounds, where F saturates in gross slip, and inconsistent answers never count.)
-    pub sensitivity_max: f32,
-    /// Time constant (s, > 0) of the exponential filter of mu, whose weight
-    /// `1 - exp(-dt / tau)` follows the time step of the sample, like the smoothing of
-    /// load and angle.
-    pub tau_s: f32,
-    /// The baseline is captured once the machine has run this long (ms, from its start,
-    /// as the start-up inhibit) ...
-    pub baseline_after_ms: u32,
-    /// ... and at least this many estimates were accepted (>= 1).
-    pub baseline_after_estimates: u32,
-    /// The relative band around the baseline (> 0): a change is raised when
-    /// `|mu / baseline - 1| > band`.
-    pub band: f32,
-    /// The change clears when `|mu / baseline - 1| < band - deadband` (0 <= deadband <
-    /// band).
-    pub deadband: f32,
-    /// Raising and clearing wait until the filtered mu has stayed on the other side for
-    /// this long (ms), counted over the accepted samples' time steps.
-    pub delay_ms: u32,
-}
-
-impl Default for FrictionConfig {
-    /// For the demo scene sampled about once a second: exact answers with a
-    /// sensitivity up to 10, a 60 s filter, the baseline after 10 minutes of running
-    /// and 100 accepted estimates, a band of 20 % with 5 % deadband, 60 s delay.
-    fn default() -> Self {
-        FrictionConfig {
-            sensitivity_max: 10.0,
-            tau_s: 60.0,
-            baseline_after_ms: 600_000,
-            baseline_after_estimates: 100,
-            band: 0.2,
-            deadband: 0.05,
-            delay_ms: 60_000,
-        }
-    }
-}
-
-impl FrictionConfig {
-    /// Whether the values are consistent (see the fields).
-    pub(crate) fn is_valid(&self) -> bool {
-        let positive = |x: f32| x.is_finite() && x > 0.0;
-        positive(self.sensitivity_max)
-            && positive(self.tau_s)
-            && self.baseline_after_estimates >= 1
-            && positive(self.band)
-            && self.deadband.is_finite()
-            && self.deadband >= 0.0
-            && self.deadband < self.band
-    }
-}
-
-/// What the tracker holds: the filtered mu, the baseline, the change state.
+/// What the tracker holds: the filtered mu, the baseline, the change state
+/// ([`Monitor::friction_status`](super::Monitor::friction_status)).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FrictionStatus {
     /// The filtered mu; meaningful once `accepted > 0`.
-    pub mu: f32,
+    pub(crate) mu: f32,
     /// The baseline mu; meaningful once `baseline_captured` (a flag rather than an
     /// `Option`: the live monitor's RAM budget).
-    pub baseline: f32,
+    pub(crate) baseline: f32,
     /// Whether the baseline has been captured.
-    pub baseline_captured: bool,
+    pub(crate) baseline_captured: bool,
     /// Estimates accepted (well-posed) so far (saturating).
-    pub accepted: u32,
-    /// Samples with a measured F whose mu was not used: ill-posed (a lower bound,
-    /// inconsistent, too sensitive) or refused (saturating).
-    pub rejected: u32,
+    pub(crate) accepted: u32,
+    /// Samples with a measured F whose mu was not used (saturating).
+    pub(crate) rejected: u32,
     /// Time (ms) the filtered mu has been on the other side of the band than `changed`
     /// says, over accepted samples.
-    pub pending_ms: u32,
+    pub(crate) pending_ms: u32,
     /// Whether a friction change is raised.
-    pub changed: bool,
+    pub(crate) changed: bool,
 }
 
 impl FrictionStatus {
@@ -111,6 +52,23 @@ impl FrictionStatus {
     /// The baseline, `None` before it is captured.
     pub fn baseline(&self) -> Option<f32> {
         self.baseline_captured.then_some(self.baseline)
+    }
+
+    /// Estimates of mu accepted (well-posed) so far (saturating).
+    pub fn accepted(&self) -> u32 {
+        self.accepted
+    }
+
+    /// Samples with a measured F whose mu was not used: ill-posed (a lower bound,
+    /// inconsistent, too sensitive) or refused (saturating).
+    pub fn rejected(&self) -> u32 {
+        self.rejected
+    }
+
+    /// Whether a friction change is raised: the filtered mu left the band around the
+    /// baseline for the delay and has not come back within the band less the deadband.
+    pub fn changed(&self) -> bool {
+        self.changed
     }
 
     /// Offers one sample's inverse over a step of `dt_ms`; `running_ms` is how long the

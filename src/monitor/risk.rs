@@ -1,9 +1,10 @@
 //! Risk states with the alarm conventions of ISA-18.2 / IEC 62682: thresholds with a
 //! clearing deadband, on-delay, off-delay (minimum dwell), start-up inhibit; a sensor
-//! fault is a state of its own and never reported as slip.
+//! fault is a state of its own and never reported as slip. The stage's state: the
+//! state machine ([`Alarm`]).
 
-use super::condition::ge;
 use super::config::{Config, Thresholds};
+use super::order::ge;
 
 /// The roller pair's state as the monitor reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -130,18 +131,18 @@ pub(crate) fn slip_level(
 /// The state machine: the current state, since when, and the pending candidate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Alarm {
+pub(crate) struct Alarm {
     /// The reported state.
-    pub state: RiskState,
+    pub(crate) state: RiskState,
     /// Monotonic time (ms) the state was entered.
-    pub since_ms: u64,
+    pub(crate) since_ms: u64,
     /// A different candidate and the time (ms) it first appeared, on the same side
     /// (more or less severe) since.
-    pub pending: Option<(RiskState, u64)>,
+    pub(crate) pending: Option<(RiskState, u64)>,
     /// Monotonic time (ms) the machine last started (its first running sample since
     /// the monitor started or since the state was `Stopped`): the start-up inhibit runs
     /// from here.
-    pub started_ms: Option<u64>,
+    pub(crate) started_ms: Option<u64>,
 }
 
 impl Alarm {
@@ -167,6 +168,25 @@ impl Alarm {
             config.on_delay_ms
         } else {
             config.off_delay_ms
+        }
+    }
+
+    /// The level a valid running sample with d/b `slip_ratio` and margin `margin`
+    /// (rad) asks for at `now_ms`: its slip level from the reported state, `Normal`
+    /// during the start-up inhibit.
+    #[inline(always)]
+    pub(crate) fn level(
+        &self,
+        config: &Config,
+        levels: &Levels,
+        slip_ratio: f32,
+        margin: Option<f32>,
+        now_ms: u64,
+    ) -> RiskState {
+        if self.inhibited(config, now_ms) {
+            RiskState::Normal
+        } else {
+            slip_level(levels, slip_ratio, margin, self.state)
         }
     }
 

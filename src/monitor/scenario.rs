@@ -16,8 +16,17 @@
 //!
 //! Noise comes from a seeded xorshift generator and every value is computed in f32
 //! with `libm`, so that the samples are bit-identical on every target.
+//!
+//! [`estimator`] builds the scenario's estimator on either core, the one the PC
+//! example, the firmware node, the host replay that checks the node and the
+//! benchmarks all run: the same model and units everywhere, so that their events agree.
 
 use super::Sample;
+use super::model::model_for_range;
+use crate::fixed::{FixedAuto, FixedEllipticScene};
+use crate::float::Auto;
+use crate::reference::ModelChoice;
+use crate::{Error, Estimator, Scene};
 
 /// Shift length (s).
 pub const SHIFT_S: u32 = 8 * 3600;
@@ -27,7 +36,8 @@ pub const SAMPLE_PERIOD_MS: u32 = 1000;
 pub const START_TIME_MS: u32 = u32::MAX - 3_600_000 + 1;
 /// The demo scene: R1, R2 (m), G (Pa), nu, mu.
 pub const SCENE: [f64; 5] = [0.05, 0.05, 79.3e9, 0.3, 0.3];
-/// The highest load of the scenario (N), for [`model_for_range`](super::model_for_range).
+/// The load (N) up to which the scenario's model is chosen ([`model_for_range`]): the
+/// press cycle's; the spikes go above it, with the same model (a test checks it).
 pub const LOAD_MAX: f64 = 5e3;
 /// The smallest misalignment worth a model choice (rad).
 pub const ANGLE_MIN: f64 = 1e-5;
@@ -43,6 +53,72 @@ pub const STOP_S: (u32, u32) = (5 * 3600, 5 * 3600 + 1200);
 /// A single-sample spike at every second `s` with `s % SPIKE_EVERY_S ==
 /// SPIKE_EVERY_S - 1`, except while the machine stands.
 pub const SPIKE_EVERY_S: u32 = 1777;
+
+/// The fixed-point core's load LSB (N a count): 10 mN.
+pub const FIXED_LOAD_LSB: f64 = 1e-2;
+/// The smallest angle LSB (rad a count) the fixed-point core is given: 0.1 nrad.
+pub const FIXED_ANGLE_LSB_MIN: f64 = 1e-10;
+
+/// The scenario's scene ([`SCENE`]).
+///
+/// # Errors
+/// None for [`SCENE`]; [`Scene::new`]'s errors were it changed to an invalid one.
+pub fn scene() -> Result<Scene, Error> {
+    let [r1, r2, g, nu, mu] = SCENE;
+    Scene::new(r1, r2, g, nu, mu)
+}
+
+/// A core the scenario's estimator is built on: [`Auto`] (f32) or [`FixedAuto`]
+/// (fixed point).
+pub trait Core: Estimator + Sized {
+    /// The core over `scene` with the contact model `choice`.
+    ///
+    /// # Errors
+    /// The core's errors for the scene.
+    fn with_model(scene: &Scene, choice: ModelChoice) -> Result<Self, Error>;
+}
+
+impl Core for Auto {
+    fn with_model(scene: &Scene, choice: ModelChoice) -> Result<Self, Error> {
+        Auto::with_choice(scene, choice)
+    }
+}
+
+impl Core for FixedAuto {
+    /// [`FIXED_LOAD_LSB`] a count; the finest angle LSB the elliptic tables allow for
+    /// the scene, at least [`FIXED_ANGLE_LSB_MIN`] ([`FIXED_ANGLE_LSB_MIN`] for line
+    /// contact).
+    fn with_model(scene: &Scene, choice: ModelChoice) -> Result<Self, Error> {
+        let angle_lsb = match choice {
+            ModelChoice::Elliptic => {
+                FixedEllipticScene::min_angle_lsb(scene).max(FIXED_ANGLE_LSB_MIN)
+            }
+            _ => FIXED_ANGLE_LSB_MIN,
+        };
+        FixedAuto::with_choice(scene, FIXED_LOAD_LSB, angle_lsb, choice)
+    }
+}
+
+/// The estimator on core `C` for `scene` sampled at loads up to `load_max` (N): one
+/// contact model for that range ([`model_for_range`] down to [`ANGLE_MIN`]), and the
+/// core's units ([`Core::with_model`]). The PC example calls it with a scene and a
+/// trace of its own.
+///
+/// # Errors
+/// [`model_for_range`]'s errors, the core's errors for the scene.
+pub fn estimator_for<C: Core>(scene: &Scene, load_max: f64) -> Result<C, Error> {
+    C::with_model(scene, model_for_range(scene, load_max, ANGLE_MIN)?)
+}
+
+/// The scenario's estimator on core `C`: [`estimator_for`] the scenario's scene up to
+/// [`LOAD_MAX`] (the same model as up to the highest load of the samples: a test
+/// checks it).
+///
+/// # Errors
+/// None for the scenario's scene; [`estimator_for`]'s were it changed.
+pub fn estimator<C: Core>() -> Result<C, Error> {
+    estimator_for(&scene()?, LOAD_MAX)
+}
 
 /// The scenario's samples, in order (an iterator of [`SHIFT_S`] minus the dropout's
 /// samples).
@@ -134,5 +210,26 @@ impl Iterator for Scenario {
             }
         }
         Some(Sample::new(time_ms, load, phi).with_speed(speed))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The model up to [`LOAD_MAX`] is the one up to the highest load of the samples
+    /// (spikes included), which the PC example chooses for a trace.
+    #[test]
+    fn the_model_covers_every_sample() {
+        let scene = scene().unwrap();
+        let highest = Scenario::new()
+            .map(|s| f64::from(s.load))
+            .fold(LOAD_MAX, f64::max);
+        assert!(highest > LOAD_MAX);
+        assert_eq!(
+            model_for_range(&scene, highest, ANGLE_MIN).unwrap(),
+            model_for_range(&scene, LOAD_MAX, ANGLE_MIN).unwrap()
+        );
+        assert!(estimator::<Auto>().is_ok() && estimator::<FixedAuto>().is_ok());
     }
 }

@@ -1,8 +1,10 @@
-//! Time to critical: the least-squares trend of the margin phi0 - |phi| over a
-//! fixed window gives the time until gross slip at the current drift.
+//! The trend stage: the least-squares trend of the margin phi0 - |phi| over a fixed
+//! window gives the time until gross slip at the current drift (the events stage
+//! warns when it falls below the horizon). Its state: the current interval, the
+//! points, the latest time to critical.
 
-use super::condition::{finite, ge};
-use super::config::TREND_CAPACITY;
+use super::config::{TREND_CAPACITY, TrendConfig};
+use super::order::{finite, ge};
 use crate::recip::recip;
 use heapless::Deque;
 
@@ -23,13 +25,88 @@ pub(crate) type TrendBuffer = Deque<TrendPoint, TREND_CAPACITY>;
 /// The accumulator of the current interval.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct TrendInterval {
+pub(crate) struct TrendInterval {
     /// Monotonic time the interval began (ms).
-    pub start_ms: u64,
+    pub(crate) start_ms: u64,
     /// Sum of the margins (rad).
-    pub sum: f32,
+    pub(crate) sum: f32,
     /// Number of margins.
-    pub count: u32,
+    pub(crate) count: u32,
+}
+
+/// The stage's state.
+#[derive(Debug, Clone)]
+pub(crate) struct Trend {
+    /// The current interval.
+    pub(crate) interval: TrendInterval,
+    /// The fit's points, oldest first.
+    pub(crate) points: TrendBuffer,
+    /// The latest time to critical (s).
+    pub(crate) time_to_critical_s: Option<f32>,
+}
+
+impl Trend {
+    pub(crate) const fn new() -> Self {
+        Trend {
+            interval: TrendInterval {
+                start_ms: 0,
+                sum: 0.0,
+                count: 0,
+            },
+            points: TrendBuffer::new(),
+            time_to_critical_s: None,
+        }
+    }
+
+    /// Adds an estimated sample's margin `margin` (rad) at monotonic time `now` (ms)
+    /// to the current interval, which becomes a point once it spans the configured
+    /// interval.
+    #[inline(always)]
+    pub(crate) fn add(&mut self, tc: TrendConfig, margin: f32, now: u64) {
+        let iv = &mut self.interval;
+        if iv.count == 0 {
+            iv.start_ms = now;
+        }
+        iv.sum += margin;
+        iv.count = iv.count.saturating_add(1);
+        if now.wrapping_sub(iv.start_ms) >= u64::from(tc.interval_ms) {
+            self.point(tc, now);
+        }
+    }
+
+    /// Closes the interval at `now`: its mean margin becomes a point, and with a full
+    /// window the time to critical is fitted anew.
+    #[cold]
+    fn point(&mut self, tc: TrendConfig, now: u64) {
+        let iv = &mut self.interval;
+        let point = TrendPoint {
+            time_ms: now as u32,
+            margin: iv.sum * recip(iv.count as f32),
+        };
+        *iv = TrendInterval::default();
+        // Points older than the window leave (after a stop, say).
+        let window = u64::from(tc.interval_ms) * u64::from(tc.points);
+        while let Some(old) = self.points.front() {
+            if u64::from((now as u32).wrapping_sub(old.time_ms)) > window {
+                self.points.pop_front();
+            } else {
+                break;
+            }
+        }
+        push(&mut self.points, point, usize::from(tc.points));
+        // The fit waits for a full window: a shorter one mistakes the load's
+        // cycles for a drift.
+        if self.points.len() < usize::from(tc.points) {
+            self.time_to_critical_s = None;
+            return;
+        }
+        let mut points = [TrendPoint::default(); TREND_CAPACITY];
+        for (slot, p) in points.iter_mut().zip(self.points.iter()) {
+            *slot = *p;
+        }
+        let n = self.points.len().min(TREND_CAPACITY);
+        self.time_to_critical_s = time_to_critical(&points[..n]);
+    }
 }
 
 /// Appends a point, keeping at most `points` (oldest dropped).

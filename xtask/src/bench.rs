@@ -240,14 +240,10 @@ fn monitor_errors(e: &mut Errors) -> Result<(), String> {
         }
         Ok(err)
     }
-    let f32_core = misalign::float::Auto::with_choice(&s, choice).map_err(|e| e.to_string())?;
+    let f32_core = scenario::estimator::<misalign::float::Auto>().map_err(|e| e.to_string())?;
     put(e, Model::F32, Operation::Monitor, run(f32_core, &worst)?);
-    let angle_lsb = match choice {
-        ModelChoice::Elliptic => FixedEllipticScene::min_angle_lsb(&s).max(1e-10),
-        _ => 1e-10,
-    };
-    let fixed_core = misalign::fixed::FixedAuto::with_choice(&s, 1e-2, angle_lsb, choice)
-        .map_err(|e| e.to_string())?;
+    let fixed_core =
+        scenario::estimator::<misalign::fixed::FixedAuto>().map_err(|e| e.to_string())?;
     put(
         e,
         Model::Fixed,

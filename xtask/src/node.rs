@@ -24,12 +24,11 @@
 //! loose, this one need not be.)
 
 use crate::log::Fields;
-use misalign::fixed::{FixedAuto, FixedEllipticScene};
+use misalign::Estimator;
+use misalign::fixed::FixedAuto;
 use misalign::float::Auto;
 use misalign::monitor::scenario::{self, Scenario};
-use misalign::monitor::{Config, EventKind, Monitor, RiskState, Sample, model_for_range};
-use misalign::reference::ModelChoice;
-use misalign::{Estimator, Scene};
+use misalign::monitor::{Config, EventKind, Monitor, RiskState, Sample};
 
 #[allow(dead_code)] // Shared with the firmware, which uses it all.
 #[path = "../../examples/firmware/sensors.rs"]
@@ -163,43 +162,21 @@ pub fn parse_measured(log: &str) -> Result<Measured, String> {
     })
 }
 
-/// The scenario's scene and one model for its range, as `examples/monitor` chooses
-/// them (the highest load of the samples, at least `scenario::LOAD_MAX`).
-fn scene_and_model() -> Result<(Scene, ModelChoice), String> {
-    let [r1, r2, g, nu, mu] = scenario::SCENE;
-    let scene = Scene::new(r1, r2, g, nu, mu).map_err(|e| e.to_string())?;
-    let load_max = Scenario::new()
-        .map(|s| f64::from(s.load))
-        .filter(|l| l.is_finite())
-        .fold(scenario::LOAD_MAX, f64::max);
-    let choice =
-        model_for_range(&scene, load_max, scenario::ANGLE_MIN).map_err(|e| e.to_string())?;
-    Ok((scene, choice))
-}
-
 /// The node's estimator: the f32 core where there is an FPU, else the fixed-point one.
 pub enum Core {
     F32(Auto),
     Fixed(FixedAuto),
 }
 
-/// The node's estimator for the scenario, built as the node builds it: the f32 core
-/// (`fpu`) or the fixed-point one.
+/// The node's estimator for the scenario, built as the node builds it
+/// (`scenario::estimator`): the f32 core (`fpu`) or the fixed-point one.
 pub fn core(fpu: bool) -> Result<Core, String> {
-    let (scene, choice) = scene_and_model()?;
     let err = |e: misalign::Error| e.to_string();
-    if fpu {
-        Ok(Core::F32(Auto::with_choice(&scene, choice).map_err(err)?))
+    Ok(if fpu {
+        Core::F32(scenario::estimator::<Auto>().map_err(err)?)
     } else {
-        // As `examples/monitor --model fixed`: 10 mN a count, the finest angle LSB the
-        // tables allow, at least 0.1 nrad.
-        let angle_lsb = match choice {
-            ModelChoice::Elliptic => FixedEllipticScene::min_angle_lsb(&scene).max(1e-10),
-            _ => 1e-10,
-        };
-        let core = FixedAuto::with_choice(&scene, 1e-2, angle_lsb, choice).map_err(err)?;
-        Ok(Core::Fixed(core))
-    }
+        Core::Fixed(scenario::estimator::<FixedAuto>().map_err(err)?)
+    })
 }
 
 /// The host's replay of the scenario, on the f32 core (`fpu`) or the fixed-point one,
@@ -235,23 +212,23 @@ fn replay<E: Estimator>(core: E, through_sensors: bool) -> Result<Log, String> {
     let s = monitor.statistics();
     out.summary = Summary {
         counts: [
-            s.samples,
-            s.repeated_timestamps.into(),
-            s.spikes.into(),
-            s.faults.total(),
-            s.events_dropped.into(),
+            s.samples(),
+            s.repeated_timestamps().into(),
+            s.spikes().into(),
+            s.faults().total(),
+            s.events_dropped().into(),
         ],
         final_state: monitor.state().as_str().into(),
-        max_slip_ratio: s.max_slip_ratio.into(),
-        max_force: s.max_axial_force.into(),
-        min_margin: s.min_margin.map(f64::from),
+        max_slip_ratio: s.max_slip_ratio().into(),
+        max_force: s.max_axial_force().into(),
+        min_margin: s.min_margin().map(f64::from),
         states: RiskState::ALL
             .iter()
             .map(|st| {
                 (
                     st.as_str().to_string(),
-                    s.time_in_state_ms[st.index()],
-                    s.energy[st.index()].total(),
+                    s.time_in_state_ms(*st),
+                    s.energy_j(*st),
                 )
             })
             .collect(),

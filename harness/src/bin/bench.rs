@@ -21,8 +21,7 @@ mod run {
     use misalign::fixed::{FixedAuto, FixedEllipticScene, FixedLineScene};
     use misalign::float::kernels::{axial_force::axial_force_ratio, cbrt::cbrt, sqrt::inv_sqrt};
     use misalign::float::{Auto, EllipticScene, G_OF_THETA, LineScene, THETA_OF_G};
-    use misalign::monitor::{Config, Monitor, model_for_range, scenario};
-    use misalign::reference::ModelChoice;
+    use misalign::monitor::{Config, Monitor, scenario};
     use misalign::{Estimator, Scene, reference};
     use misalign_harness::support::counter::{Counter, Stats, SystClkSource};
     use misalign_harness::support::parse_count;
@@ -163,23 +162,15 @@ mod run {
         })
         .print(Model::F32, Operation::InversePhiLine);
         // The monitor's whole per-sample pipeline over the built-in scenario, on both
-        // cores, with the model fixed for the scenario's operating range (section 9)
-        // and the fixed-point LSBs of `cargo run --example monitor -- --model fixed`.
-        let [r1, r2, g, nu, mu] = scenario::SCENE;
-        let Ok(shift) = Scene::new(r1, r2, g, nu, mu) else {
+        // cores: the scenario's estimator (`scenario::estimator`, as the node and
+        // `cargo run --example monitor` build it), on the scene made opaque.
+        let Ok(shift) = scenario::scene() else {
             return 2;
         };
         let shift = black_box(shift);
-        let Ok(choice) = model_for_range(&shift, scenario::LOAD_MAX, scenario::ANGLE_MIN) else {
-            return 2;
-        };
-        let angle_lsb = match choice {
-            ModelChoice::Elliptic => FixedEllipticScene::min_angle_lsb(&shift).max(1e-10),
-            _ => 1e-10,
-        };
         let (Ok(f32_core), Ok(fixed_core)) = (
-            Auto::with_choice(&shift, choice),
-            FixedAuto::with_choice(&shift, 1e-2, angle_lsb, choice),
+            scenario::estimator_for::<Auto>(&shift, scenario::LOAD_MAX),
+            scenario::estimator_for::<FixedAuto>(&shift, scenario::LOAD_MAX),
         ) else {
             return 2;
         };

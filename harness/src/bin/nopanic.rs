@@ -147,7 +147,10 @@ mod paths {
         }
         io::emit(m.pop_event());
         io::emit((m.pending_events(), m.reading(), m.time_to_critical()));
-        io::emit((m.statistics().total_energy(), m.statistics().faults.total()));
+        io::emit((
+            m.statistics().total_energy(),
+            m.statistics().faults().total(),
+        ));
         let state = io::read(&m.snapshot());
         if let Ok(mut r) = Monitor::restore(estimator, config, &state) {
             for s in samples {

@@ -1,7 +1,11 @@
-//! Conditioning: spike rejection (Hampel), exponential smoothing over irregular time
-//! steps, stuck-sensor detection.
+//! The conditioning stage: spike rejection (Hampel) and exponential smoothing over
+//! irregular time steps, of load and angle, for a sample that passed the checks and
+//! runs; the load clamped at zero. Its state: the two windows, the smoothed values and
+//! the last time step's values.
 
-use super::config::{SPIKE_WINDOW_CAPACITY, SpikeFilter};
+use super::config::{Config, SPIKE_WINDOW_CAPACITY, SpikeFilter};
+use super::order::{ge, key, positive, value};
+use super::statistics::Statistics;
 
 const CAP: usize = SPIKE_WINDOW_CAPACITY;
 
@@ -37,53 +41,6 @@ pub(crate) struct Window {
     len: u8,
     /// The window's length (1 to `CAP`) the slots are laid out for.
     size: u8,
-}
-
-/// A finite value's order key: its bits, negative ones with all but the sign bit
-/// flipped, so that keys compare as signed integers exactly as the values do (-0 just
-/// below 0). Its own inverse.
-#[inline(always)]
-fn key(x: f32) -> i32 {
-    let i = x.to_bits() as i32;
-    i ^ (((i >> 31) as u32) >> 1) as i32
-}
-
-/// The value of an order key.
-#[inline(always)]
-fn value(k: i32) -> f32 {
-    f32::from_bits(key(f32::from_bits(k as u32)) as u32)
-}
-
-/// `a >= b` for values that are not NaN: the FPU's comparison where there is one
-/// (`eabihf`), else integers ([`order`]), some ten times cheaper than a soft-float
-/// comparison on a Cortex-M0. The same answer either way, -0 equal to 0 included.
-#[inline(always)]
-pub(crate) fn ge(a: f32, b: f32) -> bool {
-    #[cfg(target_abi = "eabihf")]
-    {
-        a >= b
-    }
-    #[cfg(not(target_abi = "eabihf"))]
-    {
-        order(a) >= order(b)
-    }
-}
-
-/// Whether `x` is finite, by its bits: an integer comparison on every core (`f32`'s
-/// own test is a soft-float comparison without an FPU).
-#[inline(always)]
-pub(crate) fn finite(x: f32) -> bool {
-    x.to_bits() & 0x7fff_ffff <= f32::MAX.to_bits()
-}
-
-/// A value's place in the float order as an i32, -0 equal to 0: the non-negative
-/// ones are their bits, a negative one `i32::MIN - bits`. A NaN lands above +inf or
-/// below -inf, by its sign.
-#[cfg_attr(target_abi = "eabihf", allow(dead_code))]
-#[inline(always)]
-pub(crate) fn order(x: f32) -> i32 {
-    let i = x.to_bits() as i32;
-    if i < 0 { i32::MIN.wrapping_sub(i) } else { i }
 }
 
 impl Window {
@@ -360,134 +317,93 @@ impl StepCache {
     }
 }
 
-/// A closed range `[lo, hi]` of f32 (ends not NaN) as the per-sample checks compare
-/// it: the FPU's comparisons where there is one (`eabihf`), else the ends' order keys
-/// ([`order`]), formed once. A NaN is outside.
+/// A conditioned sample: load (N, at least 0) and angle (rad), and its time step (s).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Range {
-    lo: Ordered,
-    hi: Ordered,
+pub(crate) struct Conditioned {
+    pub(crate) load: f32,
+    pub(crate) phi: f32,
+    pub(crate) dt_s: f32,
 }
 
-/// A value as the target compares it fastest.
-#[cfg(target_abi = "eabihf")]
-type Ordered = f32;
-#[cfg(not(target_abi = "eabihf"))]
-type Ordered = i32;
-
-#[inline(always)]
-fn ordered(x: f32) -> Ordered {
-    #[cfg(target_abi = "eabihf")]
-    {
-        x
-    }
-    #[cfg(not(target_abi = "eabihf"))]
-    {
-        order(x)
-    }
+/// The stage's state: the spike windows of load and angle, the smoothed values, the
+/// last time step's values; and whether the configuration smooths at all.
+#[derive(Debug, Clone)]
+pub(crate) struct Conditioning {
+    /// The spike windows of load (N) and angle (rad).
+    pub(crate) windows: [Window; 2],
+    /// Smoothed load (N) and angle (rad), `None` after a restart.
+    pub(crate) smoothed: Option<[f32; 2]>,
+    step_cache: StepCache,
+    /// Whether the smoothing is on (its time constant above zero).
+    smoothing: bool,
 }
 
-impl Range {
-    pub(crate) fn new(lo: f32, hi: f32) -> Self {
-        Range {
-            lo: ordered(lo),
-            hi: ordered(hi),
+impl Conditioning {
+    pub(crate) fn new(config: &Config) -> Self {
+        Conditioning {
+            windows: [Window::new(), Window::new()],
+            smoothed: None,
+            step_cache: StepCache::new(),
+            // Above zero, by the bits (validated finite and not negative).
+            smoothing: positive(config.smoothing_tau_s),
         }
     }
 
+    /// Conditions a running sample's load `load` (N) and angle `phi` (rad) after a
+    /// step of `dt_ms`: spikes replaced by their window's median (counted in `stats`),
+    /// then smoothed with the weight of the step, the load clamped at zero.
     #[inline(always)]
-    pub(crate) fn contains(&self, x: f32) -> bool {
-        let x = ordered(x);
-        x >= self.lo && x <= self.hi
-    }
-}
-
-/// A lower limit (not NaN): whether a value reaches it, as [`ge`] answers.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct AtLeast(Ordered);
-
-impl AtLeast {
-    pub(crate) fn new(limit: f32) -> Self {
-        AtLeast(ordered(limit))
-    }
-
-    #[inline(always)]
-    pub(crate) fn reached(&self, x: f32) -> bool {
-        ordered(x) >= self.0
-    }
-}
-
-/// Stuck-value tracking of one channel: the raw bits and since when they are unchanged.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct StuckTracker {
-    /// Bits of the last raw value.
-    pub bits: u32,
-    /// Monotonic time (ms) since which the value is unchanged.
-    pub since_ms: u64,
-}
-
-impl StuckTracker {
-    /// Whether the raw value `x` has been unchanged for longer than `limit_ms` at
-    /// monotonic time `now_ms`. `reset` restarts the tracking (the machine stands).
-    pub(crate) fn stuck(&mut self, x: f32, now_ms: u64, limit_ms: u32, reset: bool) -> bool {
-        let bits = x.to_bits();
-        if reset || bits != self.bits {
-            self.bits = bits;
-            self.since_ms = now_ms;
-            return false;
+    pub(crate) fn condition(
+        &mut self,
+        config: &Config,
+        load: f32,
+        phi: f32,
+        dt_ms: u32,
+        stats: &mut Statistics,
+    ) -> Conditioned {
+        let (mut load, mut phi) = (load, phi);
+        if let Some(filter) = &config.spikes {
+            // One loop over both channels: one copy of the window's code in the image.
+            let mut values = [load, phi];
+            let floors = [filter.load_floor, filter.angle_floor];
+            for ((w, x), floor) in self.windows.iter_mut().zip(&mut values).zip(floors) {
+                if let Some(m) = w.hampel(*x, filter, floor) {
+                    *x = m;
+                    stats.count_spike();
+                }
+            }
+            [load, phi] = values;
         }
-        limit_ms > 0 && now_ms.saturating_sub(self.since_ms) > u64::from(limit_ms)
+        let step = self.step_cache.get(dt_ms, config.smoothing_tau_s);
+        if self.smoothing {
+            if let Some([l, p]) = self.smoothed {
+                load = l + step.weight * (load - l);
+                phi = p + step.weight * (phi - p);
+            }
+            self.smoothed = Some([load, phi]);
+        }
+        // A load cell reads a little below zero at rest; the contact has none.
+        let load = if ge(load, 0.0) { load } else { 0.0 };
+        Conditioned {
+            load,
+            phi,
+            dt_s: step.dt_s,
+        }
+    }
+
+    /// Starts afresh after a sample that was not conditioned (a fault, a stop): the
+    /// values before it say nothing about the ones after.
+    pub(crate) fn restart(&mut self) {
+        for w in &mut self.windows {
+            w.clear();
+        }
+        self.smoothed = None;
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn keys_order_as_the_values_and_invert() {
-        let xs = [
-            f32::MIN,
-            -1e30,
-            -2.0,
-            -1.0,
-            -1e-30,
-            -1e-45,
-            -0.0,
-            0.0,
-            1e-45,
-            1e-38,
-            0.5,
-            1.0,
-            3.0,
-            f32::MAX,
-        ];
-        for a in xs {
-            for b in xs {
-                // The float order, with -0 just below 0.
-                let below_zero = a == b && a.is_sign_negative() && b.is_sign_positive();
-                assert_eq!(key(a) < key(b), a < b || below_zero, "{a} {b}");
-                assert_eq!(value(key(a)).to_bits(), a.to_bits(), "{a}");
-                assert_eq!(ge(a, b), a >= b, "{a} {b}");
-                assert_eq!(order(a) >= order(b), a >= b, "{a} {b}");
-                assert!(finite(a));
-                assert_eq!(
-                    Range::new(b, 1.0).contains(a),
-                    b <= a && a <= 1.0,
-                    "{a} {b}"
-                );
-                assert_eq!(AtLeast::new(b).reached(a), a >= b, "{a} {b}");
-            }
-            assert!(!finite(f32::INFINITY) && !finite(f32::NEG_INFINITY));
-            // A NaN of either sign is outside every finite range.
-            for nan in [f32::NAN, -f32::NAN] {
-                assert!(order(nan) > order(f32::INFINITY) || order(nan) < order(f32::NEG_INFINITY));
-                assert!(!Range::new(f32::NEG_INFINITY, f32::INFINITY).contains(nan));
-                assert!(!finite(nan));
-            }
-        }
-    }
 
     #[test]
     fn one_minus_exp_neg_is_within_its_bound() {
