@@ -110,7 +110,7 @@ impl Words {
             let [hi, lo] = word.to_be_bytes();
             response[usize::from(self.at)] = hi;
             response[usize::from(self.at.wrapping_add(1))] = lo;
-            self.crc = crc::step(crc::step(self.crc, hi), lo);
+            self.crc = crc::word(self.crc, word);
             self.at = self.at.wrapping_add(2);
         }
     }

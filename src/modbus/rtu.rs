@@ -27,6 +27,12 @@ pub const ADU_MAX: usize = 256;
 /// The highest unicast address; 248 to 255 are reserved.
 const ADDRESS_MAX: u8 = 247;
 
+/// Waiting bytes before a new candidate is classified: its address and function code.
+/// (A reserved address alone would already drop it; it is dropped when the next byte
+/// comes instead, which changes no frame found and saves the first byte of every frame
+/// a classification.)
+const NEED_MIN: usize = 2;
+
 /// A frame's length from its first bytes.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum Len {
@@ -184,7 +190,7 @@ impl Framer {
             start: 0,
             consumed: 0,
             overflowed: false,
-            need: 0,
+            need: NEED_MIN,
             counters: FramingCounters {
                 frames: 0,
                 discarded: 0,
@@ -243,7 +249,7 @@ impl Framer {
 
     fn drop_one(&mut self) {
         self.start = self.start.saturating_add(1);
-        self.need = 0;
+        self.need = NEED_MIN;
         self.counters.discarded = self.counters.discarded.saturating_add(1);
     }
 
@@ -275,7 +281,7 @@ impl Framer {
         let range = self.start..self.start.saturating_add(n);
         self.start = range.end;
         self.consumed = range.end;
-        self.need = 0;
+        self.need = NEED_MIN;
         self.counters.frames = self.counters.frames.saturating_add(1);
         range
     }
@@ -310,7 +316,7 @@ impl Framer {
         self.start = 0;
         self.consumed = 0;
         self.overflowed = false;
-        self.need = 0;
+        self.need = NEED_MIN;
     }
 }
 
