@@ -232,9 +232,9 @@ impl<E: Estimator> Core<E> {
         };
         // Each table's values from a function of its own (small enough to inline).
         if function == 3 {
-            self.fill(map, start, &mut out, Self::value_holding);
+            self.fill::<true>(map, start, &mut out, Self::value_holding);
         } else {
-            self.fill(map, start, &mut out, Self::value);
+            self.fill::<false>(map, start, &mut out, Self::value);
         }
         // At most 253 bytes written: the CRC's two fit.
         let Words { at, crc, .. } = out;
@@ -247,9 +247,10 @@ impl<E: Estimator> Core<E> {
     /// The words of `map` from `start` into the response until `out.end`, each value
     /// computed once by `value`: inside the map (checked), from the word that holds
     /// `start`; the single entries one after the other, the blocks' records field by
-    /// field.
+    /// field. `ZERO_BLOCKS`: every word of the blocks reads 0 (the holding blocks are
+    /// the external samples, which are written, not read back), written as such.
     #[inline(always)]
-    fn fill(
+    fn fill<const ZERO_BLOCKS: bool>(
         &mut self,
         map: &TableMap,
         start: u16,
@@ -277,6 +278,13 @@ impl<E: Estimator> Core<E> {
         let Some((mut b, mut record, mut i, mut word)) = from else {
             return;
         };
+        if ZERO_BLOCKS {
+            // Inside the map (checked): the words left are the blocks'.
+            while out.at < out.end {
+                out.word(&mut self.response, 0);
+            }
+            return;
+        }
         'blocks: while let Some(block) = map.blocks.get(b) {
             while record < block.count {
                 while let Some(e) = block.fields.get(i) {
