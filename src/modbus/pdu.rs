@@ -75,7 +75,7 @@ const fn table_of(function: u8) -> Table {
     }
 }
 
-/// What [`Core::dispatch`] wrote.
+/// What a request's handler wrote.
 enum Reply {
     /// The PDU from `response[1]`, of this length: the unit and the CRC to add.
     Pdu(usize),
@@ -138,7 +138,13 @@ impl<E: Estimator> Core<E> {
                 self.counters.responses_overwritten.wrapping_add(1);
             self.response_len = 0;
         }
-        let result = self.dispatch(function, pdu);
+        // The reads of registers (a master's poll) apart from the dispatch, whose
+        // other functions' set-up they then do not share.
+        let result = if matches!(function, 3 | 4) {
+            self.read_registers(function, pdu).map(Reply::Adu)
+        } else {
+            self.dispatch(function, pdu).map(Reply::Pdu)
+        };
         if broadcast {
             return;
         }
@@ -166,11 +172,12 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    /// The response into `self.response`: its PDU from byte 1, or the whole ADU.
-    fn dispatch(&mut self, function: u8, pdu: &[u8]) -> Result<Reply, Exception> {
-        let pdu_only = match function {
+    /// The response PDU into `self.response[1..]`; its length. Every function but the
+    /// reads of registers, which [`handle`](Self::handle) answers through
+    /// [`read_registers`](Self::read_registers).
+    fn dispatch(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
+        match function {
             1 | 2 => self.read_bits(function, pdu),
-            3 | 4 => return self.read_registers(function, pdu).map(Reply::Adu),
             5 => self.write_coil(pdu),
             6 => self.write_register(pdu),
             15 => self.write_coils(pdu),
@@ -183,8 +190,7 @@ impl<E: Estimator> Core<E> {
                 ident::read(&self.ident, self.model_name, pdu, out)
             }
             _ => Err(Exception::IllegalFunction),
-        };
-        pdu_only.map(Reply::Pdu)
+        }
     }
 
     fn read_bits(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
