@@ -2,9 +2,10 @@
 //! length, the CRC as the judge, resynchronisation by sliding one byte past whatever
 //! is not a frame, and the 3.5-character silence where the application reports it.
 //!
-//! The bytes since the last frame wait in a buffer of one ADU (256 bytes). After each
-//! byte the *candidate* (the frame that would start at the oldest waiting byte) is
-//! classified from its address and function code: a request of a known length for
+//! The bytes since the last frame wait in a buffer of one ADU (256 bytes). Once its
+//! address and function code wait, and then at each byte that can decide it, the
+//! *candidate* (the frame that would start at the oldest waiting byte) is
+//! classified from them: a request of a known length for
 //! this unit or a broadcast is taken once complete with a valid CRC; a frame for
 //! another unit (its request, or another server's response) is skipped once either
 //! length has a valid CRC; anything else (an address above 247, an unknown function
