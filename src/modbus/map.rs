@@ -798,6 +798,17 @@ mod tests {
         }
     }
 
+    /// The read of holding registers writes the blocks' words as 0 without asking each
+    /// field (`Core::fill`): they are all external samples' fields, which read 0.
+    #[test]
+    fn holding_blocks_are_external_samples() {
+        for b in HOLDINGS.blocks {
+            for e in b.fields {
+                assert!(matches!(e.field, Field::Sample(_)), "{}", e.name);
+            }
+        }
+    }
+
     #[test]
     fn every_address_locates_its_entry() {
         for t in MAP {

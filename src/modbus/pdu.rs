@@ -3,7 +3,7 @@
 //! exceptions, broadcasts.
 
 use super::map::{Access, Block, Field, Located, Table, TableMap};
-use super::{Core, crc, ident};
+use super::{ADU_MAX, Core, crc, ident};
 use crate::Estimator;
 use core::fmt;
 
@@ -75,6 +75,47 @@ const fn table_of(function: u8) -> Table {
     }
 }
 
+/// What a request's handler wrote.
+enum Reply {
+    /// The PDU from `response[1]`, of this length: the unit and the CRC to add.
+    Pdu(usize),
+    /// The whole answer, CRC included, of this length.
+    Adu(usize),
+}
+
+/// The register words of a read being written: the next byte, the end, the CRC of
+/// what is written so far. Positions are `u8`: every index into the 256-byte response
+/// is in bounds without a check.
+struct Words {
+    at: u8,
+    end: u8,
+    crc: u16,
+}
+
+impl Words {
+    /// Writes the words `from..n` of the `n`-word value `v` (high word first) while
+    /// below `end`.
+    #[inline(always)]
+    fn put(&mut self, response: &mut [u8; ADU_MAX], v: u32, n: u16, from: u16) {
+        if n == 2 && from == 0 {
+            self.word(response, (v >> 16) as u16);
+        }
+        self.word(response, v as u16);
+    }
+
+    /// Writes `word` (big-endian) while below `end`, into the CRC as it is written.
+    #[inline(always)]
+    fn word(&mut self, response: &mut [u8; ADU_MAX], word: u16) {
+        if self.at < self.end {
+            let [hi, lo] = word.to_be_bytes();
+            response[usize::from(self.at)] = hi;
+            response[usize::from(self.at.wrapping_add(1))] = lo;
+            self.crc = crc::word(self.crc, word);
+            self.at = self.at.wrapping_add(2);
+        }
+    }
+}
+
 impl<E: Estimator> Core<E> {
     /// Answers one frame for this unit or a broadcast (CRC checked by the framer).
     pub(super) fn handle(&mut self, frame: &[u8]) {
@@ -97,12 +138,22 @@ impl<E: Estimator> Core<E> {
                 self.counters.responses_overwritten.wrapping_add(1);
             self.response_len = 0;
         }
-        let result = self.dispatch(function, pdu);
+        // The reads of registers (a master's poll) apart from the dispatch, whose
+        // other functions' set-up they then do not share.
+        let result = if matches!(function, 3 | 4) {
+            self.read_registers(function, pdu).map(Reply::Adu)
+        } else {
+            self.dispatch(function, pdu).map(Reply::Pdu)
+        };
         if broadcast {
             return;
         }
         let len = match result {
-            Ok(n) => n,
+            Ok(Reply::Adu(n)) => {
+                self.response_len = n;
+                return;
+            }
+            Ok(Reply::Pdu(n)) => n,
             Err(x) => {
                 self.counters.exceptions = self.counters.exceptions.wrapping_add(1);
                 if let Some(b) = self.response.get_mut(1..3) {
@@ -121,11 +172,12 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    /// The response PDU into `self.response[1..]`; its length.
+    /// The response PDU into `self.response[1..]`; its length. Every function but the
+    /// reads of registers, which [`handle`](Self::handle) answers through
+    /// [`read_registers`](Self::read_registers).
     fn dispatch(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
         match function {
             1 | 2 => self.read_bits(function, pdu),
-            3 | 4 => self.read_registers(function, pdu),
             5 => self.write_coil(pdu),
             6 => self.write_register(pdu),
             15 => self.write_coils(pdu),
@@ -166,6 +218,8 @@ impl<E: Estimator> Core<E> {
         Ok(2 + bytes)
     }
 
+    /// The whole answer to a read of registers (the unit, the PDU, the CRC computed as
+    /// the words are written); its length.
     fn read_registers(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
         let (start, quantity) = head(pdu)?;
         if quantity == 0 || quantity > READ_REGISTERS_MAX {
@@ -174,76 +228,82 @@ impl<E: Estimator> Core<E> {
         let map = TableMap::of(table_of(function));
         in_map(map, start, quantity)?;
         // At most 125 registers: 250 bytes, from response[3].
-        let bytes = 2 * usize::from(quantity).min(125);
-        self.response[1] = function;
-        self.response[2] = bytes as u8;
+        let bytes = 2 * quantity.min(125) as u8;
+        let head = [self.unit, function, bytes];
+        self.response[..3].copy_from_slice(&head);
+        let mut out = Words {
+            at: 3,
+            end: 3 + bytes,
+            crc: head.iter().fold(crc::INIT, |c, &b| crc::step(c, b)),
+        };
         // Each table's values from a function of its own (small enough to inline).
         if function == 3 {
-            self.fill(map, start, 3 + bytes, Self::value_holding);
+            self.fill::<true>(map, start, &mut out, Self::value_holding);
         } else {
-            self.fill(map, start, 3 + bytes, Self::value);
+            self.fill::<false>(map, start, &mut out, Self::value);
         }
-        Ok(2 + bytes)
+        // At most 253 bytes written: the CRC's two fit.
+        let Words { at, crc, .. } = out;
+        let [lo, hi] = crc.to_le_bytes();
+        self.response[usize::from(at)] = lo;
+        self.response[usize::from(at.wrapping_add(1))] = hi;
+        Ok(usize::from(at) + 2)
     }
 
-    /// The response from byte 3 to `end` with the words of `map` from `start`, each
-    /// value computed once by `value`: inside the map (checked), from the word that
-    /// holds `start`; the single entries one after the other, the blocks' records
-    /// field by field.
+    /// The words of `map` from `start` into the response until `out.end`, each value
+    /// computed once by `value`: inside the map (checked), from the word that holds
+    /// `start`; the single entries one after the other, the blocks' records field by
+    /// field. `ZERO_BLOCKS`: every word of the blocks reads 0 (the holding blocks are
+    /// the external samples, which are written, not read back), written as such.
     #[inline(always)]
-    fn fill(
+    fn fill<const ZERO_BLOCKS: bool>(
         &mut self,
         map: &TableMap,
         start: u16,
-        end: usize,
+        out: &mut Words,
         value: impl Fn(&Self, Field, u16) -> u32,
     ) {
-        let mut at = 3;
-        let mut address = start;
+        // Where the blocks' part starts: the first block's first record when the
+        // single entries lead into it.
+        let mut from = None;
         if let Some((mut i, mut word)) = map.single(start) {
-            while at < end {
-                let Some(e) = map.entries.get(i) else { break };
+            while out.at < out.end {
+                let Some(e) = map.entries.get(i) else {
+                    from = Some((0, 0, 0, 0));
+                    break;
+                };
                 let v = value(self, e.field, 0);
-                self.put(&mut at, end, v, e.ty.words(), word);
-                address = e.end();
+                out.put(&mut self.response, v, e.ty.words(), word);
                 (i, word) = (i + 1, 0);
             }
-        }
-        if at < end
-            && let Some(l) = map.locate(address)
-            && let Some(mut b) = l.block
+        } else if let Some(l) = map.locate(start)
+            && let Some(b) = l.block
         {
-            let (mut record, mut i, mut word) = (l.record, l.index, l.word);
-            'blocks: while let Some(block) = map.blocks.get(b) {
-                while record < block.count {
-                    while let Some(e) = block.fields.get(i) {
-                        let v = value(self, e.field, record);
-                        self.put(&mut at, end, v, e.ty.words(), word);
-                        if at >= end {
-                            break 'blocks;
-                        }
-                        (i, word) = (i + 1, 0);
-                    }
-                    (record, i) = (record + 1, 0);
-                }
-                (b, record) = (b + 1, 0);
-            }
+            from = Some((b, l.record, l.index, l.word));
         }
-    }
-
-    /// Writes the words `from..n` of the `n`-word value `v` at `*at` (below `end`),
-    /// high word first.
-    fn put(&mut self, at: &mut usize, end: usize, v: u32, n: u16, from: u16) {
-        for w in from..n {
-            if *at >= end {
-                return;
+        let Some((mut b, mut record, mut i, mut word)) = from else {
+            return;
+        };
+        if ZERO_BLOCKS {
+            // Inside the map (checked): the words left are the blocks'.
+            while out.at < out.end {
+                out.word(&mut self.response, 0);
             }
-            let word = if n == 2 && w == 0 { v >> 16 } else { v } as u16;
-            if let Some(slot) = self.response.get_mut(*at..*at + 2) {
-                slot[0] = (word >> 8) as u8;
-                slot[1] = word as u8;
+            return;
+        }
+        'blocks: while let Some(block) = map.blocks.get(b) {
+            while record < block.count {
+                while let Some(e) = block.fields.get(i) {
+                    if out.at >= out.end {
+                        break 'blocks;
+                    }
+                    let v = value(self, e.field, record);
+                    out.put(&mut self.response, v, e.ty.words(), word);
+                    (i, word) = (i + 1, 0);
+                }
+                (record, i) = (record + 1, 0);
             }
-            *at += 2;
+            (b, record) = (b + 1, 0);
         }
     }
 

@@ -2,9 +2,10 @@
 //! length, the CRC as the judge, resynchronisation by sliding one byte past whatever
 //! is not a frame, and the 3.5-character silence where the application reports it.
 //!
-//! The bytes since the last frame wait in a buffer of one ADU (256 bytes). After each
-//! byte the *candidate* (the frame that would start at the oldest waiting byte) is
-//! classified from its address and function code: a request of a known length for
+//! The bytes since the last frame wait in a buffer of one ADU (256 bytes). Once its
+//! address and function code wait, and then at each byte that can decide it, the
+//! *candidate* (the frame that would start at the oldest waiting byte) is
+//! classified from them: a request of a known length for
 //! this unit or a broadcast is taken once complete with a valid CRC; a frame for
 //! another unit (its request, or another server's response) is skipped once either
 //! length has a valid CRC; anything else (an address above 247, an unknown function
@@ -26,6 +27,12 @@ pub const ADU_MAX: usize = 256;
 
 /// The highest unicast address; 248 to 255 are reserved.
 const ADDRESS_MAX: u8 = 247;
+
+/// Waiting bytes before a new candidate is classified: its address and function code.
+/// (A reserved address alone would already drop it; it is dropped when the next byte
+/// comes instead, which changes no frame found and saves the first byte of every frame
+/// a classification.)
+const NEED_MIN: usize = 2;
 
 /// A frame's length from its first bytes.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -184,7 +191,7 @@ impl Framer {
             start: 0,
             consumed: 0,
             overflowed: false,
-            need: 0,
+            need: NEED_MIN,
             counters: FramingCounters {
                 frames: 0,
                 discarded: 0,
@@ -243,7 +250,7 @@ impl Framer {
 
     fn drop_one(&mut self) {
         self.start = self.start.saturating_add(1);
-        self.need = 0;
+        self.need = NEED_MIN;
         self.counters.discarded = self.counters.discarded.saturating_add(1);
     }
 
@@ -275,7 +282,7 @@ impl Framer {
         let range = self.start..self.start.saturating_add(n);
         self.start = range.end;
         self.consumed = range.end;
-        self.need = 0;
+        self.need = NEED_MIN;
         self.counters.frames = self.counters.frames.saturating_add(1);
         range
     }
@@ -310,7 +317,7 @@ impl Framer {
         self.start = 0;
         self.consumed = 0;
         self.overflowed = false;
-        self.need = 0;
+        self.need = NEED_MIN;
     }
 }
 
