@@ -50,7 +50,7 @@ fn estimate(c: &mut Criterion) {
             }
         })
     });
-    // Section 9 per sample (issue 16): the same samples on rollers 0.3 m long, where
+    // Section 9 per sample: the same samples on rollers 0.3 m long, where
     // about half of them take line contact; the choice costs one table read.
     let short = scene.with_length(0.3).unwrap();
     let auto = misalign::float::Auto::new(&short).unwrap();

@@ -293,7 +293,7 @@ fn forced_line_contact_means_the_same_in_every_model() {
     }
 }
 
-/// Issue 14, item 6: one bad row is that row's error; the batch goes on.
+/// One bad row is that row's error; the batch goes on.
 #[test]
 fn a_bad_row_does_not_end_the_batch() {
     let good = "0.05,0.05,79.3e9,0.3,0.3,1000,2e-4";
@@ -335,7 +335,7 @@ fn a_bad_row_does_not_end_the_batch() {
     assert_eq!(rows[2]["error"], "");
 }
 
-/// Issue 14, item 7: the tool says what is wrong.
+/// The tool says what is wrong.
 #[test]
 fn messages_say_what_is_wrong() {
     // Duplicate input columns: refused, naming the column.
@@ -383,7 +383,7 @@ fn messages_say_what_is_wrong() {
     );
 }
 
-/// Issue 14, item 7: a full disk is a message and a non-zero exit, not a silent 1.
+/// A full disk is a message and a non-zero exit, not a silent 1.
 #[test]
 fn a_full_disk_is_said() {
     let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {

@@ -138,7 +138,7 @@ fn axial_force_ratio_never_exceeds_one() {
     }
 }
 
-// Issue 14: an adversarial probe's crafted inputs (extreme but accepted scenes, LSBs
+// An adversarial probe's crafted inputs (extreme but accepted scenes, LSBs
 // that leave no angle but 0, loads whose mu P leaves the number format).
 
 /// Every f64 field of an elliptic result is a number (infinities where documented).
@@ -181,7 +181,7 @@ fn assert_no_nan_line(l: &reference::Line) {
     assert!(fields.iter().all(|x| !x.is_nan()), "{l:?}");
 }
 
-/// Issue 14 (3): R1 = R2 = 5e-324 m gave an effective radius of 0 (R1 R2/(R1 + R2)
+/// R1 = R2 = 5e-324 m gave an effective radius of 0 (R1 R2/(R1 + R2)
 /// is 2.5e-324, not an f64), and from it NaN in p0, phi0, P*, a. Such radii are refused;
 /// twice the smallest subnormal still works, without NaN.
 #[test]
@@ -201,7 +201,7 @@ fn effective_radius_that_underflows_is_refused() {
     }
 }
 
-/// Issue 14 (3): R = 1e308 m on a plane with G = 5e-324 Pa: the half-width b
+/// R = 1e308 m on a plane with G = 5e-324 Pa: the half-width b
 /// overflows, and d = (d/b) b was 0 x inf = NaN at phi = 0.
 #[test]
 fn line_slip_width_of_an_overflowing_strip() {
@@ -213,7 +213,7 @@ fn line_slip_width_of_an_overflowing_strip() {
     }
 }
 
-/// Issue 14 (3): R1 = R2 = f64::MAX, G = 5e-324 Pa, mu = f64::MAX, P = 0: R1 + R2
+/// R1 = R2 = f64::MAX, G = 5e-324 Pa, mu = f64::MAX, P = 0: R1 + R2
 /// overflowed and the critical load was 0 x inf = NaN; P* lost its value the same way.
 #[test]
 fn critical_load_with_radii_whose_sum_overflows() {
@@ -235,7 +235,7 @@ fn critical_load_with_radii_whose_sum_overflows() {
     );
 }
 
-/// Issue 14 (1): an angle LSB with c x LSB above pi/2 left no angle count but 0
+/// An angle LSB with c x LSB above pi/2 left no angle count but 0
 /// (angle_max = 0), and `log2 theta0 - log2(c LSB)` overflowed i32: with overflow
 /// checks a panic, without them a margin of i32::MAX counts where the true one is 0.
 /// Such an LSB is now refused when the scene is prepared.
@@ -261,7 +261,7 @@ fn fixed_angle_lsb_above_a_right_angle_is_refused() {
     assert!(e.margin.is_none_or(|m| m.abs() <= 2), "{e:?}");
 }
 
-/// Issue 14 (4): in the fixed-point core mu P above 2^127 N saturated F to
+/// In the fixed-point core mu P above 2^127 N saturated F to
 /// `Log2::INFINITY` (here in gross slip of line contact: R = 1e-30 m, G = 1e90 Pa,
 /// mu = 1e-10, mu x load LSB x 2^32 = 2^130 N). A scene whose largest load count would
 /// do so is refused.
@@ -282,7 +282,7 @@ fn fixed_axial_force_beyond_the_log2_range_is_refused() {
     }
 }
 
-/// Issue 14 (5): in gross slip the fixed-point F exceeded mu P by up to 3.8e-8
+/// In gross slip the fixed-point F exceeded mu P by up to 3.8e-8
 /// relative (a quarter of realistic rows; this one gave 300.0000050 N for mu P = 300 N).
 #[test]
 fn fixed_axial_force_never_exceeds_mu_p() {
@@ -317,7 +317,7 @@ fn fixed_axial_force_never_exceeds_mu_p() {
 /// One fixed-point scene's estimator.
 type Estimator = Box<dyn Fn(u32, i32) -> Result<FixedEstimate, Error>>;
 
-/// Issue 14 (1, 4): over extreme but accepted scenes and LSBs, every fixed-point answer
+/// Over extreme but accepted scenes and LSBs, every fixed-point answer
 /// at a load above 0 holds its values: no d/b, F or phi0 saturated to the values that
 /// stand for 0 or infinity (F was 2^-128 = `Log2::ZERO` at a misalignment for mu = 1e-10,
 /// G = 1e-38 Pa), and no sum wraps (the tests build with overflow checks).
@@ -384,7 +384,7 @@ fn fixed_results_fit_over_extreme_scenes() {
     assert!(accepted > 100, "{accepted}");
 }
 
-/// Issue 14 (4): mu = 1e10 and P = 1e38 N gave F = inf in the f32 core (rollers of
+/// Mu = 1e10 and P = 1e38 N gave F = inf in the f32 core (rollers of
 /// 1e15 m, where d/b is not small); it is refused with a typed error where mu P does
 /// not fit f32 (scene or sample), never an infinity.
 #[test]
@@ -408,7 +408,7 @@ fn f32_axial_force_that_overflows_is_refused() {
     }
 }
 
-/// Issue 14 (4): G = 1e-38 Pa and P = 1e38 N/m gave a line-contact phi0 = inf in f32
+/// G = 1e-38 Pa and P = 1e38 N/m gave a line-contact phi0 = inf in f32
 /// (a roller of 0.1 mm on a plane).
 #[test]
 fn f32_line_critical_angle_that_overflows_is_refused() {
@@ -423,7 +423,7 @@ fn f32_line_critical_angle_that_overflows_is_refused() {
     }
 }
 
-/// Issue 14 (4): phi0 underflowed to 0 at a load above 0 in the f32 cores (a light load
+/// Phi0 underflowed to 0 at a load above 0 in the f32 cores (a light load
 /// with a small critical gain); 0 is the answer for zero load only.
 #[test]
 fn f32_critical_angle_never_underflows_to_zero_at_a_load() {
@@ -452,7 +452,7 @@ fn f32_critical_angle_never_underflows_to_zero_at_a_load() {
     }
 }
 
-/// Issue 14 (4): over extreme but accepted scenes, every f32 answer at a load above 0
+/// Over extreme but accepted scenes, every f32 answer at a load above 0
 /// is finite, with |F| <= mu P and a normal phi0 (line phi0 was inf for R = 1e-30 m,
 /// G = 1e-38 Pa, mu = 1e-10, P = 1e38 N/m).
 #[test]
@@ -495,7 +495,7 @@ fn f32_results_fit_over_extreme_scenes() {
     assert_eq!(range, (f32::from_bits(1), f32::MAX));
 }
 
-/// Issue 14 (8), the structured fuzzer from an empty corpus: `Log2::to_fixed` with a
+/// The structured fuzzer from an empty corpus: `Log2::to_fixed` with a
 /// fraction-bit count above 2^31 overflowed i32 (a panic with overflow checks). It
 /// saturates like any other result beyond u32.
 #[test]

@@ -37,7 +37,7 @@
 //! log(f/s)), generated and drift-tested like its forward tables, and the differences
 //! `1 - r`, `2 - q` near saturation, which that number system forms only through a
 //! difference (Gauss-logarithm) table whose error grows as they cancel; that is more
-//! than this budget. An FPU-less node (Cortex-M0, M3) can call these f32
+//! than the fixed-point core has tables for. An FPU-less node (Cortex-M0, M3) can call these f32
 //! inverses in software floating point.
 
 use super::{Auto, EllipticScene, LineScene, check};

@@ -51,7 +51,7 @@ pub enum Operation {
     KernelExp2,
     /// The Q8.24 table log2 g(log2 theta).
     TableLogG,
-    /// The inverse mu from (P, phi, F), elliptic contact (issue 11).
+    /// The inverse mu from (P, phi, F), elliptic contact.
     InverseMu,
     /// The inverse phi from (P, F), elliptic contact.
     InversePhi,
