@@ -265,10 +265,6 @@ fn solve_row(
     answer.map_err(text)
 }
 
-/// The message of an inverse whose arithmetic gave no number.
-const NO_FINITE_ANSWER: &str = "no finite answer: the inverse overflows or underflows \
-    for these scene constants";
-
 /// The friction of the mu-inverse's scenes: `Scene::new` needs one; the inverse does
 /// not read it.
 const PLACEHOLDER_FRICTION: f64 = 1.0;
@@ -358,14 +354,6 @@ fn solve<'py>(
                     phi,
                     at(&cols[8], i),
                 )
-            });
-            // An answer without a finite number (scene constants so extreme that the
-            // inverse's arithmetic overflows) is said, never a silent NaN.
-            let answer = answer.and_then(|a| match a.value() {
-                Some(v) if v.is_nan() || a.sensitivity().is_some_and(f64::is_nan) => {
-                    Err(NO_FINITE_ANSWER.to_string())
-                }
-                _ => Ok(a),
             });
             match answer {
                 Ok(a) => {
