@@ -282,8 +282,7 @@ impl LineScene {
         }
         // Refused as the forward estimate refuses it: outside the load range, phi0 or
         // mu P leaves f32 (phi0 = inf times s = 0 would give a NaN).
-        let (lightest, heaviest) = self.load_range();
-        if !(lightest..=heaviest).contains(&load) {
+        if !self.load_in_range(load) {
             return Err(Error::OutOfRange);
         }
         let saturated = self.friction * (load * 1.0);
