@@ -667,6 +667,31 @@ mod properties {
         }
     }
 
+    /// Any positive f64 of the scene's constants, the extremes often.
+    fn any_magnitude() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            Just(f64::MAX),
+            Just(1.7e308),
+            Just(f64::MIN_POSITIVE),
+            Just(5e-324),
+            log_uniform(1e-300, 1e300),
+            log_uniform(1e-4, 10.0),
+        ]
+    }
+
+    prop_compose! {
+        /// Scenes with every constant anywhere in f64 (that `Scene::new` accepts): the
+        /// products of eqs (23), (28) overflow or underflow on their way.
+        fn extreme_scenes()(r1 in any_magnitude(), r2 in any_magnitude(), plane in 0..8u8,
+                            g in any_magnitude(), nu in 0.0..0.5f64, mu in any_magnitude(),
+                            length in any_magnitude(), with_length in any::<bool>())
+                            -> Option<Scene> {
+            let r2 = if plane == 0 { f64::INFINITY } else { r2 };
+            let s = Scene::new(r1, r2, g, nu, mu).ok()?;
+            if with_length { s.with_length(length).ok() } else { Some(s) }
+        }
+    }
+
     /// An answer inside the physical range: finite value and sensitivity, mu >= 0,
     /// |phi| <= pi/2 (theta <= pi/2 for eq 4) signed like F.
     fn physical(answer: &Inverse<f64>, max: f64, force: f64) -> Result<(), TestCaseError> {
@@ -676,6 +701,67 @@ mod properties {
         }
         if let Some(s) = answer.sensitivity() {
             prop_assert!(s >= 0.0, "{answer:?}"); // +inf allowed where F is flat
+        }
+        Ok(())
+    }
+
+    /// Every reference inverse at (P, phi, F) answers inside the physical range or
+    /// refuses the input.
+    fn reference_answers_are_physical(
+        s: &Scene,
+        load: f64,
+        phi: f64,
+        force: f64,
+    ) -> Result<(), TestCaseError> {
+        let phi_max = std::f64::consts::FRAC_PI_2 / s.radius_factor().min(1.0);
+        for answer in [
+            inverse::friction_elliptic(s, load, phi, force),
+            inverse::friction_line(s, load, phi, force),
+            inverse::friction_estimate(s, load, phi, force),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            if let Some(v) = answer.value() {
+                prop_assert!(v.is_finite() && v >= 0.0, "{answer:?}");
+            }
+            physical(&answer, f64::MAX, 1.0)?;
+        }
+        for answer in [
+            inverse::angle_elliptic(s, load, force),
+            inverse::angle_line(s, load, force),
+            inverse::angle_estimate(s, load, force),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            physical(&answer, phi_max, force)?;
+        }
+        Ok(())
+    }
+
+    /// The same for the f32 core through [`misalign::float::Auto`] (where it prepares).
+    fn float_answers_are_physical(
+        s: &Scene,
+        load: f32,
+        phi: f32,
+        force: f32,
+    ) -> Result<(), TestCaseError> {
+        let Ok(p) = misalign::float::Auto::new(s) else {
+            return Ok(());
+        };
+        if let Ok(answer) = p.friction_from_axial_force(load, phi, force) {
+            let answer = answer.map(f64::from);
+            physical(&answer, f64::MAX, 1.0)?;
+            prop_assert!(answer.value().is_none_or(|v| v >= 0.0));
+        }
+        if let Ok(answer) = p.angle_from_axial_force(load, force) {
+            let phi_max = std::f64::consts::FRAC_PI_2 / s.radius_factor().min(1.0);
+            physical(
+                &answer.map(f64::from),
+                phi_max * (1.0 + 1e-6),
+                f64::from(force),
+            )?;
         }
         Ok(())
     }
@@ -690,24 +776,7 @@ mod properties {
             sign in any::<bool>(), force in any_force(),
         ) {
             let phi = if sign { -phi } else { phi };
-            let phi_max = std::f64::consts::FRAC_PI_2 / s.radius_factor().min(1.0);
-            for answer in [
-                inverse::friction_elliptic(&s, load, phi, force),
-                inverse::friction_line(&s, load, phi, force),
-                inverse::friction_estimate(&s, load, phi, force),
-            ].into_iter().flatten() {
-                if let Some(v) = answer.value() {
-                    prop_assert!(v.is_finite() && v >= 0.0, "{answer:?}");
-                }
-                physical(&answer, f64::MAX, 1.0)?;
-            }
-            for answer in [
-                inverse::angle_elliptic(&s, load, force),
-                inverse::angle_line(&s, load, force),
-                inverse::angle_estimate(&s, load, force),
-            ].into_iter().flatten() {
-                physical(&answer, phi_max, force)?;
-            }
+            reference_answers_are_physical(&s, load, phi, force)?;
         }
 
         #[test]
@@ -716,16 +785,21 @@ mod properties {
             phi in prop_oneof![Just(0.0f32), any::<f32>(), (-1.5f32..1.5)],
             force in prop_oneof![Just(0.0f32), any::<f32>(), (-1e6f32..1e6)],
         ) {
-            let Ok(p) = misalign::float::Auto::new(&s) else { return Ok(()) };
-            if let Ok(answer) = p.friction_from_axial_force(load, phi, force) {
-                let answer = answer.map(f64::from);
-                physical(&answer, f64::MAX, 1.0)?;
-                prop_assert!(answer.value().is_none_or(|v| v >= 0.0));
-            }
-            if let Ok(answer) = p.angle_from_axial_force(load, force) {
-                let phi_max = std::f64::consts::FRAC_PI_2 / s.radius_factor().min(1.0);
-                physical(&answer.map(f64::from), phi_max * (1.0 + 1e-6), f64::from(force))?;
-            }
+            float_answers_are_physical(&s, load, phi, force)?;
+        }
+
+        /// The same over scenes with extreme constants, where mu P, phi0 and the
+        /// Hertz products leave f64 (the phi-inverse once answered `Exact` with a NaN
+        /// there, from 0 x inf in eq 28's `s phi0`).
+        #[test]
+        fn extreme_scenes_never_leave_the_physical_range(
+            s in extreme_scenes(), load in prop_oneof![any_magnitude(), any::<f64>()],
+            phi in prop_oneof![log_uniform(1e-12, 1.5), any::<f64>()],
+            force in any_force(),
+        ) {
+            let Some(s) = s else { return Ok(()) };
+            reference_answers_are_physical(&s, load, phi, force)?;
+            float_answers_are_physical(&s, load as f32, phi as f32, force as f32)?;
         }
 
         #[test]
@@ -782,5 +856,58 @@ fn overflowing_load_per_length_is_refused() {
     assert_eq!(
         inverse::angle_estimate(&ellipse, load, force),
         Err(Error::Load)
+    );
+}
+
+/// Line contact's phi-inverse where mu P and phi0 (eq 28) overflow f64: the answer is
+/// formed without mu (`s phi0 = 2 F / (sqrt(pi (1 - nu) G R P) (1 + sqrt(1 - r)))`),
+/// never `Exact` with the NaN of 0 x inf that it once gave (found by the Python
+/// package's sweep of extreme values: R1 = 1e300, R2 = 1e-300, mu = 1.7e308).
+#[test]
+fn overflowing_critical_angle_gives_an_answer_not_a_nan() {
+    // c underflows to 0: a strip at every phi, R = 1e-300 m. F = 1 N needs
+    // phi = F / sqrt(pi (1 - nu) G R P) ~ 7.6e142 rad: no phi below pi/2 gives it.
+    let s = Scene::new(1e300, 1e-300, 79.3e9, 0.3, 1.7e308).unwrap();
+    let above = Ok(Inverse::Inconsistent(Inconsistency::AboveModel));
+    assert_eq!(s.radius_factor(), 0.0);
+    assert_eq!(inverse::angle_estimate(&s, 1e3, 1.0), above);
+    assert_eq!(inverse::angle_line(&s, 1e3, -1.0), above);
+    // A plane of the paper's steel: mu P = inf and phi0 = inf, F / (mu P) = 0 in f64;
+    // the answer is the no-slip limit F = |phi| sqrt(pi (1 - nu) G R P) solved for phi.
+    let plane = Scene::new(0.05, f64::INFINITY, 79.3e9, 0.3, 1.7e308).unwrap();
+    let (load, force) = (1e3, 1.0);
+    let want = force / (std::f64::consts::PI * 0.7 * 79.3e9 * 0.05 * load).sqrt();
+    for answer in [
+        inverse::angle_line(&plane, load, force),
+        inverse::angle_estimate(&plane, load, force),
+    ] {
+        let Ok(Inverse::Exact { value, sensitivity }) = answer else {
+            panic!("{answer:?}");
+        };
+        assert!(rel_err(value, want) < 1e-15, "{value} vs {want}");
+        assert_eq!(sensitivity, 1.0);
+    }
+    // The same through a length, where only mu P / length overflows (F / (mu P) > 1:
+    // above the model, not a NaN from sqrt(1 - r)).
+    let short = Scene::new(0.3, f64::INFINITY, 5e-2, 0.3, 1e300)
+        .unwrap()
+        .with_length(1e-45)
+        .unwrap();
+    assert_eq!(inverse::angle_estimate(&short, 2e-4, 1.7e308), above);
+}
+
+/// The f32 line inverse refuses a load outside the scene's load range (where phi0 or
+/// mu P leaves f32) with the forward estimate's error, instead of `s phi0 = 0 x inf`.
+#[test]
+fn float_line_inverse_refuses_loads_the_estimate_refuses() {
+    use misalign::float::LineScene;
+    let s = Scene::new(0.05, 1e-45, 1e3, 0.0, 7.93e10).unwrap();
+    let core = LineScene::new(&s).unwrap();
+    let (load, force) = (3.4e38f32, 1.57f32);
+    assert!(load > core.load_range().1, "{:?}", core.load_range());
+    assert_eq!(core.estimate(load, 1e-3), Err(Error::OutOfRange));
+    assert_eq!(
+        core.angle_from_axial_force(load, force),
+        Err(Error::OutOfRange)
     );
 }

@@ -8,16 +8,14 @@
 
 mod plot;
 
-use misalign_cli::monitor_events as events;
 use misalign_cli::monitor_input as input;
+use misalign_cli::monitor_output::{self as output, ThresholdRow};
 
 use clap::{Parser, ValueEnum};
 use misalign::Estimator;
 use misalign::fixed::FixedAuto;
 use misalign::float::Auto;
-use misalign::monitor::{
-    Config, Event, EventKind, Monitor, RiskState, Sample, Thresholds, scenario,
-};
+use misalign::monitor::{Config, Event, EventKind, Monitor, RiskState, Sample, scenario};
 use std::error::Error;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -271,67 +269,6 @@ fn summary<E: Estimator>(m: &Monitor<E>) {
     );
 }
 
-/// The misalignment (rad) at which d/b reaches `target` at `load`, by bisection
-/// (d/b grows with |phi|); `None` if it does not below `hi`.
-fn angle_for_slip_ratio<E: Estimator>(core: &E, load: f32, target: f32, hi: f32) -> Option<f32> {
-    let s = |phi: f32| core.estimate_si(load, phi).ok().map(|e| e.slip_ratio);
-    if s(hi)? < target {
-        return None;
-    }
-    let (mut lo, mut hi) = (0.0f32, hi);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if s(mid)? < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    Some(hi)
-}
-
-/// Rows of the thresholds table: P, phi0, and where each state triggers and clears.
-pub type ThresholdRow = [f64; 6];
-
-fn thresholds<E: Estimator>(core: &E, config: &Config, load_max: f32) -> Vec<ThresholdRow> {
-    let n = 60;
-    (1..=n)
-        .filter_map(|i| {
-            let load = config.stop_load + (load_max - config.stop_load) * i as f32 / n as f32;
-            let phi0 = core.estimate_si(load, 0.0).ok()?.critical_angle?;
-            let at = |x: f32| -> f64 {
-                let phi = match config.thresholds {
-                    Thresholds::SlipRatio { .. } => {
-                        angle_for_slip_ratio(core, load, x, config.angle_max)
-                    }
-                    Thresholds::Margin { .. } => Some(phi0 - x).filter(|p| *p >= 0.0),
-                };
-                phi.map_or(f64::NAN, f64::from)
-            };
-            let (w, a, d) = match config.thresholds {
-                Thresholds::SlipRatio {
-                    warning,
-                    alarm,
-                    deadband,
-                } => (warning, alarm, deadband),
-                Thresholds::Margin {
-                    warning,
-                    alarm,
-                    deadband,
-                } => (warning, alarm, -deadband),
-            };
-            Some([
-                f64::from(load),
-                f64::from(phi0),
-                at(w),
-                at(w - d),
-                at(a),
-                at(a - d),
-            ])
-        })
-        .collect()
-}
-
 fn run<E: Estimator>(
     core: E,
     step: Step<E>,
@@ -351,11 +288,7 @@ fn run<E: Estimator>(
             .collect();
         loads.sort_by(f32::total_cmp);
         let load_max = loads.get(loads.len() * 999 / 1000).copied().unwrap_or(0.0) * 1.2;
-        thresholds(
-            &core,
-            &config,
-            load_max.min(config.load_max).max(2.0 * config.stop_load),
-        )
+        output::threshold_rows(&core, &config, load_max)
     });
     let monitor = Monitor::new(core, config).map_err(|e| format!("configuration: {e}"))?;
     if builtin {
@@ -367,11 +300,7 @@ fn run<E: Estimator>(
     let r = replay(monitor, step, samples.into_iter(), total);
     summary(&r.monitor);
     if let Some(path) = &args.events {
-        let mut out = String::from(events::HEADER);
-        for e in &r.events {
-            out += &events::event_row(e);
-            out.push('\n');
-        }
+        let out = output::events_csv(&r.events);
         std::fs::write(path, out)?;
         eprintln!("wrote {}", path.display());
     }
@@ -380,22 +309,7 @@ fn run<E: Estimator>(
         eprintln!("wrote {}", path.display());
     }
     if let (Some(path), Some(table)) = (&args.thresholds, table) {
-        let mut out =
-            String::from("P,phi0,phi_warning,phi_warning_clear,phi_alarm,phi_alarm_clear\n");
-        for row in &table {
-            let cells: Vec<String> = row
-                .iter()
-                .map(|x| {
-                    if x.is_nan() {
-                        String::new()
-                    } else {
-                        x.to_string()
-                    }
-                })
-                .collect();
-            out += &cells.join(",");
-            out.push('\n');
-        }
+        let out = output::thresholds_csv(&table);
         std::fs::write(path, out)?;
         eprintln!("wrote {}", path.display());
         if let Some(plot_path) = &args.plot {

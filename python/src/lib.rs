@@ -7,11 +7,12 @@ use misalign::batch::{self, Column, Details, Inputs, Model, Outputs};
 use misalign::fixed::{FixedAuto, FixedEllipticScene};
 use misalign::float::Auto;
 use misalign::monitor::{
-    Config, Event, EventKind, Monitor, RiskState, Sample, Thresholds, model_for_range, scenario,
+    Config, Event, Monitor, Reading, RiskState, Sample, Thresholds, model_for_range, scenario,
 };
 use misalign::reference::ModelChoice;
 use misalign::reference::inverse::{self, Inverse};
 use misalign::{Error, Estimator, Scene};
+use misalign_cli::monitor_output as output;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -265,10 +266,6 @@ fn solve_row(
     answer.map_err(text)
 }
 
-/// The message of an inverse whose arithmetic gave no number.
-const NO_FINITE_ANSWER: &str = "no finite answer: the inverse overflows or underflows \
-    for these scene constants";
-
 /// The friction of the mu-inverse's scenes: `Scene::new` needs one; the inverse does
 /// not read it.
 const PLACEHOLDER_FRICTION: f64 = 1.0;
@@ -358,14 +355,6 @@ fn solve<'py>(
                     phi,
                     at(&cols[8], i),
                 )
-            });
-            // An answer without a finite number (scene constants so extreme that the
-            // inverse's arithmetic overflows) is said, never a silent NaN.
-            let answer = answer.and_then(|a| match a.value() {
-                Some(v) if v.is_nan() || a.sensitivity().is_some_and(f64::is_nan) => {
-                    Err(NO_FINITE_ANSWER.to_string())
-                }
-                _ => Ok(a),
             });
             match answer {
                 Ok(a) => {
@@ -555,60 +544,30 @@ struct EventColumns {
 }
 
 impl EventColumns {
+    /// The event's cells of the monitor example's `--events` row, NaN for an empty
+    /// number.
     fn push(&mut self, e: &Event) {
-        let r = &e.reading;
-        let opt = |x: Option<f32>| x.map_or(f64::NAN, f64::from);
-        let (state, from, kind, fault, ttc, reading) = match e.kind {
-            EventKind::StateChange { from, to, fault } => (
-                to.as_str().to_string(),
-                from.as_str().to_string(),
-                "state",
-                fault.map_or(String::new(), |f| format!("{f:?}")),
-                f64::NAN,
-                true,
-            ),
-            EventKind::Approaching { time_to_critical_s } => (
-                String::new(),
-                String::new(),
-                "approaching",
-                String::new(),
-                f64::from(time_to_critical_s),
-                true,
-            ),
-            // The filtered mu in the state column, no reading (as the example writes).
-            EventKind::Friction { mu, changed } => (
-                format!("mu={mu}"),
-                String::new(),
-                if changed {
-                    "friction_changed"
-                } else {
-                    "friction_cleared"
-                },
-                String::new(),
-                f64::NAN,
-                false,
-            ),
+        let rec = output::event_record(e);
+        let num =
+            |f: fn(&Reading) -> f32| rec.reading.as_ref().map_or(f64::NAN, |r| f64::from(f(r)));
+        let opt = |f: fn(&Reading) -> Option<f32>| {
+            rec.reading.as_ref().and_then(f).map_or(f64::NAN, f64::from)
         };
-        let num = |x: f32| if reading { f64::from(x) } else { f64::NAN };
-        self.t.push(e.elapsed_ms as f64 / 1e3);
-        self.seq.push(e.seq);
-        self.state.push(state);
-        self.from.push(from);
-        self.kind.push(kind);
-        self.fault.push(fault);
-        self.load.push(num(r.load));
-        self.phi.push(num(r.phi));
-        self.s.push(num(r.slip_ratio));
-        self.force.push(num(r.axial_force));
-        self.phi0.push(if reading {
-            opt(r.critical_angle)
-        } else {
-            f64::NAN
-        });
-        self.margin
-            .push(if reading { opt(r.margin) } else { f64::NAN });
-        self.time_to_critical.push(ttc);
-        self.time_ms.push(e.time_ms);
+        self.t.push(rec.t);
+        self.seq.push(rec.seq);
+        self.load.push(num(|r| r.load));
+        self.phi.push(num(|r| r.phi));
+        self.s.push(num(|r| r.slip_ratio));
+        self.force.push(num(|r| r.axial_force));
+        self.phi0.push(opt(|r| r.critical_angle));
+        self.margin.push(opt(|r| r.margin));
+        self.time_to_critical
+            .push(rec.time_to_critical_s.map_or(f64::NAN, f64::from));
+        self.time_ms.push(rec.time_ms);
+        self.state.push(rec.state);
+        self.from.push(rec.from.to_string());
+        self.kind.push(rec.kind);
+        self.fault.push(rec.fault);
     }
 }
 
@@ -797,65 +756,6 @@ fn summary<'py, E: Estimator>(py: Python<'py>, m: &Monitor<E>) -> PyResult<Bound
     Ok(d)
 }
 
-/// The misalignment (rad) at which d/b reaches `target` at `load`, by bisection
-/// (d/b grows with |phi|); `None` if it does not below `hi`.
-fn angle_for_slip_ratio<E: Estimator>(core: &E, load: f32, target: f32, hi: f32) -> Option<f32> {
-    let s = |phi: f32| core.estimate_si(load, phi).ok().map(|e| e.slip_ratio);
-    if s(hi)? < target {
-        return None;
-    }
-    let (mut lo, mut hi) = (0.0f32, hi);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if s(mid)? < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    Some(hi)
-}
-
-/// The planner's rows: P, phi0 and where each state is raised and cleared, over 60
-/// loads from the stop load to `load_max`.
-fn planner_rows<E: Estimator>(core: &E, config: &Config, load_max: f32) -> Vec<[f64; 6]> {
-    let n = 60;
-    let (w, a, d, slip) = match config.thresholds {
-        Thresholds::SlipRatio {
-            warning,
-            alarm,
-            deadband,
-        } => (warning, alarm, deadband, true),
-        Thresholds::Margin {
-            warning,
-            alarm,
-            deadband,
-        } => (warning, alarm, -deadband, false),
-    };
-    (1..=n)
-        .filter_map(|i| {
-            let load = config.stop_load + (load_max - config.stop_load) * i as f32 / n as f32;
-            let phi0 = core.estimate_si(load, 0.0).ok()?.critical_angle?;
-            let at = |x: f32| -> f64 {
-                let phi = if slip {
-                    angle_for_slip_ratio(core, load, x, config.angle_max)
-                } else {
-                    Some(phi0 - x).filter(|p| *p >= 0.0)
-                };
-                phi.map_or(f64::NAN, f64::from)
-            };
-            Some([
-                f64::from(load),
-                f64::from(phi0),
-                at(w),
-                at(w - d),
-                at(a),
-                at(a - d),
-            ])
-        })
-        .collect()
-}
-
 /// The threshold planner over loads up to `load_max` (N); `trace_load_max` the
 /// trace's operating range for the model choice, as the replay makes it.
 #[pyfunction]
@@ -872,15 +772,14 @@ fn thresholds(
     let scene = scene_of(scene, length)?;
     let config = config_of(config)?;
     let choice = choice_for(&scene, trace_load_max)?;
-    let load_max = load_max.min(config.load_max).max(2.0 * config.stop_load);
     match model {
         "f32" => {
             let core = Auto::with_choice(&scene, choice).map_err(value_error)?;
-            Ok(py.detach(|| planner_rows(&core, &config, load_max)))
+            Ok(py.detach(|| output::threshold_rows(&core, &config, load_max)))
         }
         "fixed" => {
             let core = fixed_core(&scene, choice).map_err(value_error)?;
-            Ok(py.detach(|| planner_rows(&core, &config, load_max)))
+            Ok(py.detach(|| output::threshold_rows(&core, &config, load_max)))
         }
         _ => Err(value_error(format!(
             "model must be 'f32' or 'fixed', not {model:?}"

@@ -273,11 +273,17 @@ impl LineScene {
     /// `r = F/(mu P)` (eq 27), `phi = s phi0` (eqs 23, 28).
     ///
     /// # Errors
-    /// [`Error::Load`], [`Error::Force`].
+    /// [`Error::Load`], [`Error::Force`]; [`Error::OutOfRange`] for a load outside
+    /// [`LineScene::load_range`], as [`LineScene::estimate`].
     pub fn angle_from_axial_force(&self, load: f32, force: f32) -> Result<Inverse<f32>, Error> {
         check_force(load, 0.0, force)?;
         if let Some(answer) = angle_decided(load, force, 1.0) {
             return Ok(answer);
+        }
+        // Refused as the forward estimate refuses it: outside the load range, phi0 or
+        // mu P leaves f32 (phi0 = inf times s = 0 would give a NaN).
+        if !self.load_in_range(load) {
+            return Err(Error::OutOfRange);
         }
         let saturated = self.friction * (load * 1.0);
         let abs_force = force.abs();

@@ -126,7 +126,7 @@ impl LineScene {
     pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
         // One unsigned compare on the bits: load outside the scene's range (0, negative,
         // NaN and inf included) goes to the cold path, which sorts them out.
-        if load.to_bits().wrapping_sub(self.load_min_bits) > self.load_span_bits {
+        if !self.load_in_range(load) {
             return self.outside_load(load, phi);
         }
         let abs_phi = phi.abs();
@@ -146,6 +146,13 @@ impl LineScene {
             abs_phi,
             self.risk_slip_ratio,
         ))
+    }
+
+    /// Whether `load` lies in [`LineScene::load_range`]: one unsigned compare on the
+    /// bits (0, negative, NaN and inf are outside).
+    #[inline(always)]
+    pub(super) fn load_in_range(&self, load: f32) -> bool {
+        load.to_bits().wrapping_sub(self.load_min_bits) <= self.load_span_bits
     }
 
     /// Loads outside [`LineScene::load_range`]: bad input, zero load (d/b = inf at

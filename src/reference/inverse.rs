@@ -62,6 +62,8 @@
 //! model; two answers (the map is not monotone across the switch) give the smaller as
 //! a lower bound.
 
+use super::chain::chain;
+use super::line::SQRT_PI;
 use super::{ContactModel, line as strip, solve, tangential};
 use crate::{Error, Scene, ThetaRelation};
 use core::f64::consts::{FRAC_PI_2, PI};
@@ -530,15 +532,53 @@ fn angle_line_below(
         scene.friction(),
     );
     let saturated = saturated * length;
-    if force > saturated * (1.0 + ROUNDING_ABOVE_SATURATION) {
+    // r = F / (mu P), and whether F exceeds or reaches mu P: as the forward solution
+    // forms mu P, or factor by factor where that overflows (mu P beyond f64, or only
+    // mu P / length, with F finite).
+    let (r, above, at) = if saturated.is_finite() {
+        (
+            force / saturated,
+            force > saturated * (1.0 + ROUNDING_ABOVE_SATURATION),
+            force >= saturated,
+        )
+    } else {
+        let r = chain(&[force], &[scene.friction(), load, length]);
+        (r, r > 1.0 + ROUNDING_ABOVE_SATURATION, r >= 1.0)
+    };
+    if above {
         return Inverse::Inconsistent(Inconsistency::AboveModel);
     }
-    if force >= saturated {
-        return Inverse::AtLeast { value: phi0 };
+    if at {
+        // Gross slip needs |phi| >= phi0; the forward solution takes |phi| < pi/2 only
+        // (phi0 overflows to inf where mu or P / R is extreme).
+        return if phi0 < FRAC_PI_2 {
+            Inverse::AtLeast { value: phi0 }
+        } else {
+            Inverse::Inconsistent(Inconsistency::AboveModel)
+        };
     }
-    let r = force / saturated;
     let s = r / (1.0 + libm::sqrt(1.0 - r)); // eq (27): 2 s - s^2 = r
-    let phi = s * phi0; // eqs (23), (28): s = |phi| / phi0
+    // eqs (23), (28): |phi| = s phi0 = r phi0 / (1 + sqrt(1 - r)), and
+    // r phi0 = 2 (F / length) / sqrt(pi (1 - nu) G R P) holds no mu: formed so, the
+    // product s phi0 cannot be 0 x inf (mu P overflowing to inf, so r = 0, while phi0
+    // overflows too). F / length as the line inverse per unit length has it, or
+    // factor by factor where it overflows.
+    let sq = libm::sqrt;
+    let stiffness = [
+        SQRT_PI,
+        sq(1.0 - scene.poisson_ratio()),
+        sq(scene.shear_modulus()),
+        sq(scene.effective_radius()),
+        sq(load),
+    ];
+    let force_per_length = force / length;
+    let r_phi0 = if force_per_length.is_finite() {
+        chain(&[2.0, force_per_length], &stiffness)
+    } else {
+        let [a, b, c, d, e] = stiffness;
+        chain(&[2.0, force], &[a, b, c, d, e, length])
+    };
+    let phi = r_phi0 / (1.0 + sq(1.0 - r));
     if phi > FRAC_PI_2 {
         return Inverse::Inconsistent(Inconsistency::AboveModel);
     }

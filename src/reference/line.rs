@@ -4,7 +4,7 @@
 use super::chain::chain;
 use core::f64::consts::PI;
 
-const SQRT_PI: f64 = 1.772_453_850_905_516;
+pub(super) const SQRT_PI: f64 = 1.772_453_850_905_516;
 
 /// Half-width of the contact strip `b = sqrt(4 P (1 - nu) R / (pi G))` (eq 22), m.
 pub fn half_width(load: f64, nu: f64, g_modulus: f64, radius: f64) -> f64 {

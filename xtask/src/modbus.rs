@@ -515,7 +515,7 @@ mod host {
     use misalign::modbus::{Server, ServerConfig, crc16, event_from_registers};
     use misalign::monitor::scenario::{self, Scenario};
     use misalign::monitor::{Config, Event, Monitor, Sample};
-    use misalign_cli::monitor_events::event_row;
+    use misalign_cli::monitor_output::event_row;
     use std::fmt::Write as _;
     use std::path::Path;
 
@@ -683,7 +683,7 @@ mod host {
                 differences.join("\n  ")
             ));
         }
-        let mut csv = String::from(misalign_cli::monitor_events::HEADER);
+        let mut csv = format!("{}\n", misalign_cli::monitor_output::EVENTS_HEADER);
         for row in &got {
             csv += row;
             csv.push('\n');
