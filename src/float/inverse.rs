@@ -15,10 +15,9 @@
 //! Newton steps on the existing tables rather than new inverse tables: the kernel
 //! inverse is within 2e-7 of the f64 inverse (times its conditioning) with no new table
 //! bytes, and `theta(g)` is the table the forward path links anyway; new tables were
-//! not built, as this leaves nothing for them to gain in accuracy. Cost (`cargo xtask
-//! bench --short`, instructions per call, mean / max over the practical samples):
-//! mu 184 / 373 and phi 211 / 364 on the Cortex-M4F (the forward estimate: 148 / 174),
-//! line contact 88 / 101 and 72 / 92.
+//! not built, as this leaves nothing for them to gain in accuracy. Cost: `cargo xtask
+//! bench` measures the inverses beside the forward estimate on every Cortex-M core
+//! (instructions per call, docs/measurements.md).
 //!
 //! Error bound (tested in tests/inverse.rs over the public reference scenes, inputs
 //! rounded to f32, forward in f32 then inverse in f32): mu and phi within 2e-6 relative
