@@ -317,15 +317,22 @@ fn venv() -> Result<PathBuf, String> {
     Ok(python)
 }
 
-/// The whole test: both cores, both sample sources.
-fn tests(boards: bool) -> Result<(), String> {
-    let start = Instant::now();
+/// What every QEMU run needs: the tools, the venv's python, the work folder
+/// (target/modbus) and the register map written into it for the tests to read.
+fn prepare() -> Result<(PathBuf, PathBuf, PathBuf), String> {
     crate::tools::preflight()?;
     let python = venv()?;
     let dir = crate::root().join("target/modbus");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let registers = dir.join("registers.csv");
     std::fs::write(&registers, registers_text()?).map_err(|e| e.to_string())?;
+    Ok((python, dir, registers))
+}
+
+/// The whole test: both cores, both sample sources.
+fn tests(boards: bool) -> Result<(), String> {
+    let start = Instant::now();
+    let (python, dir, registers) = prepare()?;
     let mut failures = Vec::new();
     let mut nodes: Vec<Node> = ["cortex-m4f", "cortex-m0"]
         .iter()
@@ -466,12 +473,7 @@ fn trace(
         }
         _ => {}
     }
-    crate::tools::preflight()?;
-    let python = venv()?;
-    let dir = crate::root().join("target/modbus");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let registers = dir.join("registers.csv");
-    std::fs::write(&registers, registers_text()?).map_err(|e| e.to_string())?;
+    let (python, dir, registers) = prepare()?;
     let samples_csv = dir.join("trace-samples.csv");
     host::write_samples(&samples_csv, &samples)?;
     let elf = build(&Node::on(cpu, true))?;
