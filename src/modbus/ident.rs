@@ -3,7 +3,7 @@
 //! by category (codes 1 to 3: basic, regular, extended, which adds nothing here) and
 //! individual access (code 4). Conformity level 0x82.
 
-use super::pdu::Exception;
+use super::exception::Exception;
 
 /// What the node says it is (function 43/14). Each object is sent as is; one longer
 /// than 240 bytes is cut there (an object must fit one response).

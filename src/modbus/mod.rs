@@ -73,6 +73,7 @@
 
 mod crc;
 mod events;
+mod exception;
 mod ident;
 #[cfg(feature = "embedded-io")]
 mod io;
@@ -84,9 +85,9 @@ mod values;
 pub use crate::monitor::annunciation::{AlarmSet, Annunciator};
 pub use crc::crc16;
 pub use events::EVENT_WINDOW;
+pub use exception::Exception;
 pub use ident::Identification;
 pub use map::registers_csv;
-pub use pdu::Exception;
 pub use rtu::{ADU_MAX, FramingCounters};
 pub use values::{DecodeError, event_from_registers, fault_code, fault_from_code};
 
