@@ -7,7 +7,8 @@ use misalign::batch::{self, Column, Details, Inputs, Model, Outputs};
 use misalign::fixed::{FixedAuto, FixedEllipticScene};
 use misalign::float::Auto;
 use misalign::monitor::{
-    Config, Event, Monitor, Reading, RiskState, Sample, Thresholds, model_for_range, scenario,
+    Config, Event, FaultCounts, Monitor, Reading, RiskState, Sample, Thresholds, model_for_range,
+    scenario,
 };
 use misalign::reference::ModelChoice;
 use misalign::reference::inverse::{self, Inverse};
@@ -731,18 +732,8 @@ fn summary<'py, E: Estimator>(py: Python<'py>, m: &Monitor<E>) -> PyResult<Bound
     d.set_item("repeated_timestamps", s.repeated_timestamps())?;
     d.set_item("spikes", s.spikes())?;
     d.set_item("events_dropped", s.events_dropped())?;
-    let f = s.faults();
     let faults = PyDict::new(py);
-    for (name, n) in [
-        ("non_finite", f.non_finite),
-        ("out_of_range", f.out_of_range),
-        ("stuck", f.stuck),
-        ("gap", f.gap),
-        ("time_backwards", f.time_backwards),
-        ("driver", f.driver),
-        ("estimator", f.estimator),
-        ("sensor", f.sensor),
-    ] {
+    for (name, n) in FaultCounts::CAUSES.iter().zip(s.faults().by_cause()) {
         faults.set_item(name, n)?;
     }
     d.set_item("faults", faults)?;

@@ -335,22 +335,12 @@ impl<E: Estimator> Core<E> {
             Field::Spikes => s.spikes(),
             Field::EventsDropped => s.events_dropped().saturating_add(self.events.dropped),
             Field::EventSeqNext => m.next_event_seq(),
-            Field::Faults(i) => {
-                let f = s.faults();
-                [
-                    f.non_finite,
-                    f.out_of_range,
-                    f.stuck,
-                    f.gap,
-                    f.time_backwards,
-                    f.driver,
-                    f.estimator,
-                    f.sensor,
-                ]
+            Field::Faults(i) => s
+                .faults()
+                .by_cause()
                 .get(usize::from(i))
                 .copied()
-                .unwrap_or(0)
-            }
+                .unwrap_or(0),
             Field::TimeInState(i) => per_state(i).map_or(0, |state| {
                 u32::try_from(s.time_in_state_ms(state) / 1000).unwrap_or(u32::MAX)
             }),

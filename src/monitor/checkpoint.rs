@@ -407,17 +407,7 @@ fn put_stats(w: &mut Writer<'_>, s: &Statistics) -> Result<(), CodecError> {
     w.u64(s.samples)?;
     w.u32(s.repeated_timestamps)?;
     w.u32(s.spikes)?;
-    let f = &s.faults;
-    for c in [
-        f.non_finite,
-        f.out_of_range,
-        f.stuck,
-        f.gap,
-        f.time_backwards,
-        f.driver,
-        f.estimator,
-        f.sensor,
-    ] {
+    for c in s.faults.by_cause() {
         w.u32(c)?;
     }
     w.u32(s.events_dropped)?;

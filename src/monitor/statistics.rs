@@ -58,8 +58,21 @@ impl FaultCounts {
         *c = c.saturating_add(1);
     }
 
-    /// All faults.
-    pub fn total(&self) -> u64 {
+    /// The causes' names, in the order of [`FaultCounts::by_cause`] (the order of the
+    /// checkpoint record, the Modbus registers and the PC tools' columns).
+    pub const CAUSES: [&'static str; 8] = [
+        "non_finite",
+        "out_of_range",
+        "stuck",
+        "gap",
+        "time_backwards",
+        "driver",
+        "estimator",
+        "sensor",
+    ];
+
+    /// The counts in the order of [`FaultCounts::CAUSES`].
+    pub fn by_cause(&self) -> [u32; 8] {
         [
             self.non_finite,
             self.out_of_range,
@@ -70,9 +83,11 @@ impl FaultCounts {
             self.estimator,
             self.sensor,
         ]
-        .iter()
-        .map(|&c| u64::from(c))
-        .sum()
+    }
+
+    /// All faults.
+    pub fn total(&self) -> u64 {
+        self.by_cause().iter().map(|&c| u64::from(c)).sum()
     }
 }
 
