@@ -18,6 +18,7 @@
 #![no_std]
 
 pub mod io;
+pub mod node_samples;
 mod panic;
 pub mod prepared;
 pub mod shapes;

@@ -15,22 +15,11 @@
 
 use misalign::Estimator;
 use misalign::monitor::{Config, Event, EventKind, Monitor, Sample};
+use misalign_harness::node_samples::{ANGLES, LOADS, SAMPLES};
 use misalign_harness::{io, prepared, support};
 use misalign_logger as _;
 
 misalign_harness::exit_on_panic!();
-
-/// The load sensor's samples (N), one a second, repeating: about 2.5 kN.
-static LOADS: [f32; 8] = [
-    2410.0, 2530.0, 2475.0, 2610.0, 2555.0, 2420.0, 2490.0, 2535.0,
-];
-/// The misalignment (rad), one step a minute: a drift through the critical angle
-/// (about 0.5 mrad at this load) and back.
-static ANGLES: [f32; 8] = [
-    1.0e-4, 2.5e-4, 4.0e-4, 4.6e-4, 5.5e-4, 7.0e-4, 8.0e-4, 2.0e-4,
-];
-/// Eight minutes of samples.
-const SAMPLES: u32 = 480;
 
 #[cortex_m_rt::entry]
 fn main() -> ! {

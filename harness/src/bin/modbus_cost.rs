@@ -20,7 +20,7 @@
 
 use core::hint::black_box;
 use misalign::Estimator;
-use misalign::modbus::{Server, ServerConfig, crc16};
+use misalign::modbus::{Server, ServerConfig, crc16, map};
 use misalign::monitor::{Config, Monitor, Sample};
 use misalign_harness::prepared;
 use misalign_harness::support::{
@@ -33,11 +33,10 @@ misalign_harness::log_panics_and_faults!();
 
 /// Repetitions of each request.
 const REPS: u32 = 16;
-/// Records in the function-16 write: the most one write carries.
-const RECORDS: usize = 20;
-/// Registers per basic external sample (time, P, phi) and the block's first address.
-const STRIDE: usize = 6;
-const SAMPLES_ADDRESS: u16 = 7;
+/// Records in the function-16 write: the most one write carries (the map's block).
+const RECORDS: usize = map::SAMPLES as usize;
+/// Registers per basic external sample (time, P, phi).
+const STRIDE: usize = map::SAMPLE_STRIDE as usize;
 /// The function-16 request: 7 header bytes, the records, the CRC.
 const WRITE_LEN: usize = 7 + 2 * STRIDE * RECORDS + 2;
 
@@ -122,7 +121,8 @@ fn run<E: Estimator>(c: &Counter, core: E) -> i32 {
     let write = |t0: u32, out: &mut [u8]| {
         let mut body = [0u8; WRITE_LEN - 2];
         let quantity = (STRIDE * RECORDS) as u16;
-        body[..7].copy_from_slice(&[1, 16, 0, SAMPLES_ADDRESS as u8, 0, quantity as u8, 0]);
+        let [hi, lo] = map::SAMPLES_ADDRESS.to_be_bytes();
+        body[..7].copy_from_slice(&[1, 16, hi, lo, 0, quantity as u8, 0]);
         body[6] = (2 * quantity) as u8;
         for (i, record) in body[7..].chunks_exact_mut(2 * STRIDE).enumerate() {
             let s = sample(t0 + 1000 * (i as u32 + 1));

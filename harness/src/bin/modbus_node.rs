@@ -32,17 +32,9 @@ use misalign_logger as _;
 #[path = "../../../examples/firmware/uart.rs"]
 mod uart;
 
-misalign_harness::exit_on_panic!();
+use misalign_harness::node_samples::{ANGLES, LOADS, SAMPLES};
 
-/// `minimal_node`'s samples: about 2.5 kN, a misalignment drifting through the
-/// critical angle and back, one sample a second.
-static LOADS: [f32; 8] = [
-    2410.0, 2530.0, 2475.0, 2610.0, 2555.0, 2420.0, 2490.0, 2535.0,
-];
-static ANGLES: [f32; 8] = [
-    1.0e-4, 2.5e-4, 4.0e-4, 4.6e-4, 5.5e-4, 7.0e-4, 8.0e-4, 2.0e-4,
-];
-const SAMPLES: u32 = 480;
+misalign_harness::exit_on_panic!();
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
