@@ -6,5 +6,7 @@
 //! host benchmark and the fuzz targets call the same functions in-process.
 
 pub mod estimate;
+pub mod monitor;
 pub mod monitor_input;
 pub mod monitor_output;
+pub mod table;
