@@ -92,9 +92,17 @@ fn a_step_beyond_the_wrapping_counter_is_refused() {
     let e = input::read_trace(back.as_bytes()).unwrap_err().to_string();
     assert!(e.starts_with("row 3: t steps back"), "{e}");
     let mut clock = input::TraceClock::new();
-    clock.time_ms(0.0).unwrap();
-    assert_eq!(clock.time_ms(2_147_483.647), Ok((1 << 31) - 1));
-    assert!(clock.time_ms(4_294_967.295).is_err());
+    clock.time_ms(-1.0).unwrap();
+    assert_eq!(clock.time_ms(2_147_482.647), Ok((1 << 31) - 1001));
+    assert!(clock.time_ms(-1.001).is_err());
+    // Times within the counter's range are the counter: a wrap goes on, as on the node.
+    let wrap = "t,P,phi\n4294966,2000,1e-4\n4294967.2,2000,1e-4\n0.8,2000,1e-4\n";
+    let times: Vec<u32> = input::read_trace(wrap.as_bytes())
+        .unwrap()
+        .iter()
+        .map(|s| s.time_ms)
+        .collect();
+    assert_eq!(times, [4_294_966_000, 4_294_967_200, 800]);
 }
 
 /// The estimator's rules: a repeated column is named, a ';'-separated file is read

@@ -74,7 +74,9 @@ pub fn scene_and_delimiter(file: impl Read) -> Res<(Scene, u8)> {
 /// monitor would misread: a time beyond 2^53 ms (where f64 no longer tells ms apart,
 /// and `as i64` would saturate), and a step of 2^31 ms (24.8 days) or more between
 /// consecutive times, which the counter, taken modulo 2^32 ms, would turn into a
-/// shorter step or a step back.
+/// shorter step or a step back. Times that both lie in the counter's own range
+/// (0 to 2^32 ms) are read as the counter itself, as the node reads it: a wrap is a
+/// step forward, a larger step back a reset.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct TraceClock {
     last_ms: Option<i64>,
@@ -113,7 +115,10 @@ impl TraceClock {
         }
         // Exact: |ms| <= 2^53.
         let ms = ms.round() as i64;
-        if let Some(last) = self.last_ms {
+        let counter = |ms: i64| (0..1 << 32).contains(&ms);
+        if let Some(last) = self.last_ms
+            && !(counter(last) && counter(ms))
+        {
             let step = ms - last;
             if step.abs() > STEP_LIMIT_MS {
                 return Err(format!(

@@ -39,7 +39,8 @@ TRACE: a row without a usable time (t empty, not a number or not finite; a field
     finite, which the monitor counts as a sensor fault. A time the monitor's clock cannot
     represent refuses the trace before the replay, naming the row: beyond 2^53 ms (t in
     ns, say), or a step of 2^31 ms (24.8 days) or more between rows, which the node's
-    wrapping u32 millisecond counter cannot tell from a shorter one.
+    wrapping u32 millisecond counter cannot tell from a shorter one. Times within the
+    counter's range (0 to 2^32 ms) are read as the counter: a wrap is a step forward.
 
 FILES: read by the estimator's rules: each column once (a repeated one is an error
     naming it), any order, other columns ignored; a ';'-separated file is read so (said
