@@ -3,6 +3,7 @@
 
 use misalign_cli::monitor;
 use misalign_cli::monitor_input as input;
+use proptest::strategy::Strategy;
 use std::path::PathBuf;
 
 #[test]
@@ -261,4 +262,42 @@ fn help_promises_what_the_reader_does() {
     assert_eq!(code, 0);
     assert!(!out.contains("anything unreadable a sensor fault"), "{out}");
     assert!(out.contains("is skipped"), "{out}");
+}
+
+proptest::proptest! {
+    /// Whatever a row holds, the reader does not panic, and every row is a sample, a
+    /// counted skipped row or blank, unless a time refuses the trace (naming its row).
+    #[test]
+    fn every_row_is_a_sample_or_counted(
+        rows in proptest::collection::vec(
+            proptest::prop_oneof![
+                proptest::collection::vec(proptest::prelude::any::<u8>(), 0..24),
+                "[0-9eE.,;\" naif+-]{0,24}".prop_map(String::into_bytes),
+            ],
+            0..24,
+        )
+    ) {
+        let rows: Vec<Vec<u8>> = rows
+            .into_iter()
+            .map(|r| r.into_iter().filter(|&b| b != b'\n').collect())
+            .collect();
+        let mut csv = b"t,P,phi,V\n".to_vec();
+        for r in &rows {
+            csv.extend_from_slice(r);
+            csv.push(b'\n');
+        }
+        let mut trace = input::Trace::new(&csv[..]).unwrap();
+        let mut samples = 0u64;
+        for s in trace.by_ref() {
+            match s {
+                Ok(_) => samples += 1,
+                Err(e) => {
+                    proptest::prop_assert!(e.starts_with("row "), "{}", e);
+                    return Ok(());
+                }
+            }
+        }
+        let blank = rows.iter().filter(|r| r.iter().all(u8::is_ascii_whitespace)).count();
+        proptest::prop_assert_eq!(samples + trace.skipped().count + blank as u64, rows.len() as u64);
+    }
 }
