@@ -53,7 +53,7 @@ EXIT STATUS: 0; 1 when a file cannot be read, lacks a column or repeats one, the
 /// Replays the built-in scenario (or a trace) through the condition monitor: risk
 /// states, events, wear and time to critical.
 #[derive(Parser, Debug)]
-#[command(name = "monitor", about, long_about = None, after_help = AFTER_HELP)]
+#[command(name = "monitor", long_about = None, after_help = AFTER_HELP)]
 struct Args {
     /// A recorded trace instead of the built-in scenario: CSV with columns `t` (s),
     /// `P` (N), `phi` (rad) and optionally `V` (m/s) and `F` (N); an empty `V` or `F`
