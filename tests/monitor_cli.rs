@@ -127,6 +127,10 @@ fn the_files_are_read_by_the_estimators_rules() {
         .unwrap_err()
         .to_string();
     assert_eq!(e, "row 2: R2: not a number: \"5 cm\"");
+    let e = input::read_scene("R1,R2,G,nu,mu\n0.05,0.05,79.3e9,0.3\n".as_bytes())
+        .unwrap_err()
+        .to_string();
+    assert_eq!(e, "row 2: row has 4 fields, the header 5");
 }
 
 #[test]

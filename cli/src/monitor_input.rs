@@ -55,6 +55,9 @@ pub fn scene_and_delimiter(file: impl Read) -> Res<(Scene, u8)> {
         .ok_or("the scene file has no row")??;
     let line = row.position().map_or(2, |p| p.line());
     let at_row = |m: String| format!("row {line}: {m}");
+    if let Some(m) = table::bad_record(&row, header.len()) {
+        return Err(at_row(m).into());
+    }
     let get = |k: usize| table::number(SCENE[k], row.get(at[k]).unwrap_or(b"")).map_err(at_row);
     let scene = Scene::new(get(0)?, get(1)?, get(2)?, get(3)?, get(4)?)
         .map_err(|e| at_row(e.to_string()))?;

@@ -33,6 +33,25 @@ pub fn number(name: &str, field: &[u8]) -> Result<f64, String> {
     Ok(x)
 }
 
+/// What is wrong with a row's bytes, if anything, before its numbers are read.
+pub fn bad_record(record: &csv::ByteRecord, fields: usize) -> Option<String> {
+    if record.len() != fields {
+        return Some(format!(
+            "row has {} fields, the header {fields}",
+            record.len()
+        ));
+    }
+    for (k, field) in record.iter().enumerate() {
+        if field.contains(&0) {
+            return Some(format!("field {} holds a NUL byte", k + 1));
+        }
+        if std::str::from_utf8(field).is_err() {
+            return Some(format!("field {} is not UTF-8", k + 1));
+        }
+    }
+    None
+}
+
 /// Whether a field is empty (or only blanks): an optional cell left unset.
 pub fn is_blank(field: &[u8]) -> bool {
     field.iter().all(u8::is_ascii_whitespace)

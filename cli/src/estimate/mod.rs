@@ -545,25 +545,6 @@ fn find_columns(
     Ok((columns, optional[0]))
 }
 
-/// What is wrong with a row's bytes, if anything, before its numbers are read.
-fn bad_record(record: &csv::ByteRecord, fields: usize) -> Option<String> {
-    if record.len() != fields {
-        return Some(format!(
-            "row has {} fields, the header {fields}",
-            record.len()
-        ));
-    }
-    for (k, field) in record.iter().enumerate() {
-        if field.contains(&0) {
-            return Some(format!("field {} holds a NUL byte", k + 1));
-        }
-        if std::str::from_utf8(field).is_err() {
-            return Some(format!("field {} is not UTF-8", k + 1));
-        }
-    }
-    None
-}
-
 /// The header `row` is written under, alone (an input with no data row): the row
 /// serialised into a scratch writer, whose first record is the header.
 fn write_header<W: Write, R: Serialize>(
@@ -662,7 +643,7 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
             if to_the_end && rest.iter().filter(|&&b| b == b'"').count() % 2 == 1 {
                 message.push_str("unterminated quote: the row runs to the end of the input");
                 restart = rest.iter().position(|&b| b == b'\n').map(|i| start + i + 1);
-            } else if let Some(m) = bad_record(&record, header.len()) {
+            } else if let Some(m) = table::bad_record(&record, header.len()) {
                 message.push_str(&m);
             }
             let readable = message.is_empty();
