@@ -305,3 +305,76 @@ proptest::proptest! {
         proptest::prop_assert_eq!(samples + trace.skipped().count + blank as u64, rows.len() as u64);
     }
 }
+
+/// The peak resident memory (kB) of a replay of `rows` rows with every output, in a
+/// child process: this test binary running `replay_child` alone.
+#[cfg(target_os = "linux")]
+fn peak_kb(rows: u64) -> u64 {
+    let out = std::process::Command::new(std::env::current_exe().unwrap())
+        .args(["--exact", "replay_child", "--ignored", "--nocapture"])
+        .env("MONITOR_CHILD_ROWS", rows.to_string())
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    text.lines()
+        .find_map(|l| l.strip_prefix("peak_kb "))
+        .and_then(|kb| kb.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no peak in {text}"))
+}
+
+/// Memory flat in the trace's length: four times the rows, with --plot, --thresholds
+/// and --events, costs less than 4 MB more at the peak (keeping every sample and plot
+/// point, some 70 B a row, would cost 10 MB more).
+#[cfg(target_os = "linux")]
+#[test]
+fn the_replays_memory_does_not_grow_with_the_trace() {
+    let (short, long) = (peak_kb(50_000), peak_kb(200_000));
+    assert!(
+        long < short + 4096,
+        "{short} kB for 5e4 rows, {long} kB for 2e5"
+    );
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "run in a child process by the_replays_memory_does_not_grow_with_the_trace"]
+fn replay_child() {
+    use std::io::Write;
+    let rows: u64 = std::env::var("MONITOR_CHILD_ROWS")
+        .unwrap()
+        .parse()
+        .unwrap();
+    let trace = trace_file(&format!("long-{rows}.csv"), b"");
+    let mut w = std::io::BufWriter::new(std::fs::File::create(&trace).unwrap());
+    writeln!(w, "t,P,phi,V,F").unwrap();
+    for i in 0..rows {
+        let x = i as f64;
+        let phi = 1e-4 + 6e-4 * (x / rows as f64);
+        let p = 2500.0 + 40.0 * (x * 0.01).sin();
+        writeln!(w, "{i},{p:.2},{phi:.4e},2.0,{:.1}", 0.15 * p).unwrap();
+    }
+    w.into_inner().unwrap().sync_all().unwrap();
+    let dir = trace.parent().unwrap();
+    let out = |name: &str| dir.join(format!("{rows}-{name}")).display().to_string();
+    let args = [
+        "--trace".to_string(),
+        trace.display().to_string(),
+        "--plot".into(),
+        out("plot.svg"),
+        "--thresholds".into(),
+        out("thresholds.csv"),
+        "--events".into(),
+        out("events.csv"),
+    ];
+    let code = monitor::run(&args, &mut std::io::sink(), &mut std::io::sink(), false);
+    assert_eq!(code, 0);
+    let status = std::fs::read_to_string("/proc/self/status").unwrap();
+    let peak = status.lines().find(|l| l.starts_with("VmHWM:")).unwrap();
+    println!(
+        "peak_kb {}",
+        peak.trim_start_matches("VmHWM:")
+            .trim_end_matches("kB")
+            .trim()
+    );
+}

@@ -13,8 +13,8 @@ const GREEN_: RGBColor = RGBColor(0, 158, 115);
 const VERMILION: RGBColor = RGBColor(213, 94, 0);
 const GREY: RGBColor = RGBColor(150, 150, 150);
 
-/// A step longer than this (h) between plotted points is drawn as a gap.
-const GAP_H: f64 = 60.0 / 3600.0;
+/// A step longer than this (s) between plotted values is drawn as a gap.
+const GAP_S: f64 = 60.0;
 
 /// d/b, margin, F and the state over time (h), events as vertical lines (one per bin of
 /// the timeline and kind).
@@ -26,9 +26,10 @@ pub fn timeline(path: &Path, timeline: &Timeline) -> Res<()> {
     let colours = [BLUE_, GREEN_, ORANGE, VERMILION];
     for (k, (area, (name, colour))) in panels.iter().zip(CURVES.iter().zip(colours)).enumerate() {
         let name = *name;
-        let values: Vec<(f64, f32)> = timeline.curve(k).map(|(t, v)| (t / 3600.0, v)).collect();
-        let (mut lo, mut hi) = values
+        let runs = timeline.runs(k, GAP_S);
+        let (mut lo, mut hi) = runs
             .iter()
+            .flatten()
             .fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(v.1), h.max(v.1)));
         if name == "state" {
             (lo, hi) = (0.0, 4.0);
@@ -70,13 +71,9 @@ pub fn timeline(path: &Path, timeline: &Timeline) -> Res<()> {
             }
         }
         // One line per run of samples: a stop, a fault or a dropout leaves a gap.
-        let mut start = 0;
-        for i in 1..=values.len() {
-            if i == values.len() || values[i].0 - values[i - 1].0 > GAP_H {
-                let run = values[start..i].iter().copied();
-                chart.draw_series(LineSeries::new(run, colour.stroke_width(1)))?;
-                start = i;
-            }
+        for run in runs {
+            let run = run.into_iter().map(|(t, v)| (t / 3600.0, v));
+            chart.draw_series(LineSeries::new(run, colour.stroke_width(1)))?;
         }
         if name == "d/b" {
             for (y, label) in [(0.8f32, "warning"), (1.0, "alarm")] {

@@ -16,13 +16,18 @@ pub const MAX_SCATTER: usize = 4000;
 /// The timeline's curves, in the figure's panel order.
 pub const CURVES: [&str; 4] = ["d/b", "margin (mrad)", "F (N)", "state"];
 
-/// The lowest and highest value of a curve in a bin, each with its time (s).
+/// The lowest and highest value of a curve in a bin, each with its time (s), and the
+/// times of its first and last value there (where a gap before or after it starts).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Extremes {
     /// (t, value) of the minimum.
     pub min: (f64, f32),
     /// (t, value) of the maximum.
     pub max: (f64, f32),
+    /// The first value's time (s).
+    pub first: f64,
+    /// The last value's time (s).
+    pub last: f64,
 }
 
 impl Extremes {
@@ -32,6 +37,8 @@ impl Extremes {
                 *slot = Some(Extremes {
                     min: (t, v),
                     max: (t, v),
+                    first: t,
+                    last: t,
                 });
             }
             Some(e) => {
@@ -41,6 +48,8 @@ impl Extremes {
                 if v > e.max.1 {
                     e.max = (t, v);
                 }
+                e.first = e.first.min(t);
+                e.last = e.last.max(t);
             }
         }
     }
@@ -49,6 +58,10 @@ impl Extremes {
         if let Some(o) = other {
             Extremes::add(slot, o.min.0, o.min.1);
             Extremes::add(slot, o.max.0, o.max.1);
+            if let Some(e) = slot {
+                e.first = e.first.min(o.first);
+                e.last = e.last.max(o.last);
+            }
         }
     }
 
@@ -184,10 +197,31 @@ impl Timeline {
     /// Curve `k` ([`CURVES`]) as points (t in s) in time order: each bin's minimum and
     /// maximum.
     pub fn curve(&self, k: usize) -> impl Iterator<Item = (f64, f32)> + '_ {
+        self.extremes(k).flat_map(Extremes::points)
+    }
+
+    fn extremes(&self, k: usize) -> impl Iterator<Item = Extremes> + '_ {
         self.bins
             .iter()
             .filter_map(move |b| b.curves.get(k).copied().flatten())
-            .flat_map(|e| e.points())
+    }
+
+    /// Curve `k` as runs of points, a new run where no value came for more than
+    /// `gap_s` (s): a stop, a fault or a dropout; a gap within one bin is too short to
+    /// see.
+    pub fn runs(&self, k: usize, gap_s: f64) -> Vec<Vec<(f64, f32)>> {
+        let mut runs: Vec<Vec<(f64, f32)>> = Vec::new();
+        let mut last = f64::NEG_INFINITY;
+        for e in self.extremes(k) {
+            if runs.is_empty() || e.first - last > gap_s {
+                runs.push(Vec::new());
+            }
+            if let Some(run) = runs.last_mut() {
+                run.extend(e.points());
+            }
+            last = e.last;
+        }
+        runs
     }
 }
 
@@ -364,6 +398,25 @@ mod tests {
             assert!(t.curve(2).any(|p| p == (spike as f64, 75.0)));
             assert_eq!(t.end_s(), (n - 1) as f64);
         }
+    }
+
+    /// Bins wider than the gap do not break a continuous curve; a dropout does.
+    #[test]
+    fn runs_break_at_dropouts_only() {
+        let mut t = Timeline::new();
+        for i in 0..200_000u64 {
+            let dropout = (100_000..100_300).contains(&i);
+            let r = if dropout {
+                None
+            } else {
+                reading(0.5 + 1e-3 * (i % 10) as f32)
+            };
+            t.add(i * 1000, RiskState::Normal, r);
+        }
+        let runs = t.runs(0, 60.0);
+        assert_eq!(runs.len(), 2);
+        assert!(runs[0].last().unwrap().0 < 100_000.0 && runs[1][0].0 >= 100_300.0);
+        assert_eq!(t.runs(3, 60.0).len(), 1);
     }
 
     #[test]
