@@ -125,7 +125,7 @@ impl TraceClock {
             let step = ms - last;
             if step.abs() > STEP_LIMIT_MS {
                 return Err(format!(
-                    "t steps {} by {:e} s ({:.1} days) from the previous row's, beyond the \
+                    "t steps {} by {:e} s ({:.1} days) from the previous time, beyond the \
                      2^31 ms (24.8 days) the monitor's wrapping u32 millisecond counter can \
                      step; is t in s (not ms, us or ns)? A pause that long: split the trace there",
                     if step > 0 { "forward" } else { "back" },
