@@ -324,7 +324,10 @@ def replay(t, P, phi, *, V=None, F=None, scene=None, length=None, model: str = "
     ``spikes``, ``trend``, ``friction`` False to switch those off). ``progress=True``
     draws a progress bar on stderr, one step per ``chunk`` samples.
 
-    Raises ValueError for a non-finite or non-numeric time, columns of different
+    Raises ValueError for a non-finite or non-numeric time, a time the node's
+    millisecond counter cannot hold (beyond 2^53 ms, t in ns say, or a step of 2^31 ms,
+    24.8 days, or more between samples outside the counter's own range, 0 to 2^32 ms,
+    where a wrap is a wrap: the message names the sample), columns of different
     lengths, a bad scene, model or configuration. The GIL is released while samples
     are processed.
     """

@@ -13,6 +13,7 @@ use misalign::monitor::{
 use misalign::reference::ModelChoice;
 use misalign::reference::inverse::{self, Inverse};
 use misalign::{Error, Estimator, Scene};
+use misalign_cli::monitor_input::TraceClock;
 use misalign_cli::monitor_output as output;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
@@ -578,6 +579,11 @@ impl EventColumns {
 struct Replay {
     core: Core,
     events: EventColumns,
+    /// The trace's times as the node's counter, checked as the monitor example checks
+    /// them (across calls of `feed`).
+    clock: TraceClock,
+    /// Samples fed so far: the index a message names.
+    fed: u64,
 }
 
 fn drain<E: Estimator>(m: &mut Monitor<E>, events: &mut EventColumns) {
@@ -635,13 +641,17 @@ impl Replay {
         Ok(Replay {
             core,
             events: EventColumns::default(),
+            clock: TraceClock::new(),
+            fed: 0,
         })
     }
 
     /// Feeds samples: time (s, finite), P (N), phi (rad), V (m/s), F (N); NaN in V or
     /// F is "not measured" for that sample. Each becomes what the monitor example's
     /// trace reader makes of it: t the node's wrapping u32 ms counter (rounded half
-    /// away from zero), the others f32.
+    /// away from zero), the others f32. Raises ValueError, naming the sample, for a t
+    /// that counter cannot hold: beyond 2^53 ms, or a step of 2^31 ms or more outside
+    /// the counter's own range (0 to 2^32 ms).
     fn feed(
         &mut self,
         py: Python<'_>,
@@ -665,11 +675,23 @@ impl Replay {
                 "t is not a finite number at sample {i}"
             )));
         }
-        let Replay { core, events } = self;
+        // A time the node's counter cannot hold (t in ns, a step of 24.8 days or more)
+        // refuses the trace, as in the monitor example; nothing of this call is fed.
+        let mut clock = self.clock;
+        let time_ms = t
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| {
+                clock
+                    .time_ms(x)
+                    .map_err(|m| value_error(format!("sample {}: {m}", self.fed + i as u64)))
+            })
+            .collect::<PyResult<Vec<u32>>>()?;
+        (self.clock, self.fed) = (clock, self.fed + n as u64);
+        let Replay { core, events, .. } = self;
         py.detach(|| {
             let samples = (0..n).map(|i| {
-                let time_ms = ((t[i] * 1e3).round() as i64).rem_euclid(1 << 32) as u32;
-                let mut s = Sample::new(time_ms, p[i] as f32, a[i] as f32);
+                let mut s = Sample::new(time_ms[i], p[i] as f32, a[i] as f32);
                 s.speed = (!v[i].is_nan()).then_some(v[i] as f32);
                 s.axial_force = (!f[i].is_nan()).then_some(f[i] as f32);
                 s

@@ -130,6 +130,17 @@ def test_trace_time_backwards_and_repeated():
     assert r.summary["faults"]["non_finite"] >= 1
 
 
+def test_times_the_nodes_counter_cannot_hold_raise():
+    # t in ns since the epoch: refused, not saturated into repeated timestamps.
+    t = 1.7e18 + 1e9 * np.arange(300)
+    with pytest.raises(ValueError, match=r"sample 0: t = 1.7e18 s is beyond .* is t in ns"):
+        misalign.replay(t, np.full(300, 2e3), np.full(300, 2e-4))
+    # A year ahead, in a later chunk: refused, not taken modulo 2^32 ms.
+    t = np.array([0.0, 1.0, 2.0, 31557602.0])
+    with pytest.raises(ValueError, match="sample 3: t steps forward by 3.15576e7 s"):
+        misalign.replay(t, np.full(4, 2e3), np.full(4, 2e-4), chunk=2)
+
+
 def test_extreme_values_never_give_a_silent_nan():
     special = np.array([0.0, -0.0, 1e-320, 5e-324, 1e-300, 1e300, 1.7e308, np.inf, -np.inf,
                         np.nan, -1.0, 0.5, np.pi / 2, 2.0, 0.05, 79.3e9, 0.3, 1e3, 2e-4, 1e20,

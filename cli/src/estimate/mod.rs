@@ -9,6 +9,7 @@
 //! non-UTF-8 or NUL bytes, an unterminated quote, a number that is not one) becomes that
 //! row's `error` and the batch goes on.
 
+use crate::table::{self, number};
 use clap::{Parser, ValueEnum};
 use misalign::fixed::{FixedAuto, FixedContactDetails, FixedEllipticScene, Log2, exact_lsb};
 use misalign::float::{Auto, ContactDetails};
@@ -224,30 +225,6 @@ fn core_answer(
         validity: core_validity(&x.scene, x.phi, critical, p0, ellipse, near_model_switch),
         no_critical_angle: critical.is_none(),
     }
-}
-
-/// A number from one input field: UTF-8, a decimal f64, and inside f64's range
-/// (1e400 is refused, not read as infinity; 1e-400 is refused, not read as 0).
-fn number(name: &str, field: &[u8]) -> Result<f64, String> {
-    let text = std::str::from_utf8(field)
-        .map_err(|_| format!("{name}: not UTF-8"))?
-        .trim();
-    let x: f64 = text
-        .parse()
-        .map_err(|_| format!("{name}: not a number: {text:?}"))?;
-    let mantissa = text.split(['e', 'E']).next().unwrap_or("");
-    let literal_inf = mantissa.to_ascii_lowercase().contains("inf");
-    if x.is_infinite() && !literal_inf {
-        return Err(format!(
-            "{name} = {text} is outside the range of f64 numbers (|x| <= 1.8e308)"
-        ));
-    }
-    if x == 0.0 && mantissa.bytes().any(|b| (b'1'..=b'9').contains(&b)) {
-        return Err(format!(
-            "{name} = {text} is below the smallest f64 number (4.9e-324)"
-        ));
-    }
-    Ok(x)
 }
 
 /// The numbers of a row's needed columns (named `names`), or the message for its
@@ -562,49 +539,10 @@ fn find_columns(
     header: &csv::ByteRecord,
     inputs: &[&str; 7],
 ) -> Result<([usize; 7], Option<usize>), String> {
-    let names: Vec<&[u8]> = header.iter().collect();
-    let find = |name: &str| -> Result<Option<usize>, String> {
-        let at: Vec<usize> = (0..names.len())
-            .filter(|&i| names[i] == name.as_bytes())
-            .collect();
-        match at.as_slice() {
-            [] => Ok(None),
-            [i] => Ok(Some(*i)),
-            _ => Err(format!(
-                "column {name} appears {} times in the header (columns {}); keep one",
-                at.len(),
-                at.iter()
-                    .map(|i| (i + 1).to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )),
-        }
-    };
+    let (at, optional) = table::find_columns(header, inputs, &["length"])?;
     let mut columns = [0usize; 7];
-    for (k, name) in inputs.iter().enumerate() {
-        columns[k] = find(name)?
-            .ok_or_else(|| format!("input lacks column {name} (needs {})", inputs.join(",")))?;
-    }
-    Ok((columns, find("length")?))
-}
-
-/// What is wrong with a row's bytes, if anything, before its numbers are read.
-fn bad_record(record: &csv::ByteRecord, fields: usize) -> Option<String> {
-    if record.len() != fields {
-        return Some(format!(
-            "row has {} fields, the header {fields}",
-            record.len()
-        ));
-    }
-    for (k, field) in record.iter().enumerate() {
-        if field.contains(&0) {
-            return Some(format!("field {} holds a NUL byte", k + 1));
-        }
-        if std::str::from_utf8(field).is_err() {
-            return Some(format!("field {} is not UTF-8", k + 1));
-        }
-    }
-    None
+    columns.copy_from_slice(&at);
+    Ok((columns, optional[0]))
 }
 
 /// The header `row` is written under, alone (an input with no data row): the row
@@ -668,31 +606,18 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
     // The header: the first record, ','-separated, or ';'-separated if only that
     // gives the needed columns.
     let inputs = options.inputs();
-    let mut delimiter = b',';
-    let mut rdr = reader(delimiter, true, &data);
-    let mut header = match rdr.byte_headers() {
-        Ok(h) if !h.iter().all(<[u8]>::is_empty) => h.clone(),
-        _ => {
-            let _ = writeln!(
-                err,
-                "estimate: input has no header (needs {})",
-                inputs.join(",")
-            );
+    let (delimiter, header) = match table::header(&data, inputs) {
+        Ok(h) => h,
+        Err(message) => {
+            let _ = writeln!(err, "estimate: {message}");
             return 1;
         }
     };
-    if find_columns(&header, inputs).is_err() && header.len() == 1 && header[0].contains(&b';') {
-        let mut semi = reader(b';', true, &data);
-        if let Ok(h) = semi.byte_headers()
-            && find_columns(h, inputs).is_ok()
-        {
-            let _ = writeln!(
-                err,
-                "estimate: the input is ';'-separated; reading it so (numbers need a decimal point)"
-            );
-            (delimiter, header, rdr) = (b';', h.clone(), semi);
-        }
+    if delimiter == b';' {
+        let _ = writeln!(err, "estimate: {}", table::SEMICOLON_NOTE);
     }
+    let mut rdr = reader(delimiter, true, &data);
+    let _ = rdr.byte_headers();
     let (columns, length) = match find_columns(&header, inputs) {
         Ok(c) => c,
         Err(message) => {
@@ -718,7 +643,7 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
             if to_the_end && rest.iter().filter(|&&b| b == b'"').count() % 2 == 1 {
                 message.push_str("unterminated quote: the row runs to the end of the input");
                 restart = rest.iter().position(|&b| b == b'\n').map(|i| start + i + 1);
-            } else if let Some(m) = bad_record(&record, header.len()) {
+            } else if let Some(m) = table::bad_record(&record, header.len()) {
                 message.push_str(&m);
             }
             let readable = message.is_empty();

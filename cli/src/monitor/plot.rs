@@ -1,7 +1,9 @@
 //! The monitor example's figures (SVG via plotters; text stays SVG text, no fonts read).
 
-use crate::{Point, Res, ThresholdRow};
-use misalign::monitor::{Event, EventKind, RiskState};
+use super::Res;
+use super::series::{CURVES, Timeline};
+use crate::monitor_output::ThresholdRow;
+use misalign::monitor::RiskState;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -11,38 +13,23 @@ const GREEN_: RGBColor = RGBColor(0, 158, 115);
 const VERMILION: RGBColor = RGBColor(213, 94, 0);
 const GREY: RGBColor = RGBColor(150, 150, 150);
 
-/// A step longer than this (h) between plotted points is drawn as a gap.
-const GAP_H: f64 = 60.0 / 3600.0;
+/// A step longer than this (s) between plotted values is drawn as a gap.
+const GAP_S: f64 = 60.0;
 
-/// At most this many points per curve (evenly decimated).
-const MAX_POINTS: usize = 4000;
-
-fn decimate(points: &[Point]) -> impl Iterator<Item = &Point> {
-    let step = points.len().div_ceil(MAX_POINTS).max(1);
-    points.iter().step_by(step)
-}
-
-/// d/b, margin, F and the state over time (h), events as vertical lines.
-pub fn timeline(path: &Path, points: &[Point], events: &[Event]) -> Res<()> {
+/// d/b, margin, F and the state over time (h), events as vertical lines (one per bin of
+/// the timeline and kind).
+pub fn timeline(path: &Path, timeline: &Timeline) -> Res<()> {
     let root = SVGBackend::new(path, (1000, 900)).into_drawing_area();
     root.fill(&WHITE)?;
     let panels = root.split_evenly((4, 1));
-    let t_end = points.last().map_or(1.0, |p| p.t / 3600.0).max(1e-3);
-    let finite = |x: f32| x.is_finite().then_some(x);
-    type Series = (&'static str, RGBColor, fn(&Point) -> Option<f32>);
-    let series: [Series; 4] = [
-        ("d/b", BLUE_, |p| Some(p.slip_ratio)),
-        ("margin (mrad)", GREEN_, |p| p.margin.map(|m| m * 1e3)),
-        ("F (N)", ORANGE, |p| Some(p.force)),
-        ("state", VERMILION, |p| Some(p.state.index() as f32)),
-    ];
-    for (area, (name, colour, get)) in panels.iter().zip(series) {
-        let values: Vec<(f64, f32)> = decimate(points)
-            .filter(|p| p.fresh || name == "state")
-            .filter_map(|p| Some((p.t / 3600.0, finite(get(p)?)?)))
-            .collect();
-        let (mut lo, mut hi) = values
+    let t_end = (timeline.end_s() / 3600.0).max(1e-3);
+    let colours = [BLUE_, GREEN_, ORANGE, VERMILION];
+    for (k, (area, (name, colour))) in panels.iter().zip(CURVES.iter().zip(colours)).enumerate() {
+        let name = *name;
+        let runs = timeline.runs(k, GAP_S);
+        let (mut lo, mut hi) = runs
             .iter()
+            .flatten()
             .fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(v.1), h.max(v.1)));
         if name == "state" {
             (lo, hi) = (0.0, 4.0);
@@ -68,27 +55,25 @@ pub fn timeline(path: &Path, points: &[Point], events: &[Event]) -> Res<()> {
             mesh.y_labels(5).y_label_formatter(&states);
         }
         mesh.draw()?;
-        for e in events {
-            let t = e.elapsed_ms as f64 / 3.6e6;
-            let style = match e.kind {
-                EventKind::StateChange { .. } => GREY.stroke_width(1),
-                EventKind::Approaching { .. } | EventKind::Friction { .. } => {
-                    VERMILION.stroke_width(2)
+        for bin in timeline.bins() {
+            let marks = [
+                (bin.state_change, GREY.stroke_width(1)),
+                (bin.alert, VERMILION.stroke_width(2)),
+            ];
+            for (t, style) in marks {
+                if let Some(t) = t {
+                    let t = t / 3600.0;
+                    chart.draw_series(std::iter::once(PathElement::new(
+                        vec![(t, lo - pad), (t, hi + pad)],
+                        style,
+                    )))?;
                 }
-            };
-            chart.draw_series(std::iter::once(PathElement::new(
-                vec![(t, lo - pad), (t, hi + pad)],
-                style,
-            )))?;
+            }
         }
         // One line per run of samples: a stop, a fault or a dropout leaves a gap.
-        let mut start = 0;
-        for i in 1..=values.len() {
-            if i == values.len() || values[i].0 - values[i - 1].0 > GAP_H {
-                let run = values[start..i].iter().copied();
-                chart.draw_series(LineSeries::new(run, colour.stroke_width(1)))?;
-                start = i;
-            }
+        for run in runs {
+            let run = run.into_iter().map(|(t, v)| (t / 3600.0, v));
+            chart.draw_series(LineSeries::new(run, colour.stroke_width(1)))?;
         }
         if name == "d/b" {
             for (y, label) in [(0.8f32, "warning"), (1.0, "alarm")] {
@@ -107,8 +92,9 @@ pub fn timeline(path: &Path, points: &[Point], events: &[Event]) -> Res<()> {
     Ok(())
 }
 
-/// phi0(P) and the trigger angles over the load range, with the replay's (P, |phi|).
-pub fn thresholds(path: &Path, table: &[ThresholdRow], points: &[Point]) -> Res<()> {
+/// phi0(P) and the trigger angles over the load range, with the replay's operating
+/// points (P in N, |phi| in rad).
+pub fn thresholds(path: &Path, table: &[ThresholdRow], points: &[(f32, f32)]) -> Res<()> {
     let root = SVGBackend::new(path, (800, 600)).into_drawing_area();
     root.fill(&WHITE)?;
     let p_max = table.iter().map(|r| r[0]).fold(1.0, f64::max);
@@ -130,10 +116,10 @@ pub fn thresholds(path: &Path, table: &[ThresholdRow], points: &[Point]) -> Res<
         .x_desc("load P (N)")
         .y_desc("misalignment (mrad)")
         .draw()?;
-    let samples: Vec<(f64, f64)> = decimate(points)
-        .filter(|p| p.fresh)
-        .filter(|p| f64::from(p.load) <= p_max && f64::from(p.phi.abs()) * 1e3 <= phi_max)
-        .map(|p| (f64::from(p.load), f64::from(p.phi.abs()) * 1e3))
+    let samples: Vec<(f64, f64)> = points
+        .iter()
+        .map(|&(load, phi)| (f64::from(load), f64::from(phi) * 1e3))
+        .filter(|&(load, phi)| load <= p_max && phi <= phi_max)
         .collect();
     chart
         .draw_series(samples.iter().map(|&c| Circle::new(c, 1, GREY.filled())))?
