@@ -702,3 +702,30 @@ fn the_model_is_chosen_once_for_the_operating_range() {
         Err(misalign::Error::Angle)
     );
 }
+
+/// A dropout's sensor-fault candidate hands no time to a slip candidate that follows
+/// it: with a fault delay longer than the dropout, 120 s at 2 kN and 0.1 mrad (with
+/// some noise: a constant value is a stuck sensor), 10 s of `P = NaN` and then one
+/// sample at 3 mrad leave the state `Normal`; gross slip that lasts is entered after
+/// the on-delay from its own first sample.
+#[test]
+fn a_pending_fault_hands_no_time_to_a_slip_candidate() {
+    let config = Config {
+        fault_delay_ms: 60_000,
+        ..Config::default()
+    };
+    let noisy = |t: u32, phi: f32| Sample::new(t * 1000, LOAD + (t % 7) as f32, phi);
+    let mut m = Monitor::new(core(), config).unwrap();
+    for t in 0..120u32 {
+        m.process(noisy(t, 1e-4));
+    }
+    assert_eq!(m.state(), RiskState::Normal);
+    for t in 120..130u32 {
+        let state = m.process(Sample::new(t * 1000, f32::NAN, 1e-4));
+        assert_eq!(state, RiskState::Normal);
+    }
+    let states: Vec<RiskState> = (130..140u32).map(|t| m.process(noisy(t, 3e-3))).collect();
+    let entered = states.iter().position(|&s| s == RiskState::GrossSlip);
+    // The first gross-slip sample at 130 s: entered at 135 s, not before.
+    assert_eq!(entered, Some(5), "{states:?}");
+}

@@ -73,13 +73,18 @@ pub struct TrendConfig {
 pub struct Config {
     /// Warning and alarm thresholds with their deadband.
     pub thresholds: Thresholds,
-    /// On-delay: a more severe state must hold this long before it is entered (ms);
-    /// a start (`Stopped` to `Normal`) is entered at once.
+    /// On-delay: a more severe slip state must be asked for by every sample for this
+    /// long before it is entered (ms), counted from the first sample that asks for it
+    /// or for a state beyond it; a start (`Stopped` to `Normal`) is entered at once.
+    /// A sensor fault's time never counts toward it.
     pub on_delay_ms: u32,
-    /// Off-delay: a less severe state (or the end of a sensor fault) must hold this
-    /// long before it is entered (ms); the minimum dwell in a raised state.
+    /// Off-delay: a less severe state (or the end of a sensor fault) must be asked for
+    /// this long before it is entered (ms), counted the same way; the minimum dwell in
+    /// a raised state.
     pub off_delay_ms: u32,
-    /// Delay before a sensor fault is reported (ms; 0: at once).
+    /// Delay before a sensor fault is reported (ms; 0: at once), counted from the
+    /// first of an unbroken run of faulted samples. Slip's time never counts toward
+    /// it, nor its toward slip.
     pub fault_delay_ms: u32,
     /// Start-up inhibit: no warning or alarm for this long after the machine starts
     /// (first sample or leaving `Stopped`) (ms).
