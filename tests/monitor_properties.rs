@@ -155,7 +155,7 @@ fn check<E: Estimator>(core: E, config: Config, samples: &[Sample]) -> Result<()
                     last_change_ms = e.elapsed_ms;
                 }
                 EventKind::Approaching { time_to_critical_s } => {
-                    prop_assert!(time_to_critical_s >= 0.0)
+                    prop_assert!(time_to_critical_s > 0.0)
                 }
                 EventKind::Friction { .. } => {
                     prop_assert!(false, "no friction without process_with_friction")
@@ -176,7 +176,7 @@ fn check<E: Estimator>(core: E, config: Config, samples: &[Sample]) -> Result<()
             .iter()
             .all(|&state| st.energy_j(state).is_finite() && st.energy_j(state) >= 0.0)
     );
-    prop_assert!(m.time_to_critical().is_none_or(|t| t >= 0.0));
+    prop_assert!(m.time_to_critical().is_none_or(|t| t > 0.0));
     let time: u64 = RiskState::ALL
         .iter()
         .map(|&state| st.time_in_state_ms(state))

@@ -8,6 +8,12 @@ pub const SPIKE_WINDOW_CAPACITY: usize = 7;
 /// Capacity of the trend buffer (points).
 pub const TREND_CAPACITY: usize = 16;
 
+/// How credible the trend's fit must be to give a time to critical: its slope (the
+/// margin's drift, rad/s) at least this many of its standard errors below zero. With
+/// the 16 points of the default window and independent residuals, a margin that does
+/// not drift passes about once in 200 fits (Student's t, 14 degrees of freedom).
+pub const TREND_SLOPE_STANDARD_ERRORS: f32 = 3.0;
+
 /// What the warning and alarm thresholds are set on.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

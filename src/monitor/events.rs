@@ -90,7 +90,10 @@ pub enum EventKind {
         /// For a change to `SensorFault`, the fault that caused it.
         fault: Option<FaultCause>,
     },
-    /// The time to critical fell below the configured horizon.
+    /// Gross slip predicted: the trend's fit of the margin is above zero now, falls by
+    /// at least [`TREND_SLOPE_STANDARD_ERRORS`](super::TREND_SLOPE_STANDARD_ERRORS)
+    /// of its standard errors, and crosses zero ahead sooner than the configured
+    /// horizon, while the contact still sticks (`Normal` or `Microslip`).
     Approaching {
         /// Estimated time until gross slip at the current drift (s).
         time_to_critical_s: f32,

@@ -18,9 +18,10 @@
 //!    start-up inhibit decide the [`RiskState`];
 //! 8. **friction** (`friction.rs`, [`Monitor::process_with_friction`] only): mu from a
 //!    measured axial force;
-//! 9. **events** (`events.rs`): state changes, the `Approaching` warning (the time to
-//!    critical below the horizon) and friction changes go to a fixed queue that a
-//!    consumer drains ([`Monitor::pop_event`]);
+//! 9. **events** (`events.rs`): state changes, the `Approaching` warning (a credible
+//!    fit of the margin crosses zero ahead, sooner than the horizon, while the contact
+//!    still sticks) and friction changes go to a fixed queue that a consumer drains
+//!    ([`Monitor::pop_event`]);
 //! 10. **statistics** (`statistics.rs`): the step's energy added to the state
 //!     reported after it.
 //!
@@ -105,7 +106,7 @@ mod trend;
 
 pub use config::{
     Config, ConfigError, FrictionConfig, SPIKE_WINDOW_CAPACITY, SpikeFilter, TREND_CAPACITY,
-    Thresholds, TrendConfig,
+    TREND_SLOPE_STANDARD_ERRORS, Thresholds, TrendConfig,
 };
 pub use energy::dissipated_power;
 pub use events::{EVENT_CAPACITY, Event, EventKind, FaultCause, Reading};
@@ -223,7 +224,11 @@ impl<E: Estimator> Monitor<E> {
     }
 
     /// The latest estimate of the time until gross slip (s) at the current drift of
-    /// the margin; `None` while the margin does not fall or the trend is off.
+    /// the margin: the time until the trend's fitted line crosses zero, ahead of its
+    /// newest point; `None` while the trend is off or its window not full, and while
+    /// the fit predicts no crossing ahead (the margin does not fall, its fall is within
+    /// the scatter, see [`TREND_SLOPE_STANDARD_ERRORS`], or the fit is already at or
+    /// below zero).
     pub fn time_to_critical(&self) -> Option<f32> {
         self.trend.time_to_critical_s
     }

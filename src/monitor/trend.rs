@@ -1,9 +1,10 @@
 //! The trend stage: the least-squares trend of the margin phi0 - |phi| over a fixed
-//! window gives the time until gross slip at the current drift (the events stage
-//! warns when it falls below the horizon). Its state: the current interval, the
-//! points, the latest time to critical.
+//! window gives the time until gross slip at the current drift, when the fit is above
+//! zero now and falls credibly ([`time_to_critical`]); the events stage warns when it
+//! falls below the horizon. Its state: the current interval, the points, the latest
+//! time to critical.
 
-use super::config::{TREND_CAPACITY, TrendConfig};
+use super::config::{TREND_CAPACITY, TREND_SLOPE_STANDARD_ERRORS, TrendConfig};
 use super::order::{finite, ge};
 use crate::recip::recip;
 use heapless::Deque;
@@ -117,16 +118,21 @@ pub(crate) fn push(buffer: &mut TrendBuffer, point: TrendPoint, points: usize) {
     let _ = buffer.push_back(point);
 }
 
-/// Time (s) until the fitted margin reaches zero: `Some(0)` when the fit at the newest
-/// point is already at or below zero, `None` when the margin does not fall (or fewer
-/// than 3 points). Least squares of margin on time, times taken relative to the newest
-/// point so that f32 keeps them exact. `points` oldest first.
+/// Time (s) until the fitted margin reaches zero, ahead of the newest point: `Some`
+/// only when the least-squares line of margin on time is above zero at the newest
+/// point, falls, and falls credibly (its slope at least
+/// [`TREND_SLOPE_STANDARD_ERRORS`] of its standard errors below zero); `None`
+/// otherwise (fewer than 3 points, a margin that does not fall or whose fall the
+/// scatter hides, or a fit already at or below zero: a crossing in the past predicts
+/// nothing). Times are taken relative to the newest point so that f32 keeps them
+/// exact. `points` oldest first.
 pub fn time_to_critical(points: &[TrendPoint]) -> Option<f32> {
     let newest = points.last()?.time_ms;
+    let x = |p: &TrendPoint| -(newest.wrapping_sub(p.time_ms) as f32 * 1e-3);
     let (mut n, mut sx, mut sy) = (0u32, 0.0f32, 0.0f32);
     for p in points {
         n += 1;
-        sx -= newest.wrapping_sub(p.time_ms) as f32 * 1e-3;
+        sx += x(p);
         sy += p.margin;
     }
     if n < 3 {
@@ -138,7 +144,7 @@ pub fn time_to_critical(points: &[TrendPoint]) -> Option<f32> {
     let (mx, my) = (sx * per_n, sy * per_n);
     let (mut sxx, mut sxy) = (0.0f32, 0.0f32);
     for p in points {
-        let dx = -(newest.wrapping_sub(p.time_ms) as f32 * 1e-3) - mx;
+        let dx = x(p) - mx;
         sxx += dx * dx;
         sxy += dx * (p.margin - my);
     }
@@ -148,15 +154,19 @@ pub fn time_to_critical(points: &[TrendPoint]) -> Option<f32> {
     }
     let slope = sxy * recip(sxx); // rad/s
     let now = my - slope * mx; // the fit at the newest point (x = 0)
-    if !finite(now) || !finite(slope) {
+    if !finite(now) || !finite(slope) || ge(0.0, now) || ge(slope, 0.0) {
         return None;
     }
-    if ge(0.0, now) {
-        Some(0.0)
-    } else if !ge(slope, 0.0) {
-        let t = now * recip(-slope);
-        finite(t).then_some(t)
-    } else {
-        None
+    // Credible: slope / se >= k with se^2 = ssr / ((n - 2) sxx), squared.
+    let mut ssr = 0.0f32;
+    for p in points {
+        let r = p.margin - my - slope * (x(p) - mx);
+        ssr += r * r;
     }
+    let k = TREND_SLOPE_STANDARD_ERRORS;
+    if !ge(slope * slope * sxx * (n - 2) as f32, k * k * ssr) {
+        return None;
+    }
+    let t = now * recip(-slope);
+    finite(t).then_some(t)
 }
