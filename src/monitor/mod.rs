@@ -44,7 +44,9 @@
 //! switch per sample: not for a monitor.)
 //!
 //! **Sensor faults are never slip.** A faulted sample is not estimated; its
-//! candidate state is `SensorFault`, and leaving that state waits the off-delay. A
+//! candidate state is `SensorFault`, and leaving that state waits the off-delay. Each
+//! state waits its own delay from its own first candidate: a fault's time never counts
+//! toward a slip state's on-delay, nor slip's toward the fault delay. A
 //! fault the sensors' own detection found ([`Sample::sensor_fault`]; with the
 //! `sensors` feature `Sample::from_sensors` carries it over) is counted and the
 //! state change names the sensor and the reason

@@ -142,11 +142,12 @@ pub fn time_to_critical(points: &[TrendPoint]) -> Option<f32> {
     // on a core without an FPU), within 2 ulp.
     let per_n = recip(n as f32);
     let (mx, my) = (sx * per_n, sy * per_n);
-    let (mut sxx, mut sxy) = (0.0f32, 0.0f32);
+    let (mut sxx, mut sxy, mut syy) = (0.0f32, 0.0f32, 0.0f32);
     for p in points {
-        let dx = x(p) - mx;
+        let (dx, dy) = (x(p) - mx, p.margin - my);
         sxx += dx * dx;
-        sxy += dx * (p.margin - my);
+        sxy += dx * dy;
+        syy += dy * dy;
     }
     // Comparisons as integers where floats are soft (condition::ge).
     if !finite(sxx) || ge(0.0, sxx) {
@@ -157,14 +158,11 @@ pub fn time_to_critical(points: &[TrendPoint]) -> Option<f32> {
     if !finite(now) || !finite(slope) || ge(0.0, now) || ge(slope, 0.0) {
         return None;
     }
-    // Credible: slope / se >= k with se^2 = ssr / ((n - 2) sxx), squared.
-    let mut ssr = 0.0f32;
-    for p in points {
-        let r = p.margin - my - slope * (x(p) - mx);
-        ssr += r * r;
-    }
-    let k = TREND_SLOPE_STANDARD_ERRORS;
-    if !ge(slope * slope * sxx * (n - 2) as f32, k * k * ssr) {
+    // Credible: -slope / se >= k, se^2 = (syy - slope sxy) / ((n - 2) sxx), which
+    // squared is R^2 = sxy^2 / (sxx syy) >= k^2 / (n - 2 + k^2): no pass over the
+    // residuals.
+    let k2 = TREND_SLOPE_STANDARD_ERRORS * TREND_SLOPE_STANDARD_ERRORS;
+    if !ge(sxy * sxy * ((n - 2) as f32 + k2), k2 * sxx * syy) {
         return None;
     }
     let t = now * recip(-slope);
