@@ -9,8 +9,9 @@ pub const SPIKE_WINDOW_CAPACITY: usize = 7;
 pub const TREND_CAPACITY: usize = 16;
 
 /// How credible the trend's fit must be to give a time to critical: its slope (the
-/// margin's drift, rad/s) at least this many of its standard errors below zero. With
-/// the 16 points of the default window and independent residuals, a margin that does
+/// margin's drift, rad/s) at least this many of its standard errors below zero, which
+/// is the fit's R^2 at least k^2 / (n - 2 + k^2) over n points (0.39 over the 16 of
+/// the default window). With 16 points and independent residuals, a margin that does
 /// not drift passes about once in 200 fits (Student's t, 14 degrees of freedom).
 pub const TREND_SLOPE_STANDARD_ERRORS: f32 = 3.0;
 
