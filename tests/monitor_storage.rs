@@ -255,7 +255,7 @@ fn corrupted_payloads_are_refused() {
 
 /// Where the state's fields sit in its payload (version 1, docs/formats.md), with their
 /// sizes: the fields a mutation test rewrites.
-const FIELDS: [(&str, usize, usize); 38] = [
+const FIELDS: [(&str, usize, usize); 44] = [
     ("clock: last timestamp flag", 0, 1),
     ("clock: last timestamp", 1, 4),
     ("clock: elapsed", 5, 8),
@@ -266,6 +266,8 @@ const FIELDS: [(&str, usize, usize); 38] = [
     ("alarm: pending since", 24, 8),
     ("alarm: started flag", 32, 1),
     ("alarm: started", 33, 8),
+    ("smoothing: load", 42, 4),
+    ("smoothing: angle", 46, 4),
     ("stuck: load bits", 50, 4),
     ("stuck: load since", 54, 8),
     ("stuck: angle since", 66, 8),
@@ -290,6 +292,10 @@ const FIELDS: [(&str, usize, usize); 38] = [
     ("friction: rejected", 289, 4),
     ("friction: pending", 293, 4),
     ("friction: changed", 297, 1),
+    ("spike window: a load", 298 + 12, 4),
+    ("spike window: an angle", 327 + 12, 4),
+    ("spike window: angle length", 327 + 28, 1),
+    ("trend point 0: margin", 356 + 4, 4),
     ("trend point 0: time", 356, 4),
     ("trend point 15: time", 356 + 15 * 8, 4),
     ("event 0: sequence", 485, 4),

@@ -495,10 +495,16 @@ impl<E: Estimator> Monitor<E> {
     /// second monitor on the stack. With `storage::Store::restore_into` (feature
     /// `sequential-storage`) a node restores its state at start-up holding one monitor
     /// and one state.
+    ///
+    /// The conditioning holds only values this configuration accepts: a smoothed
+    /// value, or a spike window holding a value, outside its load and angle ranges (a
+    /// state of another configuration, or no monitor's) is left out, and the
+    /// conditioning starts afresh there, as after a fault.
     pub fn resume(&mut self, state: &MonitorState) {
         self.clock = state.clock;
         self.alarm = state.alarm;
-        self.conditioning.smoothed = state.smoothed;
+        let limits = &self.limits;
+        self.conditioning.smoothed = state.smoothed.filter(|&[l, p]| limits.accepts([l], [p]));
         self.checks = state.checks;
         self.trend.interval = state.trend_interval;
         self.trend.time_to_critical_s = state.time_to_critical_s;
@@ -513,14 +519,11 @@ impl<E: Estimator> Monitor<E> {
             .config
             .spikes
             .map_or(SPIKE_WINDOW_CAPACITY, |s| usize::from(s.window));
-        for (window, saved) in self
-            .conditioning
-            .windows
-            .iter_mut()
-            .zip([&state.load_window, &state.angle_window])
-        {
+        let saved = [&state.load_window, &state.angle_window];
+        let accepted = limits.accepts(saved[0].iter(), saved[1].iter());
+        for (window, saved) in self.conditioning.windows.iter_mut().zip(saved) {
             window.clear();
-            for x in saved.iter() {
+            for x in saved.iter().filter(|_| accepted) {
                 window.push_back(x, n);
             }
         }
