@@ -802,3 +802,53 @@ fn time_to_critical_needs_a_crossing_ahead_and_a_credible_fall() {
     // standard error.
     assert_eq!(time_to_critical(&line(2e-4 + 4.5e-5, -1e-8, 1e-4)), None);
 }
+
+/// A fit's crossing that has passed by the time the contact sticks again predicts
+/// nothing: the margin falls linearly to cross zero at 260 s, the fit made at 302 s
+/// (the third point; over interval means, half an interval behind) crosses at about
+/// 310 s while the contact slips; a dropout at 303 s and a smaller angle after it bring
+/// `Normal` back at 334 s, after that crossing and before the next fit: no
+/// `Approaching` then.
+#[test]
+fn approaching_never_for_a_crossing_already_past() {
+    let config = Config {
+        on_delay_ms: 0,
+        trend: Some(TrendConfig {
+            interval_ms: 100_000,
+            points: 3,
+            horizon_s: 3_600.0,
+        }),
+        ..plain()
+    };
+    let mut m = Monitor::new(core(), config).unwrap();
+    let phi0 = core()
+        .estimate_si(LOAD, 0.0)
+        .unwrap()
+        .critical_angle
+        .unwrap();
+    let mut approaching = Vec::new();
+    for t in 0..400u32 {
+        let sample = match t {
+            0..303 => Sample::new(t * 1000, LOAD, phi0 - 1e-6 * (260.0 - t as f32)),
+            303 => Sample {
+                driver_fault: Some(Channel::Angle),
+                ..Sample::new(t * 1000, LOAD, 1e-4)
+            },
+            _ => Sample::new(t * 1000, LOAD, 1e-4),
+        };
+        m.process(sample);
+        if t == 302 {
+            let ttc = m.time_to_critical().expect("a credible fall at 302 s");
+            assert!((5.0..15.0).contains(&ttc), "{ttc} s");
+        }
+        if t == 334 {
+            assert_eq!(m.state(), RiskState::Normal);
+        }
+        while let Some(e) = m.pop_event() {
+            if let EventKind::Approaching { time_to_critical_s } = e.kind {
+                approaching.push((e.elapsed_ms, time_to_critical_s));
+            }
+        }
+    }
+    assert_eq!(approaching, []);
+}

@@ -410,8 +410,12 @@ impl<E: Estimator> Monitor<E> {
         if let Some(from) = changed {
             self.state_changed(from, fault, sample.time_ms);
         }
-        let ttc = self.trend.time_to_critical_s;
-        if let Some(t) = self.events.approaching(self.config.trend, ttc, state) {
+        let (trend, ttc) = (&self.trend, self.trend.time_to_critical_s);
+        let fit_age_s = || trend.fit_age_s(now);
+        if let Some(t) = self
+            .events
+            .approaching(self.config.trend, ttc, fit_age_s, state)
+        {
             let kind = EventKind::Approaching {
                 time_to_critical_s: t,
             };

@@ -75,6 +75,14 @@ impl Trend {
         }
     }
 
+    /// Seconds from the newest point (the fit's time) to monotonic time `now` (ms).
+    #[cold]
+    pub(crate) fn fit_age_s(&self, now: u64) -> f32 {
+        self.points
+            .back()
+            .map_or(0.0, |p| (now as u32).wrapping_sub(p.time_ms) as f32 * 1e-3)
+    }
+
     /// Closes the interval at `now`: its mean margin becomes a point, and with a full
     /// window the time to critical is fitted anew.
     #[cold]
