@@ -326,7 +326,7 @@ fn unreachable_states_are_refused() {
     let elapsed = state.elapsed_ms();
     assert!(codec::decode::<MonitorState>(&record_with(&state, 0, &[1])).is_ok());
     let later = (elapsed + 1).to_le_bytes();
-    let cases: [(&str, usize, &[u8]); 8] = [
+    let cases: [(&str, usize, &[u8]); 9] = [
         (
             "an alarm start-up time of u64::MAX",
             32,
@@ -338,6 +338,11 @@ fn unreachable_states_are_refused() {
             "a pending state since after the clock",
             22,
             &[[1, 3].as_slice(), &later].concat(),
+        ),
+        (
+            "a pending state since before its state was entered",
+            22,
+            &[1, 3, 0, 0, 0, 0, 0, 0, 0, 0],
         ),
         ("a load stuck since after the clock", 54, &later),
         ("an angle stuck since after the clock", 66, &later),

@@ -479,7 +479,7 @@ const MAX_EVENTS_PER_SAMPLE: u64 = 4;
 ///   the next step cannot wrap it; the time per state sums to it.
 /// - The state machine, stuck tracking, the trend's interval, the friction's pending
 ///   time, the events and the trend's points: no time after the clock; a pending state
-///   differs from the reported one.
+///   differs from the reported one and began no earlier than it was entered.
 /// - Counts: repeated timestamps and faults (one a sample) within the samples, spikes
 ///   within two a sample, estimates of mu (one a sample) within the samples, dropped
 ///   events within what the samples can emit, a trend interval's margins within the
@@ -511,8 +511,10 @@ fn reachable(s: &MonitorState) -> Result<(), CodecError> {
     // Times against the clock.
     let a = &s.alarm;
     ok(at_most_now(a.since_ms) && a.started_ms.is_none_or(at_most_now))?;
+    // A run of candidates begins after the state it would leave was entered.
+    let after_entry = |t: u64| a.since_ms <= t && at_most_now(t);
     ok(a.pending
-        .is_none_or(|(p, t)| p != a.state && at_most_now(t)))?;
+        .is_none_or(|(p, t)| p != a.state && after_entry(t)))?;
     ok(s.checks.stuck.iter().all(|t| at_most_now(t.since_ms)))?;
     let iv = &s.trend_interval;
     ok(at_most_now(iv.start_ms) && u64::from(iv.count) <= n)?;
