@@ -702,3 +702,153 @@ fn the_model_is_chosen_once_for_the_operating_range() {
         Err(misalign::Error::Angle)
     );
 }
+
+/// A dropout's sensor-fault candidate hands no time to a slip candidate that follows
+/// it: with a fault delay longer than the dropout, 120 s at 2 kN and 0.1 mrad (with
+/// some noise: a constant value is a stuck sensor), 10 s of `P = NaN` and then one
+/// sample at 3 mrad leave the state `Normal`; gross slip that lasts is entered after
+/// the on-delay from its own first sample.
+#[test]
+fn a_pending_fault_hands_no_time_to_a_slip_candidate() {
+    let config = Config {
+        fault_delay_ms: 60_000,
+        ..Config::default()
+    };
+    let noisy = |t: u32, phi: f32| Sample::new(t * 1000, LOAD + (t % 7) as f32, phi);
+    let mut m = Monitor::new(core(), config).unwrap();
+    for t in 0..120u32 {
+        m.process(noisy(t, 1e-4));
+    }
+    assert_eq!(m.state(), RiskState::Normal);
+    for t in 120..130u32 {
+        let state = m.process(Sample::new(t * 1000, f32::NAN, 1e-4));
+        assert_eq!(state, RiskState::Normal);
+    }
+    let states: Vec<RiskState> = (130..140u32).map(|t| m.process(noisy(t, 3e-3))).collect();
+    let entered = states.iter().position(|&s| s == RiskState::GrossSlip);
+    // The first gross-slip sample at 130 s: entered at 135 s, not before.
+    assert_eq!(entered, Some(5), "{states:?}");
+}
+
+/// The fit's slope over its standard error (f64), from the trend's points.
+fn slope_over_its_error(points: &[misalign::monitor::TrendPoint]) -> f64 {
+    let newest = points.last().unwrap().time_ms;
+    let x: Vec<f64> = points
+        .iter()
+        .map(|p| -f64::from(newest.wrapping_sub(p.time_ms)) * 1e-3)
+        .collect();
+    let y: Vec<f64> = points.iter().map(|p| f64::from(p.margin)).collect();
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxx: f64 = x.iter().map(|x| (x - mx).powi(2)).sum();
+    let sxy: f64 = x.iter().zip(&y).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let slope = sxy / sxx;
+    let ssr: f64 = x
+        .iter()
+        .zip(&y)
+        .map(|(x, y)| (y - my - slope * (x - mx)).powi(2))
+        .sum();
+    slope / (ssr / (n - 2.0) / sxx).sqrt()
+}
+
+/// `Approaching` predicts: in the built-in scenario every one has its zero crossing
+/// ahead (a positive time to critical) and a credible fit (the slope at least
+/// `TREND_SLOPE_STANDARD_ERRORS` below zero); none where the fit already crossed, as
+/// at 24365 s, where gross slip had just cleared with a margin of +0.071 mrad.
+#[test]
+fn approaching_only_ahead_of_a_credible_fit() {
+    let mut m = Monitor::new(core(), Config::default()).unwrap();
+    let mut approaching = 0;
+    for s in scenario::Scenario::new() {
+        m.process(s);
+        while let Some(e) = m.pop_event() {
+            if let EventKind::Approaching { time_to_critical_s } = e.kind {
+                approaching += 1;
+                let at = e.elapsed_ms / 1000;
+                assert!(time_to_critical_s > 0.0, "{time_to_critical_s} s at {at} s");
+                let t = slope_over_its_error(m.snapshot().trend_points());
+                let limit = f64::from(misalign::monitor::TREND_SLOPE_STANDARD_ERRORS);
+                assert!(t <= -limit, "slope {t} standard errors at {at} s");
+            }
+        }
+        // Past the fit's crossing there is no time to critical, never 0.
+        assert!(m.time_to_critical().is_none_or(|t| t > 0.0));
+    }
+    assert!(approaching > 0);
+}
+
+/// The fit's answer on its own: a clean fall gives the time to its crossing; a fit
+/// already at or below zero, a rising margin, and a fall hidden in the scatter give
+/// none.
+#[test]
+fn time_to_critical_needs_a_crossing_ahead_and_a_credible_fall() {
+    use misalign::monitor::{TrendPoint, time_to_critical};
+    let line = |m0: f32, rate: f32, wobble: f32| -> Vec<TrendPoint> {
+        (0..16u32)
+            .map(|i| TrendPoint {
+                time_ms: i * 300_000,
+                margin: m0 + rate * (i * 300) as f32 + if i % 2 == 0 { wobble } else { -wobble },
+            })
+            .collect()
+    };
+    // 0.2 mrad at the newest point, falling 1e-8 rad/s: 20 000 s ahead.
+    let t = time_to_critical(&line(2e-4 + 4.5e-5, -1e-8, 0.0)).unwrap();
+    assert!((t / 20_000.0 - 1.0).abs() < 1e-3, "{t} s");
+    // Already crossed at the newest point.
+    assert_eq!(time_to_critical(&line(2e-5, -1e-8, 0.0)), None);
+    // Rising.
+    assert_eq!(time_to_critical(&line(2e-4, 1e-8, 0.0)), None);
+    // The same fall under a scatter of +-0.1 mrad: the slope is a fraction of its
+    // standard error.
+    assert_eq!(time_to_critical(&line(2e-4 + 4.5e-5, -1e-8, 1e-4)), None);
+}
+
+/// A fit's crossing that has passed by the time the contact sticks again predicts
+/// nothing: the margin falls linearly to cross zero at 260 s, the fit made at 302 s
+/// (the third point; over interval means, half an interval behind) crosses at about
+/// 310 s while the contact slips; a dropout at 303 s and a smaller angle after it bring
+/// `Normal` back at 334 s, after that crossing and before the next fit: no
+/// `Approaching` then.
+#[test]
+fn approaching_never_for_a_crossing_already_past() {
+    let config = Config {
+        on_delay_ms: 0,
+        trend: Some(TrendConfig {
+            interval_ms: 100_000,
+            points: 3,
+            horizon_s: 3_600.0,
+        }),
+        ..plain()
+    };
+    let mut m = Monitor::new(core(), config).unwrap();
+    let phi0 = core()
+        .estimate_si(LOAD, 0.0)
+        .unwrap()
+        .critical_angle
+        .unwrap();
+    let mut approaching = Vec::new();
+    for t in 0..400u32 {
+        let sample = match t {
+            0..303 => Sample::new(t * 1000, LOAD, phi0 - 1e-6 * (260.0 - t as f32)),
+            303 => Sample {
+                driver_fault: Some(Channel::Angle),
+                ..Sample::new(t * 1000, LOAD, 1e-4)
+            },
+            _ => Sample::new(t * 1000, LOAD, 1e-4),
+        };
+        m.process(sample);
+        if t == 302 {
+            let ttc = m.time_to_critical().expect("a credible fall at 302 s");
+            assert!((5.0..15.0).contains(&ttc), "{ttc} s");
+        }
+        if t == 334 {
+            assert_eq!(m.state(), RiskState::Normal);
+        }
+        while let Some(e) = m.pop_event() {
+            if let EventKind::Approaching { time_to_critical_s } = e.kind {
+                approaching.push((e.elapsed_ms, time_to_critical_s));
+            }
+        }
+    }
+    assert_eq!(approaching, []);
+}

@@ -155,7 +155,7 @@ fn check<E: Estimator>(core: E, config: Config, samples: &[Sample]) -> Result<()
                     last_change_ms = e.elapsed_ms;
                 }
                 EventKind::Approaching { time_to_critical_s } => {
-                    prop_assert!(time_to_critical_s >= 0.0)
+                    prop_assert!(time_to_critical_s > 0.0)
                 }
                 EventKind::Friction { .. } => {
                     prop_assert!(false, "no friction without process_with_friction")
@@ -176,7 +176,7 @@ fn check<E: Estimator>(core: E, config: Config, samples: &[Sample]) -> Result<()
             .iter()
             .all(|&state| st.energy_j(state).is_finite() && st.energy_j(state) >= 0.0)
     );
-    prop_assert!(m.time_to_critical().is_none_or(|t| t >= 0.0));
+    prop_assert!(m.time_to_critical().is_none_or(|t| t > 0.0));
     let time: u64 = RiskState::ALL
         .iter()
         .map(|&state| st.time_in_state_ms(state))
@@ -238,5 +238,231 @@ proptest! {
         let emitted = u64::from(m.next_event_seq());
         prop_assert_eq!(m.snapshot().next_event_seq(), m.next_event_seq());
         prop_assert_eq!(delivered + pending + u64::from(m.statistics().events_dropped()), emitted);
+    }
+}
+
+/// A stream in segments: each a run of samples at one load and angle (running, slow,
+/// a dropout with `P = NaN`, or an angle anywhere from normal to gross slip at 2 kN),
+/// with the time steps of `step` (repeated, backwards, gaps and wraps too).
+fn segmented() -> impl Strategy<Value = Vec<Sample>> {
+    let segment = (
+        prop_oneof![
+            6 => (0.0f32..2.5e-3).prop_map(|phi| (2e3f32, phi)),
+            1 => Just((f32::NAN, 1e-4f32)),
+            1 => Just((50.0f32, 1e-4f32)),
+        ],
+        1usize..40,
+    );
+    (
+        prop::collection::vec(segment, 1..20),
+        prop::collection::vec(step(), 400),
+        any::<u32>(),
+    )
+        .prop_map(|(segments, steps, start)| {
+            let mut t = start;
+            let mut steps = steps.into_iter().cycle();
+            let mut out = Vec::new();
+            for ((load, phi), n) in segments {
+                for i in 0..n {
+                    t = t.wrapping_add(steps.next().unwrap_or(1000));
+                    // Noise, so that a steady angle is not one value.
+                    let noise = (i % 5) as f32 * 1e-7;
+                    out.push(Sample::new(t, load, phi + noise));
+                }
+            }
+            out
+        })
+}
+
+prop_compose! {
+    /// Random delays and inhibit, a random deadband; conditioning, stuck detection and
+    /// trend off (so that a test can tell each sample's candidate from the sample).
+    fn delay_configs()(on in prop_oneof![Just(0u32), 0u32..20_000],
+                       off in prop_oneof![Just(0u32), 0u32..40_000],
+                       fault in prop_oneof![Just(0u32), 0u32..40_000],
+                       inhibit in prop_oneof![Just(0u32), 0u32..20_000],
+                       gap in prop_oneof![Just(0u32), 1u32..20_000],
+                       deadband in 0.0f32..0.3) -> Config {
+        Config {
+            on_delay_ms: on,
+            off_delay_ms: off,
+            fault_delay_ms: fault,
+            inhibit_ms: inhibit,
+            spikes: None,
+            smoothing_tau_s: 0.0,
+            stuck_ms: 0,
+            gap_ms: gap,
+            trend: None,
+            friction: None,
+            thresholds: misalign::monitor::Thresholds::SlipRatio { warning: 0.8, alarm: 1.0, deadband },
+            ..Config::default()
+        }
+    }
+}
+
+/// The state a sample asks for, found from the sample and what the monitor counted
+/// (with conditioning off): a fault, `Stopped`, `Normal` in the start-up inhibit, or
+/// the slip level of its d/b with the deadband on clearing from `before`.
+fn candidate(
+    config: &Config,
+    s: &Sample,
+    faulted: bool,
+    inhibited: bool,
+    before: RiskState,
+) -> RiskState {
+    let speed = s.speed.unwrap_or(config.nominal_speed);
+    if faulted {
+        return RiskState::SensorFault;
+    }
+    if !(s.load >= config.stop_load && speed >= config.stop_speed) {
+        return RiskState::Stopped;
+    }
+    if inhibited {
+        return RiskState::Normal;
+    }
+    let misalign::monitor::Thresholds::SlipRatio {
+        warning,
+        alarm,
+        deadband,
+    } = config.thresholds
+    else {
+        unreachable!("the strategy sets d/b thresholds")
+    };
+    let x = EllipticScene::new(&scene())
+        .unwrap()
+        .estimate_si(s.load, s.phi)
+        .unwrap()
+        .slip_ratio;
+    let gross = x >= alarm || (before == RiskState::GrossSlip && x >= alarm - deadband);
+    let raised = matches!(before, RiskState::Microslip | RiskState::GrossSlip);
+    let micro = x >= warning || (raised && x >= warning - deadband);
+    if gross {
+        RiskState::GrossSlip
+    } else if micro {
+        RiskState::Microslip
+    } else {
+        RiskState::Normal
+    }
+}
+
+/// Since when (ms) candidates have stood without a break for `target` seen from
+/// `from`: faults for `SensorFault`, slip levels at or beyond `target` on its side of
+/// `from` for the others (one start per state and side, kept in `runs`).
+#[derive(Default)]
+struct Runs {
+    /// Per state: at or above it (slip levels only).
+    up: [Option<u64>; 5],
+    /// Per state: at or below it (slip levels only).
+    down: [Option<u64>; 5],
+    fault: Option<u64>,
+}
+
+impl Runs {
+    fn note(&mut self, c: RiskState, now: u64) {
+        let start = |run: &mut Option<u64>, holds: bool| {
+            *run = if holds {
+                Some(run.unwrap_or(now))
+            } else {
+                None
+            };
+        };
+        let slip = c != RiskState::SensorFault;
+        for x in RiskState::ALL {
+            start(&mut self.up[x.index()], slip && c.index() >= x.index());
+            start(&mut self.down[x.index()], slip && c.index() <= x.index());
+        }
+        start(&mut self.fault, !slip);
+    }
+
+    fn since(&self, from: RiskState, target: RiskState) -> Option<u64> {
+        if target == RiskState::SensorFault {
+            self.fault
+        } else if target.index() > from.index() {
+            self.up[target.index()]
+        } else {
+            self.down[target.index()]
+        }
+    }
+}
+
+/// Every state is entered only after its own candidates stood for its own delay
+/// (counted from the first of them, whatever came before: a fault's time never counts
+/// toward slip, nor slip's toward a fault), and once some state's candidates have
+/// stood for its delay since the last change, the state does change.
+fn delays_hold(config: Config, samples: &[Sample]) -> Result<(), TestCaseError> {
+    let core = EllipticScene::new(&scene()).unwrap();
+    let mut m = Monitor::new(core, config).unwrap();
+    // Runs over the whole stream (safety) and since the last change (liveness).
+    let (mut whole, mut since_change) = (Runs::default(), Runs::default());
+    let mut started: Option<u64> = None;
+    for s in samples {
+        let before = m.state();
+        let (repeated, faults, refused) = {
+            let st = m.statistics();
+            (
+                st.repeated_timestamps(),
+                st.faults().total(),
+                st.faults().estimator,
+            )
+        };
+        let after = m.process(*s);
+        let st = m.statistics();
+        if st.repeated_timestamps() > repeated {
+            prop_assert_eq!(after, before, "a repeated timestamp changes nothing");
+            continue;
+        }
+        let now = m.elapsed_ms();
+        let faulted = st.faults().total() > faults;
+        // The start-up inhibit runs from the first running sample the checks passed
+        // (the estimator may still refuse it) since the start or `Stopped`.
+        let running_valid = st.faults().estimator > refused || !faulted;
+        let speed = s.speed.unwrap_or(config.nominal_speed);
+        if running_valid && s.load >= config.stop_load && speed >= config.stop_speed {
+            started.get_or_insert(now);
+        }
+        let inhibited = started.is_none_or(|t| now - t < u64::from(config.inhibit_ms));
+        let c = candidate(&config, s, faulted, inhibited, before);
+        whole.note(c, now);
+        since_change.note(c, now);
+        if after != before {
+            let since = whole.since(before, after);
+            prop_assert!(
+                since.is_some_and(|t| now - t >= delay(&config, before, after)),
+                "{:?} -> {:?} at {} ms, its candidates since {:?}",
+                before,
+                after,
+                now,
+                since
+            );
+            since_change = Runs::default();
+            if after == RiskState::Stopped {
+                started = None;
+            }
+        } else {
+            for x in RiskState::ALL.into_iter().filter(|&x| x != before) {
+                let due = since_change
+                    .since(before, x)
+                    .is_some_and(|t| now - t >= delay(&config, before, x));
+                prop_assert!(
+                    !due,
+                    "{:?} held its delay from {:?} at {} ms",
+                    x,
+                    before,
+                    now
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// Over random streams and random delays, no state is entered before its own delay
+    /// since its own candidate began, and none is held back beyond it.
+    #[test]
+    fn each_state_waits_its_own_delay(samples in segmented(), config in delay_configs()) {
+        delays_hold(config, &samples)?;
     }
 }

@@ -253,6 +253,111 @@ fn corrupted_payloads_are_refused() {
     );
 }
 
+/// Where the state's fields sit in its payload (version 1, docs/formats.md), with their
+/// sizes: the fields a mutation test rewrites.
+const FIELDS: [(&str, usize, usize); 44] = [
+    ("clock: last timestamp flag", 0, 1),
+    ("clock: last timestamp", 1, 4),
+    ("clock: elapsed", 5, 8),
+    ("alarm: state", 13, 1),
+    ("alarm: since", 14, 8),
+    ("alarm: pending flag", 22, 1),
+    ("alarm: pending state", 23, 1),
+    ("alarm: pending since", 24, 8),
+    ("alarm: started flag", 32, 1),
+    ("alarm: started", 33, 8),
+    ("smoothing: load", 42, 4),
+    ("smoothing: angle", 46, 4),
+    ("stuck: load bits", 50, 4),
+    ("stuck: load since", 54, 8),
+    ("stuck: angle since", 66, 8),
+    ("trend interval: start", 74, 8),
+    ("trend interval: sum", 82, 4),
+    ("trend interval: count", 86, 4),
+    ("time to critical flag", 90, 1),
+    ("time to critical", 91, 4),
+    ("approaching armed", 95, 1),
+    ("next event sequence", 96, 4),
+    ("statistics: samples", 131, 8),
+    ("statistics: repeated", 139, 4),
+    ("statistics: spikes", 143, 4),
+    ("statistics: stuck faults", 155, 4),
+    ("statistics: events dropped", 179, 4),
+    ("statistics: time normal", 191, 8),
+    ("statistics: time gross slip", 207, 8),
+    ("friction: mu", 276, 4),
+    ("friction: baseline", 280, 4),
+    ("friction: captured", 284, 1),
+    ("friction: accepted", 285, 4),
+    ("friction: rejected", 289, 4),
+    ("friction: pending", 293, 4),
+    ("friction: changed", 297, 1),
+    ("spike window: a load", 298 + 12, 4),
+    ("spike window: an angle", 327 + 12, 4),
+    ("spike window: angle length", 327 + 28, 1),
+    ("trend point 0: margin", 356 + 4, 4),
+    ("trend point 0: time", 356, 4),
+    ("trend point 15: time", 356 + 15 * 8, 4),
+    ("event 0: sequence", 485, 4),
+    ("event 0: elapsed", 485 + 8, 8),
+];
+
+/// The record of `state` with `bytes` written into its payload at `at`, and its CRC
+/// made valid again: what a writer with a bug, not a damaged flash, would store.
+fn record_with(state: &MonitorState, at: usize, bytes: &[u8]) -> Vec<u8> {
+    let mut record = vec![0u8; codec::record_len(MonitorState::SIZE)];
+    let n = codec::encode(state, 1, &mut record).unwrap();
+    record.truncate(n);
+    let at = n - 4 - MonitorState::SIZE + at;
+    record[at..at + bytes.len()].copy_from_slice(bytes);
+    let crc = codec::crc32(&record[..n - 4]);
+    record[n - 4..].copy_from_slice(&crc.to_le_bytes());
+    record
+}
+
+/// States no monitor reaches are refused, CRC or not: an alarm start-up time of
+/// u64::MAX (a monitor that would never raise gross slip again), a clock so near
+/// u64::MAX that the next sample wraps it, pending, stuck-tracking and trend times
+/// after the state's own clock, a time per state that does not sum to it.
+#[test]
+fn unreachable_states_are_refused() {
+    let (m, _) = mid_scenario();
+    let state = m.snapshot();
+    let elapsed = state.elapsed_ms();
+    assert!(codec::decode::<MonitorState>(&record_with(&state, 0, &[1])).is_ok());
+    let later = (elapsed + 1).to_le_bytes();
+    let cases: [(&str, usize, &[u8]); 9] = [
+        (
+            "an alarm start-up time of u64::MAX",
+            32,
+            &[[1].as_slice(), &u64::MAX.to_le_bytes()].concat(),
+        ),
+        ("a clock near u64::MAX", 5, &(u64::MAX - 1000).to_le_bytes()),
+        ("a state entered after the clock", 14, &later),
+        (
+            "a pending state since after the clock",
+            22,
+            &[[1, 3].as_slice(), &later].concat(),
+        ),
+        (
+            "a pending state since before its state was entered",
+            22,
+            &[1, 3, 0, 0, 0, 0, 0, 0, 0, 0],
+        ),
+        ("a load stuck since after the clock", 54, &later),
+        ("an angle stuck since after the clock", 66, &later),
+        ("a trend interval begun after the clock", 74, &later),
+        ("more time in gross slip than elapsed", 207, &later),
+    ];
+    for (what, at, bytes) in cases {
+        assert_eq!(
+            codec::decode::<MonitorState>(&record_with(&state, at, bytes)).map(|d| d.value),
+            Err(CodecError::Inconsistent),
+            "{what}"
+        );
+    }
+}
+
 #[test]
 fn the_configuration_round_trips_and_is_validated_on_decode() {
     let custom = Config {
@@ -442,6 +547,145 @@ proptest::proptest! {
         if let Ok(c) = decode::<Config>(&config) {
             proptest::prop_assert_eq!(payload(&c), config);
             proptest::prop_assert!(c.validate().is_ok());
+        }
+    }
+}
+
+/// Runs a restored monitor on 2 mrad at about 2 kN, one sample a second from the
+/// state's last timestamp, for 10 minutes: its clock never runs backwards, the time per
+/// state sums to it, and gross slip is entered within the delays that can stand in its
+/// way (start-up inhibit, the off-delay out of a fault or a stop, the on-delay) and a
+/// minute for the conditioning to settle. Returns the time it took (ms).
+fn raises_gross_slip(state: &MonitorState) -> Result<u64, String> {
+    let config = Config::default();
+    let mut m = Monitor::restore(core(0.3), config, state).unwrap();
+    let t0 = state.last_time_ms().unwrap_or(0);
+    let start = m.elapsed_ms();
+    let mut entered = None;
+    for i in 1..=600u32 {
+        let before = m.elapsed_ms();
+        let load = 2000.0 + (i % 7) as f32;
+        let phi = 2e-3 + (i % 5) as f32 * 1e-7;
+        let sample = Sample::new(t0.wrapping_add(i * 1000), load, phi).with_speed(2.0);
+        if m.process(sample) == RiskState::GrossSlip && entered.is_none() {
+            entered = Some(m.elapsed_ms() - start);
+        }
+        if m.elapsed_ms() < before {
+            return Err(format!("the clock ran backwards at sample {i}"));
+        }
+    }
+    let st = m.statistics();
+    let in_states: u64 = RiskState::ALL.iter().map(|&s| st.time_in_state_ms(s)).sum();
+    if in_states != m.elapsed_ms() {
+        return Err(format!(
+            "{in_states} ms in states, {} elapsed",
+            m.elapsed_ms()
+        ));
+    }
+    let bound = u64::from(config.inhibit_ms + config.off_delay_ms + config.on_delay_ms) + 60_000;
+    match entered {
+        Some(t) if t <= bound => Ok(t),
+        t => Err(format!("gross slip after {t:?} ms, bound {bound} ms")),
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
+
+    /// Each field of a real state (four hours into the scenario) rewritten with values
+    /// around its own clock, at the ends of its type, or at random, the CRC made valid
+    /// again: what still decodes runs as a reachable state (gross slip within its
+    /// delays, a clock that goes forward, time per state that sums to it).
+    #[test]
+    fn a_mutated_state_that_decodes_is_reachable(
+        field in 0..FIELDS.len(),
+        choice in 0usize..9,
+        random in proptest::prelude::any::<u64>(),
+    ) {
+        let state = mid_scenario_state();
+        let now = state.elapsed_ms();
+        let (what, at, size) = FIELDS[field];
+        let value: u64 = [0, 1, now - 1, now, now + 1, now + (1 << 31), u64::MAX - 1, u64::MAX, random][choice];
+        let record = record_with(&state, at, &value.to_le_bytes()[..size]);
+        if let Ok(decoded) = codec::decode::<MonitorState>(&record) {
+            let took = raises_gross_slip(&decoded.value);
+            proptest::prop_assert!(took.is_ok(), "{} = {:#x}: {:?}", what, value, took);
+        }
+    }
+}
+
+/// The state of [`mid_scenario`], computed once.
+fn mid_scenario_state() -> MonitorState {
+    static STATE: std::sync::OnceLock<MonitorState> = std::sync::OnceLock::new();
+    *STATE.get_or_init(|| mid_scenario().0.snapshot())
+}
+
+/// The untouched state raises gross slip within the bound too, after the on-delay.
+#[test]
+fn the_untouched_state_raises_gross_slip() {
+    let took = raises_gross_slip(&mid_scenario_state()).unwrap();
+    assert!(
+        took >= u64::from(Config::default().on_delay_ms),
+        "{took} ms"
+    );
+}
+
+use proptest::prelude::Strategy as _;
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(128))]
+
+    /// The other way round: whatever a monitor reaches over a random stream (repeated
+    /// and backward timestamps, gaps, wraps, faults, stops, slip, a measured F, a
+    /// baseline captured on demand) passes every check and decodes to itself.
+    #[test]
+    fn every_reached_state_decodes(
+        steps in proptest::collection::vec(proptest::prop_oneof![
+            8 => 1u32..3_000,
+            1 => proptest::prelude::Just(0u32),
+            1 => (1u32..100_000).prop_map(|d| d.wrapping_neg()),
+            1 => 10_000u32..10_000_000,
+            1 => proptest::prelude::any::<u32>(),
+        ], 1..400),
+        loads in proptest::collection::vec(proptest::prop_oneof![
+            8 => 1e3f32..4e3,
+            1 => proptest::prelude::Just(f32::NAN),
+            1 => 0.0f32..150.0,
+        ], 400),
+        phis in proptest::collection::vec(0.0f32..2.5e-3, 400),
+        forced in proptest::collection::vec(proptest::prelude::any::<bool>(), 400),
+        start in proptest::prelude::any::<u32>(),
+        fast in proptest::prelude::any::<bool>(),
+    ) {
+        let config = if fast {
+            Config { on_delay_ms: 1_000, off_delay_ms: 2_000, inhibit_ms: 3_000, fault_delay_ms: 1_500, ..Config::default() }
+        } else {
+            Config::default()
+        };
+        let mut m = Monitor::new(core(0.3), config).unwrap();
+        let forward = core(0.3);
+        let mut t = start;
+        for (i, d) in steps.iter().enumerate() {
+            t = t.wrapping_add(*d);
+            let mut s = Sample::new(t, loads[i], phis[i]).with_speed(2.0);
+            if forced[i]
+                && let Ok(e) = forward.estimate_si(loads[i].max(0.0), phis[i])
+                && e.axial_force.is_finite()
+            {
+                s = s.with_axial_force(e.axial_force * 0.8);
+            }
+            m.process_with_friction(s);
+            if i % 97 == 96 {
+                m.capture_friction_baseline();
+            }
+            if i % 3 == 0 {
+                m.pop_event();
+            }
+            let state = m.snapshot();
+            let mut record = vec![0u8; codec::record_len(MonitorState::SIZE)];
+            let n = codec::encode(&state, 1, &mut record).unwrap();
+            let decoded = codec::decode::<MonitorState>(&record[..n]).map(|d| d.value);
+            proptest::prop_assert_eq!(decoded, Ok(state), "after sample {}", i);
         }
     }
 }

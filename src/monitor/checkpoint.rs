@@ -7,8 +7,10 @@
 //! unknown state, channel, sensor, fault or event code, a flag byte other than 0 or 1,
 //! a buffer length above its capacity, the bytes of an absent value or of padding
 //! other than zero, a NaN or infinite value where the monitor keeps finite ones, and a
-//! configuration that fails [`Config::validate`]. So a restored state is one the
-//! monitor could have reached, never a wrong value.
+//! configuration that fails [`Config::validate`]. A state whose fields, each valid,
+//! contradict each other (a time after its own clock, a count above what it counts:
+//! see `reachable`) is refused with [`CodecError::Inconsistent`]. So a restored state
+//! is one the monitor could have reached, never a wrong value.
 
 use super::checks::{Checks, StuckTracker};
 use super::clock::Clock;
@@ -461,6 +463,93 @@ fn get_stats(r: &mut Reader<'_>) -> Result<Statistics, CodecError> {
     })
 }
 
+/// The longest forward step of the clock (ms): a u32 counter difference below 2^31.
+const MAX_STEP_MS: u64 = (1 << 31) - 1;
+
+/// Events one sample can emit at most: a state change, `Approaching`, a friction
+/// change, and the clearing of that change by a baseline captured on demand.
+const MAX_EVENTS_PER_SAMPLE: u64 = 4;
+
+/// Whether the fields of a decoded state hold together as a monitor's do
+/// ([`CodecError::Inconsistent`] otherwise): every time against the state's own clock
+/// (`elapsed_ms`), every count against what it counts.
+///
+/// - The clock: a last timestamp exactly when a sample was seen; the elapsed time at
+///   most the samples' steps (each below 2^31 ms) and far enough below `u64::MAX` that
+///   the next step cannot wrap it; the time per state sums to it.
+/// - The state machine, stuck tracking, the trend's interval, the friction's pending
+///   time, the events and the trend's points: no time after the clock; a pending state
+///   differs from the reported one and began no earlier than it was entered.
+/// - Counts: repeated timestamps and faults (one a sample) within the samples, spikes
+///   within two a sample, estimates of mu (one a sample) within the samples, dropped
+///   events within what the samples can emit, a trend interval's margins within the
+///   samples; an empty interval holds no start and no sum.
+/// - The events pending are numbered consecutively up to the next sequence number,
+///   oldest first in time; the trend's points too.
+/// - Friction: no mu before an accepted estimate, no baseline before it is captured,
+///   no change raised without a baseline.
+fn reachable(s: &MonitorState) -> Result<(), CodecError> {
+    let ok = |c: bool| {
+        if c {
+            Ok(())
+        } else {
+            Err(CodecError::Inconsistent)
+        }
+    };
+    let now = s.clock.elapsed_ms;
+    let st = &s.stats;
+    let n = st.samples;
+    let at_most_now = |t: u64| t <= now;
+    // The clock.
+    ok(s.clock.last_time_ms.is_some() == (n > 0))?;
+    ok(now <= n.saturating_sub(1).saturating_mul(MAX_STEP_MS) && now <= u64::MAX - MAX_STEP_MS)?;
+    let in_states = st
+        .time_in_state_ms
+        .iter()
+        .try_fold(0u64, |sum, &t| sum.checked_add(t));
+    ok(in_states == Some(now))?;
+    // Times against the clock.
+    let a = &s.alarm;
+    ok(at_most_now(a.since_ms) && a.started_ms.is_none_or(at_most_now))?;
+    // A run of candidates begins after the state it would leave was entered.
+    let after_entry = |t: u64| a.since_ms <= t && at_most_now(t);
+    ok(a.pending
+        .is_none_or(|(p, t)| p != a.state && after_entry(t)))?;
+    ok(s.checks.stuck.iter().all(|t| at_most_now(t.since_ms)))?;
+    let iv = &s.trend_interval;
+    ok(at_most_now(iv.start_ms) && u64::from(iv.count) <= n)?;
+    ok(iv.count > 0 || (iv.start_ms == 0 && iv.sum == 0.0))?;
+    ok(u64::from(s.friction.pending_ms) <= now)?;
+    // Counts against what they count.
+    let repeated = u64::from(st.repeated_timestamps);
+    ok(repeated <= n && st.faults.total() <= n - repeated)?;
+    ok(u64::from(st.spikes) <= n.saturating_mul(2))?;
+    ok(u64::from(st.events_dropped) <= n.saturating_mul(MAX_EVENTS_PER_SAMPLE))?;
+    let f = &s.friction;
+    ok(u64::from(f.accepted) + u64::from(f.rejected) <= n)?;
+    ok(f.accepted > 0 || f.mu == 0.0)?;
+    ok(f.baseline_captured || (f.baseline == 0.0 && !f.changed))?;
+    ok(s.time_to_critical_s.is_none_or(|t| t >= 0.0))?;
+    // The events: consecutive up to the next number, in time order, none after now.
+    let count = u32::from(s.events.len.min(EVENT_CAPACITY as u8));
+    let mut seq = s.next_seq.wrapping_sub(count);
+    let mut previous = 0;
+    for e in s.events.iter() {
+        ok(e.seq == seq && previous <= e.elapsed_ms && at_most_now(e.elapsed_ms))?;
+        seq = seq.wrapping_add(1);
+        previous = e.elapsed_ms;
+    }
+    // The trend's points (low 32 bits of the clock): ages within the clock, oldest
+    // first.
+    let mut age = now;
+    for p in s.trend.iter() {
+        let this = u64::from((now as u32).wrapping_sub(p.time_ms));
+        ok(this <= age)?;
+        age = this;
+    }
+    Ok(())
+}
+
 /// The state of a monitor, stored under [`kind::MONITOR_STATE`]: everything
 /// [`Monitor::restore`](super::Monitor::restore) needs to go on identically (energy
 /// and time per state, counters, the clock, the state machine, the buffers, the
@@ -490,7 +579,8 @@ impl Checkpoint for MonitorState {
         Ok(state)
     }
 
-    /// Field by field into `self`: a restore holds one state, not three.
+    /// Field by field into `self`: a restore holds one state, not three. Then the
+    /// fields against each other ([`reachable`]).
     fn decode_into(&mut self, r: &mut Reader<'_>) -> Result<(), CodecError> {
         get_status(r, self)?;
         get_saved(r, &mut self.load_window, finite)?;
@@ -501,7 +591,8 @@ impl Checkpoint for MonitorState {
                 margin: finite(r)?,
             })
         })?;
-        get_saved(r, &mut self.events, get_event)
+        get_saved(r, &mut self.events, get_event)?;
+        reachable(self)
     }
 }
 

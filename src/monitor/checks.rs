@@ -41,6 +41,17 @@ impl Limits {
         }
     }
 
+    /// Whether load and angle values are within the accepted ranges (N, rad): what the
+    /// conditioning's windows and smoothing can hold, made of accepted values only.
+    pub(crate) fn accepts(
+        &self,
+        loads: impl IntoIterator<Item = f32>,
+        angles: impl IntoIterator<Item = f32>,
+    ) -> bool {
+        loads.into_iter().all(|x| self.load.contains(x))
+            && angles.into_iter().all(|x| self.angle.contains(x))
+    }
+
     /// The first fault of a sample that failed the checks at speed `speed`: a
     /// sensor's report, a driver's, then load, angle, speed and axial force, each
     /// non-finite or out of range.

@@ -8,6 +8,13 @@ pub const SPIKE_WINDOW_CAPACITY: usize = 7;
 /// Capacity of the trend buffer (points).
 pub const TREND_CAPACITY: usize = 16;
 
+/// How credible the trend's fit must be to give a time to critical: its slope (the
+/// margin's drift, rad/s) at least this many of its standard errors below zero, which
+/// is the fit's R^2 at least k^2 / (n - 2 + k^2) over n points (0.39 over the 16 of
+/// the default window). With 16 points and independent residuals, a margin that does
+/// not drift passes about once in 200 fits (Student's t, 14 degrees of freedom).
+pub const TREND_SLOPE_STANDARD_ERRORS: f32 = 3.0;
+
 /// What the warning and alarm thresholds are set on.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -73,13 +80,18 @@ pub struct TrendConfig {
 pub struct Config {
     /// Warning and alarm thresholds with their deadband.
     pub thresholds: Thresholds,
-    /// On-delay: a more severe state must hold this long before it is entered (ms);
-    /// a start (`Stopped` to `Normal`) is entered at once.
+    /// On-delay: a more severe slip state must be asked for by every sample for this
+    /// long before it is entered (ms), counted from the first sample that asks for it
+    /// or for a state beyond it; a start (`Stopped` to `Normal`) is entered at once.
+    /// A sensor fault's time never counts toward it.
     pub on_delay_ms: u32,
-    /// Off-delay: a less severe state (or the end of a sensor fault) must hold this
-    /// long before it is entered (ms); the minimum dwell in a raised state.
+    /// Off-delay: a less severe state (or the end of a sensor fault) must be asked for
+    /// this long before it is entered (ms), counted the same way; the minimum dwell in
+    /// a raised state.
     pub off_delay_ms: u32,
-    /// Delay before a sensor fault is reported (ms; 0: at once).
+    /// Delay before a sensor fault is reported (ms; 0: at once), counted from the
+    /// first of an unbroken run of faulted samples. Slip's time never counts toward
+    /// it, nor its toward slip.
     pub fault_delay_ms: u32,
     /// Start-up inhibit: no warning or alarm for this long after the machine starts
     /// (first sample or leaving `Stopped`) (ms).

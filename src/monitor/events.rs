@@ -90,9 +90,14 @@ pub enum EventKind {
         /// For a change to `SensorFault`, the fault that caused it.
         fault: Option<FaultCause>,
     },
-    /// The time to critical fell below the configured horizon.
+    /// Gross slip predicted: the trend's fit of the margin is above zero at its newest
+    /// point, falls by at least
+    /// [`TREND_SLOPE_STANDARD_ERRORS`](super::TREND_SLOPE_STANDARD_ERRORS) of its
+    /// standard errors, and crosses zero ahead of this sample sooner than the
+    /// configured horizon, while the contact still sticks (`Normal` or `Microslip`).
     Approaching {
-        /// Estimated time until gross slip at the current drift (s).
+        /// Estimated time until gross slip at the current drift (s), from this
+        /// sample: the fit's time to critical less the time since the fit.
         time_to_critical_s: f32,
     },
     /// The filtered friction coefficient left the band around its baseline
@@ -150,34 +155,43 @@ impl Events {
     }
 
     /// Whether the `Approaching` warning is due, at the time to critical
-    /// `time_to_critical_s` (s) of the trend `trend` with the state `state` reported:
-    /// once when it falls below the horizon while the contact still sticks; re-armed
-    /// above 1.5 horizons. Returns the time to critical to report.
+    /// `time_to_critical_s` (s) of the trend `trend`, fitted `fit_age_s()` seconds ago,
+    /// with the state `state` reported: once when it falls below the horizon while the
+    /// contact still sticks and the fit's crossing still lies ahead; re-armed above 1.5
+    /// horizons. Returns the time left until the crossing, to report.
     #[inline(always)]
     pub(crate) fn approaching(
         &mut self,
         trend: Option<TrendConfig>,
         time_to_critical_s: Option<f32>,
+        fit_age_s: impl FnOnce() -> f32,
         state: RiskState,
     ) -> Option<f32> {
         if time_to_critical_s.is_none() && self.approaching_armed {
             return None;
         }
-        self.approaching_check(trend?, time_to_critical_s, state)
+        self.approaching_check(trend?, time_to_critical_s, fit_age_s, state)
     }
 
     fn approaching_check(
         &mut self,
         tc: TrendConfig,
         time_to_critical_s: Option<f32>,
+        fit_age_s: impl FnOnce() -> f32,
         state: RiskState,
     ) -> Option<f32> {
         match time_to_critical_s {
             Some(t) if !ge(t, tc.horizon_s) => {
                 let live = matches!(state, RiskState::Normal | RiskState::Microslip);
                 if self.approaching_armed && live {
+                    // The fit predicts from its newest point: a crossing that has
+                    // passed since predicts nothing (the warning stays armed).
+                    let left = t - fit_age_s();
+                    if ge(0.0, left) {
+                        return None;
+                    }
                     self.approaching_armed = false;
-                    return Some(t);
+                    return Some(left);
                 }
             }
             Some(t) if !ge(t, 1.5 * tc.horizon_s) => {}

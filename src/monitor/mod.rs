@@ -18,9 +18,10 @@
 //!    start-up inhibit decide the [`RiskState`];
 //! 8. **friction** (`friction.rs`, [`Monitor::process_with_friction`] only): mu from a
 //!    measured axial force;
-//! 9. **events** (`events.rs`): state changes, the `Approaching` warning (the time to
-//!    critical below the horizon) and friction changes go to a fixed queue that a
-//!    consumer drains ([`Monitor::pop_event`]);
+//! 9. **events** (`events.rs`): state changes, the `Approaching` warning (a credible
+//!    fit of the margin crosses zero ahead, sooner than the horizon, while the contact
+//!    still sticks) and friction changes go to a fixed queue that a consumer drains
+//!    ([`Monitor::pop_event`]);
 //! 10. **statistics** (`statistics.rs`): the step's energy added to the state
 //!     reported after it.
 //!
@@ -43,7 +44,9 @@
 //! switch per sample: not for a monitor.)
 //!
 //! **Sensor faults are never slip.** A faulted sample is not estimated; its
-//! candidate state is `SensorFault`, and leaving that state waits the off-delay. A
+//! candidate state is `SensorFault`, and leaving that state waits the off-delay. Each
+//! state waits its own delay from its own first candidate: a fault's time never counts
+//! toward a slip state's on-delay, nor slip's toward the fault delay. A
 //! fault the sensors' own detection found ([`Sample::sensor_fault`]; with the
 //! `sensors` feature `Sample::from_sensors` carries it over) is counted and the
 //! state change names the sensor and the reason
@@ -105,7 +108,7 @@ mod trend;
 
 pub use config::{
     Config, ConfigError, FrictionConfig, SPIKE_WINDOW_CAPACITY, SpikeFilter, TREND_CAPACITY,
-    Thresholds, TrendConfig,
+    TREND_SLOPE_STANDARD_ERRORS, Thresholds, TrendConfig,
 };
 pub use energy::dissipated_power;
 pub use events::{EVENT_CAPACITY, Event, EventKind, FaultCause, Reading};
@@ -223,7 +226,11 @@ impl<E: Estimator> Monitor<E> {
     }
 
     /// The latest estimate of the time until gross slip (s) at the current drift of
-    /// the margin; `None` while the margin does not fall or the trend is off.
+    /// the margin: the time until the trend's fitted line crosses zero, ahead of its
+    /// newest point; `None` while the trend is off or its window not full, and while
+    /// the fit predicts no crossing ahead (the margin does not fall, its fall is within
+    /// the scatter, see [`TREND_SLOPE_STANDARD_ERRORS`], or the fit is already at or
+    /// below zero).
     pub fn time_to_critical(&self) -> Option<f32> {
         self.trend.time_to_critical_s
     }
@@ -403,8 +410,12 @@ impl<E: Estimator> Monitor<E> {
         if let Some(from) = changed {
             self.state_changed(from, fault, sample.time_ms);
         }
-        let ttc = self.trend.time_to_critical_s;
-        if let Some(t) = self.events.approaching(self.config.trend, ttc, state) {
+        let (trend, ttc) = (&self.trend, self.trend.time_to_critical_s);
+        let fit_age_s = || trend.fit_age_s(now);
+        if let Some(t) = self
+            .events
+            .approaching(self.config.trend, ttc, fit_age_s, state)
+        {
             let kind = EventKind::Approaching {
                 time_to_critical_s: t,
             };
@@ -488,10 +499,16 @@ impl<E: Estimator> Monitor<E> {
     /// second monitor on the stack. With `storage::Store::restore_into` (feature
     /// `sequential-storage`) a node restores its state at start-up holding one monitor
     /// and one state.
+    ///
+    /// The conditioning holds only values this configuration accepts: a smoothed
+    /// value, or a spike window holding a value, outside its load and angle ranges (a
+    /// state of another configuration, or no monitor's) is left out, and the
+    /// conditioning starts afresh there, as after a fault.
     pub fn resume(&mut self, state: &MonitorState) {
         self.clock = state.clock;
         self.alarm = state.alarm;
-        self.conditioning.smoothed = state.smoothed;
+        let limits = &self.limits;
+        self.conditioning.smoothed = state.smoothed.filter(|&[l, p]| limits.accepts([l], [p]));
         self.checks = state.checks;
         self.trend.interval = state.trend_interval;
         self.trend.time_to_critical_s = state.time_to_critical_s;
@@ -506,14 +523,11 @@ impl<E: Estimator> Monitor<E> {
             .config
             .spikes
             .map_or(SPIKE_WINDOW_CAPACITY, |s| usize::from(s.window));
-        for (window, saved) in self
-            .conditioning
-            .windows
-            .iter_mut()
-            .zip([&state.load_window, &state.angle_window])
-        {
+        let saved = [&state.load_window, &state.angle_window];
+        let accepted = limits.accepts(saved[0].iter(), saved[1].iter());
+        for (window, saved) in self.conditioning.windows.iter_mut().zip(saved) {
             window.clear();
-            for x in saved.iter() {
+            for x in saved.iter().filter(|_| accepted) {
                 window.push_back(x, n);
             }
         }

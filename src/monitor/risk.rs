@@ -136,8 +136,9 @@ pub(crate) struct Alarm {
     pub(crate) state: RiskState,
     /// Monotonic time (ms) the state was entered.
     pub(crate) since_ms: u64,
-    /// A different candidate and the time (ms) it first appeared, on the same side
-    /// (more or less severe) since.
+    /// The state pending and the time (ms) since which every candidate has been it
+    /// or beyond it on its side of the reported state (a fault: a fault); see
+    /// [`Alarm::offer`].
     pub(crate) pending: Option<(RiskState, u64)>,
     /// Monotonic time (ms) the machine last started (its first running sample since
     /// the monitor started or since the state was `Stopped`): the start-up inhibit runs
@@ -207,9 +208,18 @@ impl Alarm {
     }
 
     /// Offers this sample's candidate state at `now_ms`; returns `Some(previous)` when
-    /// the state changes. The candidate must hold for the transition's delay; a
-    /// candidate that changes but stays on the same side of the current state keeps
-    /// its start time (its delay class is the same), any other restarts it.
+    /// the state changes.
+    ///
+    /// Each state is entered only once candidates for it have stood for its own delay,
+    /// counted from the first of them: the pending state is the *nearest* one (to the
+    /// reported state) of an unbroken run of candidates on one side of it, and the
+    /// run's start is its time. A more severe candidate in the run keeps the pending
+    /// state (its own run has not lasted the delay; after the nearer state is entered
+    /// it waits its own), a less severe one on the same side takes its place and keeps
+    /// the start (it has stood since then). A sensor fault is a kind of its own, never
+    /// a slip level: a fault candidate breaks a slip run and a slip candidate a fault
+    /// run, so that neither lends the other its age. The reported state as candidate
+    /// breaks every run.
     pub(crate) fn offer(
         &mut self,
         config: &Config,
@@ -220,25 +230,47 @@ impl Alarm {
             self.pending = None;
             return None;
         }
-        let up = |s: RiskState| s.rank() > self.state.rank();
-        let since = match self.pending {
-            Some((p, t)) if up(p) == up(candidate) => t,
-            _ => now_ms,
+        // The run a candidate belongs to: a fault, or a slip level above or below the
+        // reported state (from `SensorFault`, every slip level is below).
+        let rank = self.state.rank();
+        let run = |s: RiskState| {
+            if s == RiskState::SensorFault {
+                2u8
+            } else {
+                u8::from(s.rank() > rank)
+            }
+        };
+        let (candidate, since) = match self.pending {
+            Some((p, t)) if run(p) == run(candidate) => {
+                // The nearer of the two to the reported state has stood since `t`.
+                let nearer = if (p.rank() > rank) == (candidate.rank() > p.rank()) {
+                    p
+                } else {
+                    candidate
+                };
+                (nearer, t)
+            }
+            _ => (candidate, now_ms),
         };
         self.pending = Some((candidate, since));
-        let delay = Self::delay_ms(config, self.state, candidate);
-        if now_ms.saturating_sub(since) >= u64::from(delay) {
-            let previous = self.state;
-            self.state = candidate;
-            if candidate == RiskState::Stopped {
-                // The next start runs the start-up inhibit again.
-                self.started_ms = None;
-            }
-            self.since_ms = now_ms;
-            self.pending = None;
-            Some(previous)
+        let age = now_ms.saturating_sub(since);
+        let candidate = if age >= u64::from(Self::delay_ms(config, self.state, candidate)) {
+            candidate
+        } else if self.state == RiskState::Stopped && run(candidate) == 1 {
+            // A running candidate is a start, which waits nothing: `Normal` now, the
+            // raised state its own on-delay from here.
+            RiskState::Normal
         } else {
-            None
+            return None;
+        };
+        let previous = self.state;
+        self.state = candidate;
+        if candidate == RiskState::Stopped {
+            // The next start runs the start-up inhibit again.
+            self.started_ms = None;
         }
+        self.since_ms = now_ms;
+        self.pending = None;
+        Some(previous)
     }
 }

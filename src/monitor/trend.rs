@@ -1,9 +1,10 @@
 //! The trend stage: the least-squares trend of the margin phi0 - |phi| over a fixed
-//! window gives the time until gross slip at the current drift (the events stage
-//! warns when it falls below the horizon). Its state: the current interval, the
-//! points, the latest time to critical.
+//! window gives the time until gross slip at the current drift, when the fit is above
+//! zero now and falls credibly ([`time_to_critical`]); the events stage warns when it
+//! falls below the horizon. Its state: the current interval, the points, the latest
+//! time to critical.
 
-use super::config::{TREND_CAPACITY, TrendConfig};
+use super::config::{TREND_CAPACITY, TREND_SLOPE_STANDARD_ERRORS, TrendConfig};
 use super::order::{finite, ge};
 use crate::recip::recip;
 use heapless::Deque;
@@ -74,6 +75,14 @@ impl Trend {
         }
     }
 
+    /// Seconds from the newest point (the fit's time) to monotonic time `now` (ms).
+    #[cold]
+    pub(crate) fn fit_age_s(&self, now: u64) -> f32 {
+        self.points
+            .back()
+            .map_or(0.0, |p| (now as u32).wrapping_sub(p.time_ms) as f32 * 1e-3)
+    }
+
     /// Closes the interval at `now`: its mean margin becomes a point, and with a full
     /// window the time to critical is fitted anew.
     #[cold]
@@ -117,16 +126,21 @@ pub(crate) fn push(buffer: &mut TrendBuffer, point: TrendPoint, points: usize) {
     let _ = buffer.push_back(point);
 }
 
-/// Time (s) until the fitted margin reaches zero: `Some(0)` when the fit at the newest
-/// point is already at or below zero, `None` when the margin does not fall (or fewer
-/// than 3 points). Least squares of margin on time, times taken relative to the newest
-/// point so that f32 keeps them exact. `points` oldest first.
+/// Time (s) until the fitted margin reaches zero, ahead of the newest point: `Some`
+/// only when the least-squares line of margin on time is above zero at the newest
+/// point, falls, and falls credibly (its slope at least
+/// [`TREND_SLOPE_STANDARD_ERRORS`] of its standard errors below zero); `None`
+/// otherwise (fewer than 3 points, a margin that does not fall or whose fall the
+/// scatter hides, or a fit already at or below zero: a crossing in the past predicts
+/// nothing). Times are taken relative to the newest point so that f32 keeps them
+/// exact. `points` oldest first.
 pub fn time_to_critical(points: &[TrendPoint]) -> Option<f32> {
     let newest = points.last()?.time_ms;
+    let x = |p: &TrendPoint| -(newest.wrapping_sub(p.time_ms) as f32 * 1e-3);
     let (mut n, mut sx, mut sy) = (0u32, 0.0f32, 0.0f32);
     for p in points {
         n += 1;
-        sx -= newest.wrapping_sub(p.time_ms) as f32 * 1e-3;
+        sx += x(p);
         sy += p.margin;
     }
     if n < 3 {
@@ -136,11 +150,12 @@ pub fn time_to_critical(points: &[TrendPoint]) -> Option<f32> {
     // on a core without an FPU), within 2 ulp.
     let per_n = recip(n as f32);
     let (mx, my) = (sx * per_n, sy * per_n);
-    let (mut sxx, mut sxy) = (0.0f32, 0.0f32);
+    let (mut sxx, mut sxy, mut syy) = (0.0f32, 0.0f32, 0.0f32);
     for p in points {
-        let dx = -(newest.wrapping_sub(p.time_ms) as f32 * 1e-3) - mx;
+        let (dx, dy) = (x(p) - mx, p.margin - my);
         sxx += dx * dx;
-        sxy += dx * (p.margin - my);
+        sxy += dx * dy;
+        syy += dy * dy;
     }
     // Comparisons as integers where floats are soft (condition::ge).
     if !finite(sxx) || ge(0.0, sxx) {
@@ -148,15 +163,16 @@ pub fn time_to_critical(points: &[TrendPoint]) -> Option<f32> {
     }
     let slope = sxy * recip(sxx); // rad/s
     let now = my - slope * mx; // the fit at the newest point (x = 0)
-    if !finite(now) || !finite(slope) {
+    if !finite(now) || !finite(slope) || ge(0.0, now) || ge(slope, 0.0) {
         return None;
     }
-    if ge(0.0, now) {
-        Some(0.0)
-    } else if !ge(slope, 0.0) {
-        let t = now * recip(-slope);
-        finite(t).then_some(t)
-    } else {
-        None
+    // Credible: -slope / se >= k, se^2 = (syy - slope sxy) / ((n - 2) sxx), which
+    // squared is R^2 = sxy^2 / (sxx syy) >= k^2 / (n - 2 + k^2): no pass over the
+    // residuals.
+    let k2 = TREND_SLOPE_STANDARD_ERRORS * TREND_SLOPE_STANDARD_ERRORS;
+    if !ge(sxy * sxy * ((n - 2) as f32 + k2), k2 * sxx * syy) {
+        return None;
     }
+    let t = now * recip(-slope);
+    finite(t).then_some(t)
 }

@@ -68,6 +68,9 @@ pub enum CodecError {
     },
     /// The payload decoded, but a field holds a value the type refuses.
     InvalidValue,
+    /// Every field holds a value of its type, but together they hold a state no writer
+    /// reaches: a time after the state's own clock, a count above what it counts.
+    Inconsistent,
 }
 
 impl fmt::Display for CodecError {
@@ -86,6 +89,7 @@ impl fmt::Display for CodecError {
                 write!(f, "unsupported format version {version}")
             }
             CodecError::InvalidValue => f.write_str("a field holds a value the type refuses"),
+            CodecError::Inconsistent => f.write_str("the fields contradict each other"),
         }
     }
 }
