@@ -298,11 +298,10 @@ fn summary<E: Estimator>(out: &mut dyn Write, m: &Monitor<E>) -> Res<()> {
         out,
         "final state {}  time to critical {}",
         m.state().as_str(),
-        m.time_to_critical()
-            .map_or("- (margin not falling)".into(), |t| format!(
-                "{:.0} min",
-                t / 60.0
-            ))
+        m.time_to_critical().map_or(
+            "- (no credible fall of the margin ahead)".into(),
+            |t| format!("{:.0} min", t / 60.0)
+        )
     );
     Ok(())
 }
