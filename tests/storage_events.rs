@@ -459,3 +459,33 @@ fn wear_figures_are_the_documented_ones() {
     );
     assert!(spec.contains(&row), "docs/formats.md lacks {row}");
 }
+
+/// Garbage over the region (cold RAM, another program's data): no event comes out of
+/// it; the region is erased and reported, and the queue works.
+#[test]
+fn garbage_gives_no_event_and_erase_recovers() {
+    for seed in 0u64..12 {
+        let mut flash = Flash::new();
+        let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+        for i in 0..SECTORS {
+            for b in flash.sector_mut(i).unwrap().iter_mut() {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                *b = match seed {
+                    10 => 0x00,
+                    11 => 0x55,
+                    _ => x as u8,
+                };
+            }
+        }
+        let mut q = new_queue(flash);
+        let found = block_on(q.open()).unwrap();
+        assert!(found.erased, "{seed}");
+        assert_eq!((found.newest, found.acknowledged), (None, None), "{seed}");
+        push(&mut q, 0);
+        let mut q = boot(flash_of(q));
+        assert!(!q.state().erased);
+        assert_eq!(unacked(&mut q), [0], "{seed}");
+    }
+}

@@ -88,6 +88,10 @@ pub struct Recovered {
     /// Items that are not records of this queue (damaged, foreign, another version),
     /// skipped.
     pub skipped: u32,
+    /// The region held no record of this queue and was not blank (another program's
+    /// data, garbage), or damage `sequential-storage` could not repair: it was erased
+    /// (no event of this queue was in it).
+    pub erased: bool,
 }
 
 /// What one push did.
@@ -190,11 +194,46 @@ impl<F: NorFlash, T: Checkpoint, const BUF: usize> EventQueue<F, T, BUF> {
     }
 
     /// Reads the log through at start-up: the acknowledgement, the records not
-    /// acknowledged. `Err` for a flash driver error, or damage `sequential-storage`
-    /// cannot repair ([`StorageError::Corrupted`]: [`EventQueue::erase`] is the remedy).
+    /// acknowledged. A region that holds no record of this queue and is not blank, or
+    /// that `sequential-storage` cannot read, is erased and reported
+    /// ([`Recovered::erased`]): pushing onto garbage could lose the record. `Err` for a
+    /// flash driver error.
     pub async fn open(&mut self) -> Result<Recovered, StorageError<F::Error>> {
-        self.state = self.scan().await?;
-        Ok(self.state)
+        let found = match self.scan().await {
+            Ok(found) if found.newest.is_some() || found.acknowledged.is_some() => found,
+            Ok(found) if self.region_is_blank().await? => found,
+            Ok(_) | Err(StorageError::Corrupted) => {
+                self.erase().await?;
+                Recovered {
+                    erased: true,
+                    ..Recovered::default()
+                }
+            }
+            Err(e) => return Err(e),
+        };
+        self.state = found;
+        Ok(found)
+    }
+
+    /// True if every byte of the region reads 0xFF.
+    async fn region_is_blank(&mut self) -> Result<bool, StorageError<F::Error>> {
+        let range = self.queue.flash_range();
+        let chunk = BUF - BUF % F::READ_SIZE.max(1);
+        let mut at = range.start;
+        while at < range.end && chunk > 0 {
+            let n = chunk.min((range.end - at) as usize);
+            let buf = self.buf.0.get_mut(..n).ok_or(StorageError::Internal)?;
+            self.queue
+                .flash()
+                .read(at, buf)
+                .await
+                .map_err(StorageError::Flash)?;
+            if buf.iter().any(|&b| b != 0xFF) {
+                return Ok(false);
+            }
+            at += n as u32;
+        }
+        Ok(chunk > 0)
     }
 
     /// What the log holds now (as [`EventQueue::open`] found it, kept up to date).
