@@ -10,7 +10,7 @@ use misalign::modbus::{
     EVENT_WINDOW, Server, ServerConfig, StorageStatus, crc16, event_from_registers,
 };
 use misalign::monitor::{Config, Event, Monitor, MonitorState, Sample, model_for_range};
-use misalign::storage::{BlockingFlash, EventQueue, MockFlash, block_on};
+use misalign::storage::{BlockingFlash, EventQueue, MockFlash, RestoreOutcome, Store, block_on};
 use misalign::{Estimator, Scene};
 
 type Flash = MockFlash<4, 1024, 4>;
@@ -252,4 +252,66 @@ fn every_event_is_read_once_in_order_across_resets_and_beyond_the_window() {
     eprintln!("{raised} events read through {resets} resets");
     assert_eq!(q.state().unacknowledged, 0);
     assert_eq!(q.dropped(), 0);
+}
+
+type StateFlash = MockFlash<4, 4096, 4>;
+type States = Store<BlockingFlash<StateFlash>, 1024>;
+
+/// The monitor's state checkpointed at each event and once a minute, restored at
+/// start-up; `checkpoints` and `checkpoint_age` say which and how old.
+#[test]
+fn checkpoints_at_each_event_and_periodically_show_in_the_map() {
+    let mut states = States::new(BlockingFlash(StateFlash::new()), 0..4 * 4096, 60).unwrap();
+    let mut q = open_queue(Flash::new());
+    let mut s = Server::new(monitor(None), ServerConfig::default()).unwrap();
+    s.store_events(None);
+    let mut written = 0u32;
+    for i in 0..400u32 {
+        // Faults in the first 40 samples only: then a quiet run, periodic checkpoints.
+        let x = if i < 40 { sample(i) } else { sample(4 * i) };
+        let x = Sample {
+            time_ms: i * 1000,
+            ..x
+        };
+        let before = s.monitor().next_event_seq();
+        s.process(x);
+        service(&mut s, &mut q);
+        let state = s.monitor().snapshot();
+        let now_ms = s.monitor().elapsed_ms();
+        let done = if s.monitor().next_event_seq() != before {
+            Some(block_on(states.checkpoint(&state)).unwrap())
+        } else {
+            block_on(states.checkpoint_if_due(now_ms / 1000, &state)).unwrap()
+        };
+        let mut status = s.storage_status();
+        if let Some(n) = done {
+            written += 1;
+            status.checkpoints = n;
+            status.last_checkpoint_ms = Some(now_ms);
+        }
+        s.set_storage_status(status);
+        assert_eq!(input(&mut s, "checkpoints"), written);
+        let age = now_ms - status.last_checkpoint_ms.unwrap_or(now_ms);
+        assert_eq!(input(&mut s, "checkpoint_age"), (age / 1000) as u32);
+    }
+    let events = s.monitor().next_event_seq();
+    // One at each event and one a minute between (the first call starts the period).
+    assert!(
+        written >= events && written < events + 400 / 60 + 1,
+        "{written}"
+    );
+    assert!(input(&mut s, "checkpoint_age") > 0);
+    // A reset: the newest checkpoint restored, its number shown, its age 0.
+    let mut states = States::new(states.into_flash(), 0..4 * 4096, 60).unwrap();
+    let mut state = MonitorState::default();
+    let outcome = block_on(states.restore_into(&mut state)).unwrap();
+    assert_eq!(outcome, RestoreOutcome::Restored { sequence: written });
+    let mut s = Server::new(monitor(Some(&state)), ServerConfig::default()).unwrap();
+    s.set_storage_status(StorageStatus {
+        checkpoints: written,
+        last_checkpoint_ms: Some(state.elapsed_ms()),
+        ..StorageStatus::default()
+    });
+    assert_eq!(input(&mut s, "checkpoints"), written);
+    assert_eq!(input(&mut s, "checkpoint_age"), 0);
 }

@@ -43,8 +43,8 @@
 //! `wanted_event`, `offer_stored_event`, `end_backlog`, `acknowledged_through`,
 //! `set_storage_status` ([`StorageStatus`]), `storage_status`. The server stores
 //! nothing itself (it does not depend on `misalign::storage`): the application moves
-//! the events between it and its flash. Beside it: [`registers_csv`], [`silence_us`], the map's
-//! addresses in [`map`], and for a master written in Rust [`event_from_registers`]
+//! the events between it and its flash. Beside it: [`registers_csv`], [`silence_us`],
+//! the map's addresses in [`map`], and for a master written in Rust [`event_from_registers`]
 //! and [`fault_from_code`].
 //!
 //! **External samples** written by a master over the bus (holding blocks `sample_*`,
