@@ -5,7 +5,7 @@
 //! figures of docs/formats.md.
 //!
 //! `MISALIGN_POWER_LOSS=full` sweeps every push and acknowledgement of four turns of
-//! the ring (about 15 s) instead of the default's chosen ones (the first push on a
+//! the ring (seconds) instead of the default's chosen ones (the first push on a
 //! blank flash, the first that opens a sector, the first that erases a sector of
 //! acknowledged events, the first that erases unacknowledged ones; the first
 //! acknowledgement and the first that erases a sector).
