@@ -24,6 +24,12 @@
 //! [`EventQueue::dropped`]), and leave a gap in the sequence numbers of equal size.
 //! Numbers are compared modulo 2^32 (a record is acknowledged when its number is at
 //! or before the acknowledged one, within 2^31).
+//!
+//! Cost: the queue keeps no index in RAM (nothing that could disagree with the flash
+//! after a reset): [`open`](EventQueue::open), each push and each acknowledgement read
+//! the log through (twice, checking every record's CRC), so their time grows with the
+//! region. Events are rare (a risk state changes a few times a day); size the region
+//! for the backlog a master may leave, not larger.
 
 use core::fmt;
 use core::marker::PhantomData;
