@@ -4,8 +4,8 @@
 
 use misalign::float::Auto;
 use misalign::modbus::map::{
-    EVENT_SLOTS, EVENT_STRIDE, EVENT_WINDOW_ADDRESS, SAMPLE_FULL_STRIDE, SAMPLES, SAMPLES_ADDRESS,
-    SAMPLES_FULL_ADDRESS, TableMap,
+    EVENT_SLOTS, EVENT_SLOTS_ADDRESS, EVENT_STRIDE, EVENT_WINDOW_ADDRESS, MAP_VERSION,
+    SAMPLE_FULL_STRIDE, SAMPLES, SAMPLES_ADDRESS, SAMPLES_FULL_ADDRESS, TableMap,
 };
 use misalign::modbus::{
     AlarmSet, NONE, Server, ServerConfig, crc16, event_from_registers, fault_code, fault_from_code,
@@ -234,7 +234,7 @@ fn exceptions_as_the_specification_orders_them() {
     assert_eq!(exception(&request(&mut s, 5, &be(&[0, 0x1234])), 5), 3);
     assert_eq!(exception(&request(&mut s, 5, &be(&[6, 0xFF00])), 5), 2);
     // Read-only holding registers: 02 by function 6 and 16, nothing changes.
-    assert_eq!(read(&mut s, 3, 5, 2), vec![1, 1]);
+    assert_eq!(read(&mut s, 3, 5, 2), vec![1, MAP_VERSION]);
     assert_eq!(
         exception(&request(&mut s, 6, &be(&[5, 9])), 6),
         2,
@@ -383,11 +383,12 @@ fn alarms_latch_and_are_acknowledged_over_the_bus() {
 fn read_events<E: Estimator>(s: &mut Server<E>, from: u32) -> (Vec<misalign::monitor::Event>, u32) {
     let pdu = write(s, 0, &[(from >> 16) as u16, from as u16]);
     assert_eq!(pdu, vec![16, 0, 0, 0, 2]);
-    let n = 5 + EVENT_SLOTS * EVENT_STRIDE;
+    let slots = EVENT_SLOTS_ADDRESS - EVENT_WINDOW_ADDRESS;
+    let n = slots + EVENT_SLOTS * EVENT_STRIDE;
     let regs = read(s, 4, EVENT_WINDOW_ADDRESS, n);
     let (first, count, missed) = (u32_at(&regs, 0), regs[2], u32_at(&regs, 3));
     let mut events = Vec::new();
-    for slot in regs[5..].chunks_exact(usize::from(EVENT_STRIDE)) {
+    for slot in regs[usize::from(slots)..].chunks_exact(usize::from(EVENT_STRIDE)) {
         match event_from_registers(slot).unwrap() {
             Some(e) => events.push(e),
             None => break,

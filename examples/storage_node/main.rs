@@ -7,8 +7,12 @@
 //! second) over the demo scene prepared at build time, with the core the monitoring
 //! node uses on that target (f32 with an FPU, fixed point without), and checkpoints
 //! the monitor's whole state (`MonitorState`, an 812-byte record) once a minute of
-//! samples. The "flash" is 4 KiB of RAM in cortex-m-rt's `.uninit` section: not zeroed
-//! at start, not reloaded by QEMU's reset, so it survives the reset as flash would. A
+//! samples and at each event it raises; each event goes first to the flash event queue
+//! (`EventQueue`, 2 KiB of its own), which every boot reads back: exactly the events
+//! stored and not acknowledged (a master acknowledges every one after the first reset;
+//! none may come back). The "flash" is 4 KiB of RAM in cortex-m-rt's `.uninit`
+//! section: not zeroed at start, not reloaded by QEMU's reset, so it survives the
+//! reset as flash would. A
 //! control block in `.uninit` carries the test's progress across resets. The image
 //! runs many times in one QEMU session:
 //!
@@ -35,7 +39,8 @@
 //! node reports the deepest stack use of its boots.
 //!
 //! Exit status (semihosting): 0 when every step holds; 10 + step on a wrong restore,
-//! 20 + step on a storage error (step: 0 to 3 as above), 30 if the power-cut phase
+//! 20 + step on a storage error (step: 0 to 3 as above), 40 + step on a wrong event
+//! queue (or none stored before the first reset), 30 if the power-cut phase
 //! swept less than a record, 31 if the monitor refused its configuration or the scene
 //! or the scenario ended, 32 if the final state is not the reference's; 101 on a panic.
 //!
@@ -70,8 +75,10 @@ mod node {
     #[cfg(target_abi = "eabihf")]
     use misalign::float::EllipticScene;
     use misalign::monitor::scenario::Scenario;
-    use misalign::monitor::{Config, Monitor, MonitorState};
-    use misalign::storage::{BlockingFlash, Checkpoint, RestoreOutcome, Store, block_on, codec};
+    use misalign::monitor::{Config, Event, Monitor, MonitorState};
+    use misalign::storage::{
+        BlockingFlash, Checkpoint, EventQueue, RestoreOutcome, Store, block_on, codec,
+    };
     use misalign_harness::prepared;
     use misalign_harness::support::{exit, stack};
 
@@ -96,9 +103,16 @@ mod node {
     const RECORD: usize = codec::record_len(MonitorState::SIZE);
     /// The store's buffer for it.
     const BUF: usize = Store::<BlockingFlash<RamFlash>, 0>::buffer_len::<MonitorState>();
+    /// The event queue's region: two sectors.
+    const EVENTS_SIZE: usize = 2 * SECTOR;
+    /// The event queue's buffer.
+    const EVENT_BUF: usize = EventQueue::<BlockingFlash<RamFlash>, Event, 0>::buffer_len();
+    type Events = EventQueue<BlockingFlash<RamFlash>, Event, EVENT_BUF>;
 
     #[unsafe(link_section = ".uninit.misalign_flash")]
     static mut FLASH: MaybeUninit<[u8; SIZE]> = MaybeUninit::uninit();
+    #[unsafe(link_section = ".uninit.misalign_events")]
+    static mut EVENTS: MaybeUninit<[u8; EVENTS_SIZE]> = MaybeUninit::uninit();
     #[unsafe(link_section = ".uninit.misalign_control")]
     static mut CONTROL: MaybeUninit<Control> = MaybeUninit::uninit();
 
@@ -124,13 +138,17 @@ mod node {
         /// stack use of any boot (bytes).
         sp: u32,
         stack_max: u32,
+        /// Events stored on flash (the next one's number), and the acknowledgement on
+        /// flash plus one (0: none).
+        events: u32,
+        acked: u32,
     }
 
     /// NOR flash over the `.uninit` RAM: erase to 0xFF, writes only clear bits. With a
     /// cut armed, it resets the core at the `cut`-th point: a byte written or a word
     /// erased (the bytes and words before it done, that one and the rest not).
     struct RamFlash {
-        bytes: &'static mut [u8; SIZE],
+        bytes: &'static mut [u8],
         points: u32,
         cut: Option<u32>,
     }
@@ -170,7 +188,7 @@ mod node {
         }
 
         fn capacity(&self) -> usize {
-            SIZE
+            self.bytes.len()
         }
     }
 
@@ -256,6 +274,7 @@ mod node {
         m: &mut Monitor<E>,
         until: usize,
         store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        events: &mut Events,
         control: &mut Control,
     ) {
         let code = control.step as i32;
@@ -264,7 +283,7 @@ mod node {
                 break;
             }
             m.process(sample);
-            if done(m) == ON_DEMAND_AT && control.step == 0 {
+            if store_events(m, events, control) || (done(m) == ON_DEMAND_AT && control.step == 0) {
                 checkpoint_now(m, store, control);
                 continue;
             }
@@ -279,6 +298,63 @@ mod node {
         }
         if done(m) != until {
             exit(31)
+        }
+    }
+
+    /// The monitor's new events onto the flash queue (a sample replayed after a reset
+    /// raises again the events already stored: skipped). True if the sample raised an
+    /// event: the state is checkpointed at each.
+    fn store_events<E: Estimator>(
+        m: &mut Monitor<E>,
+        events: &mut Events,
+        control: &mut Control,
+    ) -> bool {
+        let mut raised = false;
+        while let Some(e) = m.pop_event() {
+            raised = true;
+            if e.seq < control.events {
+                continue;
+            }
+            match block_on(events.push(e.seq, &e)) {
+                Ok(pushed) if pushed.dropped == 0 && e.seq == control.events => {}
+                _ => exit(40 + control.step as i32),
+            }
+            control.events = e.seq + 1;
+        }
+        raised
+    }
+
+    /// Exits unless the event queue holds exactly the events stored and not
+    /// acknowledged, in order: none lost, none acknowledged back.
+    fn check_events(events: &mut Events, control: &Control) {
+        let code = 40 + control.step as i32;
+        let Ok(found) = block_on(events.open()) else {
+            exit(code)
+        };
+        let acked = control.acked.checked_sub(1);
+        let newest = control.events.checked_sub(1);
+        let first = newest
+            .map(|_| control.acked)
+            .filter(|&f| f < control.events);
+        let unacked = control.events - control.acked;
+        let expected = (acked, newest, first, unacked);
+        if (
+            found.acknowledged,
+            found.newest,
+            found.first,
+            found.unacknowledged,
+        ) != expected
+        {
+            exit(code);
+        }
+        let mut next = control.acked;
+        let read = block_on(events.read(0, |seq, e| {
+            let ok = seq == next && e.seq == seq;
+            next += 1;
+            ok
+        }));
+        if read != Ok(unacked) || next != control.events {
+            exit(code);
         }
     }
 
@@ -305,6 +381,8 @@ mod node {
     fn reference<E: Estimator>(mut m: Monitor<E>) -> u32 {
         for sample in samples_from(0).take(FINAL) {
             m.process(sample);
+            // Delivered, as the node delivers each to its event queue.
+            while m.pop_event().is_some() {}
         }
         crc_of(&m.snapshot())
     }
@@ -337,10 +415,11 @@ mod node {
         core: &impl Fn() -> Option<E>,
         m: &mut Monitor<E>,
         store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        events: &mut Events,
         control: &mut Control,
     ) -> ! {
         control.reference_crc = reference(monitor(core));
-        run_to(m, FIRST_RESET_AT, store, control);
+        run_to(m, FIRST_RESET_AT, store, events, control);
         control.step = 1;
         reset(control)
     }
@@ -351,9 +430,10 @@ mod node {
     fn after_reset<E: Estimator>(
         m: &mut Monitor<E>,
         store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        events: &mut Events,
         control: &mut Control,
     ) -> ! {
-        run_to(m, SECOND_RESET_AT, store, control);
+        run_to(m, SECOND_RESET_AT, store, events, control);
         checkpoint_now(m, store, control);
         (control.step, control.cut, control.boots) = (2, 0, 0);
         reset(control)
@@ -366,12 +446,14 @@ mod node {
     fn power_cut<E: Estimator>(
         m: &mut Monitor<E>,
         store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        events: &mut Events,
         control: &mut Control,
     ) -> ! {
         let Some(sample) = samples_from(done(m)).next() else {
             exit(31)
         };
         m.process(sample);
+        store_events(m, events, control);
         checkpoint_now(m, store, control);
         // This boot's cut point was `control.cut - 1`.
         if (control.cut as usize) <= RECORD {
@@ -387,19 +469,21 @@ mod node {
     fn finish<E: Estimator>(
         m: &mut Monitor<E>,
         store: &mut Store<BlockingFlash<RamFlash>, BUF>,
+        events: &mut Events,
         control: &mut Control,
     ) -> ! {
-        run_to(m, FINAL, store, control);
+        run_to(m, FINAL, store, events, control);
         if crc_of(&m.snapshot()) != control.reference_crc {
             exit(32);
         }
         note_stack(control);
         defmt::println!(
-            "storage node: {=usize} samples monitored through 3 resets and {=u32} power cuts (one at every point of a checkpoint of the {=usize}-byte record), {=u32} checkpoints; the state is the uninterrupted run's; deepest stack {=u32} bytes",
+            "storage node: {=usize} samples monitored through 3 resets and {=u32} power cuts (one at every point of a checkpoint of the {=usize}-byte record), {=u32} checkpoints (once a minute and at each event); the state is the uninterrupted run's; events kept on flash, read back at every boot, none back once acknowledged: {=u32}; deepest stack {=u32} bytes",
             FINAL,
             control.boots - 1,
             RECORD,
             control.committed,
+            control.events,
             control.stack_max
         );
         // Cold start next time QEMU runs this image.
@@ -411,6 +495,7 @@ mod node {
     fn node<E: Estimator>(
         core: impl Fn() -> Option<E>,
         flash: &'static mut [u8; SIZE],
+        events_flash: &'static mut [u8; EVENTS_SIZE],
         control: &mut Control,
     ) -> ! {
         let step = control.step;
@@ -423,6 +508,14 @@ mod node {
             control.boots += 1;
         }
         let mut store = open(flash, (step == 2).then_some(cut));
+        let events_flash = RamFlash {
+            bytes: events_flash,
+            points: 0,
+            cut: None,
+        };
+        let Ok(mut events) = Events::new(BlockingFlash(events_flash), 0..EVENTS_SIZE as u32) else {
+            exit(40 + code)
+        };
         // As a node restores: one monitor and one state, decoded in place.
         let mut m = monitor(&core);
         let mut state = MonitorState::default();
@@ -430,29 +523,46 @@ mod node {
             exit(20 + code)
         };
         if step == 0 {
-            // Cold RAM is not a blank flash: nothing restored, an event reported.
+            // Cold RAM is not a blank flash: nothing restored, an event reported; the
+            // event queue's region erased and reported.
             if !matches!(outcome, RestoreOutcome::Rejected(_)) || store.stats().rejected != 1 {
                 exit(10 + code);
             }
-            cold(&core, &mut m, &mut store, control)
+            if !block_on(events.open()).is_ok_and(|found| found.erased) {
+                exit(40 + code);
+            }
+            cold(&core, &mut m, &mut store, &mut events, control)
         }
         check_restore(outcome, &state, control);
+        check_events(&mut events, control);
+        if step == 1 {
+            // A master acknowledges every event stored before the first reset (there
+            // is one: the start): from here on each boot must find it acknowledged.
+            let Some(newest) = control.events.checked_sub(1) else {
+                exit(40 + code)
+            };
+            if block_on(events.acknowledge(newest)) != Ok(true) {
+                exit(40 + code);
+            }
+            control.acked = newest + 1;
+        }
         m.resume(&state);
         match step {
-            1 => after_reset(&mut m, &mut store, control),
-            2 => power_cut(&mut m, &mut store, control),
-            _ => finish(&mut m, &mut store, control),
+            1 => after_reset(&mut m, &mut store, &mut events, control),
+            2 => power_cut(&mut m, &mut store, &mut events, control),
+            _ => finish(&mut m, &mut store, &mut events, control),
         }
     }
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
-        // SAFETY: the only references to the two statics, taken once at start-up;
+        // SAFETY: the only references to the three statics, taken once at start-up;
         // u8 and u32 hold any bit pattern, and the RAM is initialised memory on the
         // target (what the previous boot left, or the power-on contents).
-        let (flash, control) = unsafe {
+        let (flash, events, control) = unsafe {
             (
                 &mut *addr_of_mut!(FLASH).cast::<[u8; SIZE]>(),
+                &mut *addr_of_mut!(EVENTS).cast::<[u8; EVENTS_SIZE]>(),
                 &mut *addr_of_mut!(CONTROL).cast::<Control>(),
             )
         };
@@ -469,6 +579,8 @@ mod node {
                 boots: 0,
                 sp: 0,
                 stack_max: 0,
+                events: 0,
+                acked: 0,
             };
         }
         control.sp = sp as u32;
@@ -478,7 +590,7 @@ mod node {
         let core = || EllipticScene::from_bytes(&prepared::ELLIPTIC).ok();
         #[cfg(not(target_abi = "eabihf"))]
         let core = || FixedEllipticScene::from_bytes(&prepared::FIXED_ELLIPTIC).ok();
-        node(core, flash, control)
+        node(core, flash, events, control)
     }
 }
 

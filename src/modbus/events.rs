@@ -21,6 +21,13 @@ pub(crate) struct EventWindow {
     pub from: u32,
     /// Events dropped from the full window before the master read them.
     pub dropped: u32,
+    /// Store-and-forward: the application hands the events in, and the window never
+    /// drops one the master has not read ([`offer`](Self::offer)).
+    pub stored: bool,
+    /// Store-and-forward: the next event the window wants from the application's
+    /// store (the window fell behind: it was full of unread events, or a reset left
+    /// events on flash). `None`: it takes new events as they come.
+    pub backlog: Option<u32>,
 }
 
 impl EventWindow {
@@ -29,7 +36,45 @@ impl EventWindow {
             events: Deque::new(),
             from,
             dropped: 0,
+            stored: false,
+            backlog: None,
         }
+    }
+
+    /// Whether an event fits without dropping one the master has not read.
+    pub(crate) fn has_room(&self) -> bool {
+        !self.events.is_full()
+            || self
+                .events
+                .front()
+                .is_some_and(|e| !at_or_after(e.seq, self.from))
+    }
+
+    /// Store-and-forward: takes `event` if it is the next the window wants and fits
+    /// without dropping an unread event. While the window is behind (`backlog`) it
+    /// wants that event: a new one (`from_store` false) only if it is that one; one
+    /// read from the store may be later (the store lost some: the gap counts as
+    /// missed). An event that does not fit stays in the store only: the window wants
+    /// it later. `next` is the next event's number.
+    pub(crate) fn offer(&mut self, event: Event, next: u32, from_store: bool) -> bool {
+        if let Some(b) = self.backlog {
+            let wanted = if from_store {
+                at_or_after(event.seq, b)
+            } else {
+                event.seq == b
+            };
+            if !wanted {
+                return false;
+            }
+        }
+        if !self.has_room() {
+            self.backlog.get_or_insert(event.seq);
+            return false;
+        }
+        self.push(event);
+        let after = event.seq.wrapping_add(1);
+        self.backlog = self.backlog.map(|_| after).filter(|&b| b != next);
+        true
     }
 
     /// Keeps `event`; a full window drops its oldest, counted when the master had
@@ -72,4 +117,25 @@ impl EventWindow {
             0
         }
     }
+}
+
+/// What the application's storage reports to the map (store-and-forward events,
+/// checkpoints), through `Server::set_storage_status`. The server itself stores
+/// nothing: it shows these values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct StorageStatus {
+    /// The acknowledgement on flash: every event through this number (register
+    /// `event_acked`; `None` reads `0xFFFF_FFFF`).
+    pub events_acknowledged: Option<u32>,
+    /// Unacknowledged events on flash (`events_stored`).
+    pub events_stored: u32,
+    /// Unacknowledged events dropped from flash because its region was full
+    /// (`events_overwritten`).
+    pub events_overwritten: u32,
+    /// The number of the newest checkpoint of the monitor's state (`checkpoints`).
+    pub checkpoints: u32,
+    /// The monitor's monotonic time (`Monitor::elapsed_ms`) at the newest checkpoint;
+    /// `checkpoint_age` is the time since (`None`: none, reads `0xFFFF_FFFF`).
+    pub last_checkpoint_ms: Option<u64>,
 }

@@ -147,6 +147,13 @@ pub(crate) enum Field {
     ExternalMode,
     UnitId,
     MapVersion,
+    // Store-and-forward and checkpoints.
+    EventAck,
+    EventAcked,
+    EventsStored,
+    EventsOverwritten,
+    Checkpoints,
+    CheckpointAge,
 
     /// An external sample's field (the basic or the full record).
     Sample(SampleField),
@@ -319,12 +326,14 @@ pub static DISCRETES: TableMap = TableMap {
 
 /// The register map's version (holding register `map_version`): a change of an
 /// address, a type or a meaning increments it.
-pub const MAP_VERSION: u16 = 1;
+pub const MAP_VERSION: u16 = 2;
 
 /// Where the event window's header starts (input registers).
 pub const EVENT_WINDOW_ADDRESS: u16 = 82;
+/// Where the storage's registers start (input registers), after the window's header.
+pub const STORAGE_ADDRESS: u16 = EVENT_WINDOW_ADDRESS + 5;
 /// Where the event window's slots start (input registers).
-pub const EVENT_SLOTS_ADDRESS: u16 = EVENT_WINDOW_ADDRESS + 5;
+pub const EVENT_SLOTS_ADDRESS: u16 = STORAGE_ADDRESS + 10;
 /// Event slots in the window.
 pub const EVENT_SLOTS: u16 = 4;
 /// Registers per event slot.
@@ -428,6 +437,16 @@ pub static INPUTS: TableMap = TableMap {
             "filled event slots (0 to 4), from slot 0"),
         e!(Input, EVENT_WINDOW_ADDRESS + 3, "events_missed", U32, "", R, F::EventsMissed,
             "events from event_from to event_first that were lost (the gap this read cannot fill)"),
+        e!(Input, STORAGE_ADDRESS, "event_acked", U32, "", R, F::EventAcked,
+            "events through this number are acknowledged on flash; 0xFFFFFFFF none"),
+        e!(Input, STORAGE_ADDRESS + 2, "events_stored", U32, "", R, F::EventsStored,
+            "unacknowledged events on flash"),
+        e!(Input, STORAGE_ADDRESS + 4, "events_overwritten", U32, "", R, F::EventsOverwritten,
+            "unacknowledged events dropped from full flash, the oldest (a gap as large in the numbers)"),
+        e!(Input, STORAGE_ADDRESS + 6, "checkpoints", U32, "", R, F::Checkpoints,
+            "number of the newest checkpoint of the monitor's state (0 none)"),
+        e!(Input, STORAGE_ADDRESS + 8, "checkpoint_age", U32, "s", R, F::CheckpointAge,
+            "monitor time since the newest checkpoint, power-off not counted; 0xFFFFFFFF none"),
     ],
     blocks: &[Block {
         table: Table::Input,
@@ -476,7 +495,7 @@ static EVENT_FIELDS: [Entry; 15] = [
 ];
 
 /// Where the basic external samples start (holding registers).
-pub const SAMPLES_ADDRESS: u16 = 7;
+pub const SAMPLES_ADDRESS: u16 = 9;
 /// Records of the basic block: the most one function-16 write carries.
 pub const SAMPLES: u16 = 20;
 /// Registers per basic record (time, P, phi).
@@ -532,6 +551,8 @@ pub static HOLDINGS: TableMap = TableMap {
             "the unit id this node answers (read only)"),
         e!(Holding, 6, "map_version", U16, "", R, F::MapVersion,
             "the version of this register map (read only): a change of an address, type or meaning increments it"),
+        e!(Holding, 7, "event_ack", U32, "", Rw, F::EventAck,
+            "write n: acknowledge events through n (below event_seq_next), freeing them on flash; event_from moves past n; 0xFFFFFFFF none"),
     ],
     blocks: &[
         Block {

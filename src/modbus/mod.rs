@@ -38,8 +38,13 @@
 //! [`Identification`], external samples on or off, the latching [`AlarmSet`]);
 //! `receive`, `idle`, `response`, `sent` for the bus; `process` for samples;
 //! `monitor`, `annunciator`, `acknowledge`, `external_samples`, `unit_id`,
-//! `counters`, `into_monitor`. Beside it: [`registers_csv`], [`silence_us`], the map's
-//! addresses in [`map`], and for a master written in Rust [`event_from_registers`]
+//! `counters`, `into_monitor`; for events kept on flash until acknowledged
+//! (store-and-forward, docs/modbus.md) `store_events`, `pop_event`, `offer_event`,
+//! `wanted_event`, `offer_stored_event`, `end_backlog`, `acknowledged_through`,
+//! `set_storage_status` ([`StorageStatus`]), `storage_status`. The server stores
+//! nothing itself (it does not depend on `misalign::storage`): the application moves
+//! the events between it and its flash. Beside it: [`registers_csv`], [`silence_us`],
+//! the map's addresses in [`map`], and for a master written in Rust [`event_from_registers`]
 //! and [`fault_from_code`].
 //!
 //! **External samples** written by a master over the bus (holding blocks `sample_*`,
@@ -84,14 +89,14 @@ mod values;
 
 pub use crate::monitor::annunciation::{AlarmSet, Annunciator};
 pub use crc::crc16;
-pub use events::EVENT_WINDOW;
+pub use events::{EVENT_WINDOW, StorageStatus};
 pub use exception::Exception;
 pub use ident::Identification;
 pub use map::registers_csv;
 pub use rtu::{ADU_MAX, FramingCounters};
 pub use values::{DecodeError, event_from_registers, fault_code, fault_from_code};
 
-use crate::monitor::{Monitor, RiskState, Sample};
+use crate::monitor::{Event, Monitor, RiskState, Sample};
 use crate::{Estimator, FrictionInverse};
 use core::fmt;
 use events::EventWindow;
@@ -207,6 +212,9 @@ struct Core<E> {
     /// The last sample's own timestamp.
     last_time_ms: u32,
     counters: Counters,
+    /// The last acknowledgement a master wrote (`event_ack`).
+    ack: Option<u32>,
+    storage: StorageStatus,
     response: [u8; ADU_MAX],
     monitor: Monitor<E>,
 }
@@ -247,6 +255,8 @@ impl<E: Estimator> Server<E> {
             external: config.external_samples,
             last_time_ms: 0,
             counters: Counters::default(),
+            ack: None,
+            storage: StorageStatus::default(),
             response: [0; ADU_MAX],
             response_len: 0,
         };
@@ -346,6 +356,82 @@ impl<E: Estimator> Server<E> {
     pub fn into_monitor(self) -> Monitor<E> {
         self.core.monitor
     }
+
+    /// Store-and-forward (docs/modbus.md): from now on the application takes each
+    /// event ([`pop_event`](Self::pop_event)), stores it, and hands it to the event
+    /// window ([`offer_event`](Self::offer_event)); the window never drops an event a
+    /// master has not read, and falls behind instead, fed from the store
+    /// ([`wanted_event`](Self::wanted_event)). `first`: the oldest unacknowledged event
+    /// the store holds at start-up, which the window wants first and `event_from`
+    /// points at. Call it once, before the first sample.
+    pub fn store_events(&mut self, first: Option<u32>) {
+        let next = self.core.monitor.next_event_seq();
+        let w = &mut self.core.events;
+        w.stored = true;
+        if let Some(f) = first {
+            w.from = f;
+            w.backlog = Some(f).filter(|&f| f != next);
+        }
+    }
+
+    /// Store-and-forward: the monitor's next new event, to store, then to
+    /// [`offer_event`](Self::offer_event). `None` without [`store_events`](Self::store_events)
+    /// (the server takes the events itself).
+    pub fn pop_event(&mut self) -> Option<Event> {
+        if self.core.events.stored {
+            self.core.monitor.pop_event()
+        } else {
+            None
+        }
+    }
+
+    /// Store-and-forward: a new event, stored, into the window; false if the window
+    /// does not take it now (it is behind, or full of unread events): it wants it
+    /// from the store later.
+    pub fn offer_event(&mut self, event: Event) -> bool {
+        let next = self.core.monitor.next_event_seq();
+        self.core.events.offer(event, next, false)
+    }
+
+    /// Store-and-forward: the number of the event the window wants from the store
+    /// (the first unacknowledged event at or after it), while it is behind and has
+    /// room; hand it to [`offer_stored_event`](Self::offer_stored_event). If the store
+    /// holds none at or after it, call [`end_backlog`](Self::end_backlog).
+    pub fn wanted_event(&self) -> Option<u32> {
+        let w = &self.core.events;
+        w.backlog.filter(|_| w.has_room())
+    }
+
+    /// Store-and-forward: an event read from the store, the first at or after
+    /// [`wanted_event`](Self::wanted_event), into the window.
+    pub fn offer_stored_event(&mut self, event: Event) -> bool {
+        let next = self.core.monitor.next_event_seq();
+        self.core.events.offer(event, next, true)
+    }
+
+    /// Store-and-forward: the store holds no event at or after
+    /// [`wanted_event`](Self::wanted_event) (they were lost): the window takes new
+    /// events again; the gap counts as missed.
+    pub fn end_backlog(&mut self) {
+        self.core.events.backlog = None;
+    }
+
+    /// The number through which a master acknowledged the events (holding register
+    /// `event_ack`), for the application to make durable; `None` before any.
+    pub fn acknowledged_through(&self) -> Option<u32> {
+        self.core.ack
+    }
+
+    /// What the application's storage reports (the registers `event_acked`,
+    /// `events_stored`, `events_overwritten`, `checkpoints`, `checkpoint_age`).
+    pub fn set_storage_status(&mut self, status: StorageStatus) {
+        self.core.storage = status;
+    }
+
+    /// What [`set_storage_status`](Self::set_storage_status) set last.
+    pub fn storage_status(&self) -> StorageStatus {
+        self.core.storage
+    }
 }
 
 impl<E: Estimator + FrictionInverse> Server<E> {
@@ -370,9 +456,12 @@ impl<E: Estimator> Core<E> {
         state
     }
 
-    /// The monitor's queued events into the window; the alarms from its state.
+    /// The monitor's queued events into the window (unless the application takes
+    /// them: [`Server::store_events`]); the alarms from its state.
     fn drain(&mut self) {
-        while let Some(e) = self.monitor.pop_event() {
+        while !self.events.stored
+            && let Some(e) = self.monitor.pop_event()
+        {
             self.events.push(e);
         }
         self.annunciator.update(AlarmSet::of(&self.monitor));

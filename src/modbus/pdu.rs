@@ -463,6 +463,12 @@ impl<E: Estimator> Core<E> {
             Field::AcknowledgeAlarms | Field::LatchingAlarms => v <= 15,
             Field::ExternalMode => v <= 1,
             Field::EventFrom => true,
+            // Only numbers already given: a later one would acknowledge an event not
+            // yet raised.
+            Field::EventAck => {
+                let newest = self.monitor.next_event_seq().wrapping_sub(1);
+                super::events::at_or_after(newest, v)
+            }
             _ => false,
         };
         if ok {
@@ -486,6 +492,12 @@ impl<E: Estimator> Core<E> {
         let bits = super::AlarmSet::from_bits(v as u8);
         match field {
             Field::EventFrom => self.events.from = v,
+            Field::EventAck => {
+                self.ack = Some(v);
+                if super::events::at_or_after(v, self.events.from) {
+                    self.events.from = v.wrapping_add(1);
+                }
+            }
             Field::AcknowledgeAlarms => self.annunciator.acknowledge(bits),
             Field::LatchingAlarms => self.annunciator.set_latching(bits),
             Field::ExternalMode => self.external = v != 0,

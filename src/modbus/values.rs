@@ -292,6 +292,7 @@ impl<E: Estimator> Core<E> {
             Field::ExternalMode => u32::from(self.external),
             Field::UnitId => u32::from(self.unit),
             Field::MapVersion => u32::from(super::map::MAP_VERSION),
+            Field::EventAck => self.ack.unwrap_or(u32::MAX),
             _ => self.value_other(field, record),
         }
     }
@@ -370,6 +371,14 @@ impl<E: Estimator> Core<E> {
             Field::EventFrom => self.events.from,
             Field::UnitId => u32::from(self.unit),
             Field::MapVersion => u32::from(super::map::MAP_VERSION),
+            Field::EventAck => self.ack.unwrap_or(u32::MAX),
+            Field::EventAcked => self.storage.events_acknowledged.unwrap_or(u32::MAX),
+            Field::EventsStored => self.storage.events_stored,
+            Field::EventsOverwritten => self.storage.events_overwritten,
+            Field::Checkpoints => self.storage.checkpoints,
+            Field::CheckpointAge => self.storage.last_checkpoint_ms.map_or(u32::MAX, |t| {
+                u32::try_from(m.elapsed_ms().saturating_sub(t) / 1000).unwrap_or(u32::MAX - 1)
+            }),
         }
     }
 

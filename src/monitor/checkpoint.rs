@@ -596,6 +596,36 @@ impl Checkpoint for MonitorState {
     }
 }
 
+/// One event as a record of its own, under [`kind::EVENT`]: what the flash event queue
+/// (`storage::EventQueue`) holds, the record's sequence field the event's own number.
+/// The payload is the event's bytes in the monitor's state (docs/formats.md).
+impl Checkpoint for Event {
+    const KIND: u8 = kind::EVENT;
+    const VERSION: u16 = 1;
+    const SIZE: usize = EVENT_SIZE;
+
+    fn encode(&self, w: &mut Writer<'_>) -> Result<(), CodecError> {
+        put_event(w, self)
+    }
+
+    fn decode(r: &mut Reader<'_>) -> Result<Self, CodecError> {
+        get_event(r)
+    }
+}
+
+impl MonitorState {
+    /// Numbers the next event after `seq` (modulo 2^32) if this state would number it
+    /// at or before `seq`: at start-up, after the newest event found stored elsewhere
+    /// (the flash event queue), so that no number is given twice even when this state
+    /// is older than the newest stored event.
+    pub fn continue_events_after(&mut self, seq: u32) {
+        let next = seq.wrapping_add(1);
+        if next.wrapping_sub(self.next_seq) < 1 << 31 {
+            self.next_seq = next;
+        }
+    }
+}
+
 /// The monitor's configuration, stored under [`kind::MONITOR_CONFIG`]; a decoded one
 /// must pass [`Config::validate`].
 impl Checkpoint for Config {

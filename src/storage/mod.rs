@@ -14,6 +14,9 @@
 //!   start-up ([`Store::restore_into`] decodes in place, for a large state on a small
 //!   stack). A corrupt or foreign region restores nothing and reports a
 //!   [`StorageEvent`] ([`RestoreOutcome::Rejected`]), counted in [`Store::stats`].
+//! - [`EventQueue`]: numbered records (the monitor's `Event`s) in a region of their
+//!   own, kept until a master acknowledges them, through a reset and a power loss at
+//!   any moment; a full region drops the oldest unacknowledged ones, counted.
 //! - [`BlockingFlash`] and [`block_on`]: the store on bare metal without an executor
 //!   (see [`blocking`]). The store owns its flash; to share a driver, hand it
 //!   `&mut driver` (the flash traits are implemented for `&mut F`) or take it back with
@@ -67,6 +70,7 @@ pub mod blocking;
 mod calibration;
 pub mod codec;
 pub mod endurance;
+mod event_queue;
 #[cfg(feature = "_mock-flash")]
 mod mock_flash;
 mod store;
@@ -75,6 +79,7 @@ pub use blocking::{BlockingFlash, block_on};
 #[cfg(feature = "sensors")]
 pub use calibration::SensorCalibration;
 pub use codec::{CodecError, Reader, Writer};
+pub use event_queue::{EventQueue, Pushed, QueueStats, Recovered};
 #[cfg(feature = "_mock-flash")]
 pub use mock_flash::{MockError, MockFlash};
 pub use store::{
@@ -91,6 +96,11 @@ pub mod kind {
     pub const CALIBRATION: u8 = 2;
     /// The monitor's configuration.
     pub const MONITOR_CONFIG: u8 = 3;
+    /// One event of the monitor, in the flash event queue ([`EventQueue`](super::EventQueue)).
+    pub const EVENT: u8 = 8;
+    /// An acknowledgement in the flash event queue: every record up to its sequence
+    /// number is acknowledged.
+    pub const EVENT_ACK: u8 = 9;
 }
 
 /// A value stored as a checkpoint: a fixed-size, versioned payload.

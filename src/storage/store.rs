@@ -106,7 +106,7 @@ impl<E: fmt::Debug> core::error::Error for StorageError<E> {
 }
 
 impl<E> StorageError<E> {
-    fn from_ss(e: SsError<E>) -> Self {
+    pub(super) fn from_ss(e: SsError<E>) -> Self {
         match e {
             SsError::Storage { value, .. } => StorageError::Flash(value),
             SsError::FullStorage => StorageError::Full,

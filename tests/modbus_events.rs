@@ -1,0 +1,373 @@
+//! Store-and-forward over Modbus: the server's `event_ack` and storage registers, and
+//! the application's loop between the server and the flash event queue
+//! (`storage::EventQueue` on the mock flash): every event read in order with its own
+//! number, across resets, beyond the window's capacity, and an acknowledged event
+//! never read again.
+
+use misalign::float::Auto;
+use misalign::modbus::map::{EVENT_SLOTS, EVENT_SLOTS_ADDRESS, EVENT_STRIDE, EVENT_WINDOW_ADDRESS};
+use misalign::modbus::{
+    EVENT_WINDOW, Server, ServerConfig, StorageStatus, crc16, event_from_registers,
+};
+use misalign::monitor::{Config, Event, Monitor, MonitorState, Sample, model_for_range};
+use misalign::storage::{BlockingFlash, EventQueue, MockFlash, RestoreOutcome, Store, block_on};
+use misalign::{Estimator, Scene};
+
+type Flash = MockFlash<4, 1024, 4>;
+type Q = EventQueue<BlockingFlash<Flash>, Event, 72>;
+
+fn monitor(state: Option<&MonitorState>) -> Monitor<Auto> {
+    let scene = Scene::DEMO;
+    let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5).unwrap()).unwrap();
+    // A fault clears at once: an event in and one out every few samples.
+    let config = Config {
+        off_delay_ms: 0,
+        ..Config::default()
+    };
+    match state {
+        Some(s) => Monitor::restore(core, config, s).unwrap(),
+        None => Monitor::new(core, config).unwrap(),
+    }
+}
+
+/// Sample `i`: running, a sensor fault every few samples (an event in and one out).
+fn sample(i: u32) -> Sample {
+    // Noise enough that no sensor reads as stuck.
+    let noise = (i % 7) as f32;
+    let mut s = Sample::new(i * 1000, 1e3 + noise, 5e-5 + 1e-8 * noise).with_speed(2.0);
+    if i % 4 == 3 {
+        s.load = f32::NAN;
+    }
+    s
+}
+
+/// A request of `function` with `data` to unit 1; the answer's PDU.
+fn pdu<E: Estimator>(s: &mut Server<E>, function: u8, data: &[u8]) -> Vec<u8> {
+    let mut f = vec![1, function];
+    f.extend_from_slice(data);
+    f.extend_from_slice(&crc16(&f).to_le_bytes());
+    f.iter().for_each(|&b| s.receive(b));
+    let answer = s.response().expect("an answer").to_vec();
+    s.sent();
+    answer[1..answer.len() - 2].to_vec()
+}
+
+fn words(pdu: &[u8]) -> Vec<u16> {
+    pdu[2..]
+        .chunks_exact(2)
+        .map(|c| u16::from_be_bytes([c[0], c[1]]))
+        .collect()
+}
+
+fn u32_at(w: &[u16], i: usize) -> u32 {
+    u32::from(w[i]) << 16 | u32::from(w[i + 1])
+}
+
+fn input<E: Estimator>(s: &mut Server<E>, name: &str) -> u32 {
+    let mut csv = String::new();
+    misalign::modbus::registers_csv(&mut csv).unwrap();
+    let row = csv
+        .lines()
+        .find(|l| l.starts_with("input,") && l.split(',').nth(2) == Some(name))
+        .unwrap_or_else(|| panic!("{name} in the map"));
+    let address: u16 = row.split(',').nth(1).unwrap().parse().unwrap();
+    let [a, b] = address.to_be_bytes();
+    u32_at(&words(&pdu(s, 4, &[a, b, 0, 2])), 0)
+}
+
+/// Writes `event_ack` (holding 7, two registers); the answer's PDU.
+fn ack<E: Estimator>(s: &mut Server<E>, n: u32) -> Vec<u8> {
+    let [a, b, c, d] = n.to_be_bytes();
+    pdu(s, 16, &[0, 7, 0, 2, 4, a, b, c, d])
+}
+
+/// The master's read of the window: `event_from` written (the number after the last
+/// event it read, if any), then the events and the missed count.
+fn read_window<E: Estimator>(s: &mut Server<E>, from: Option<u32>) -> (Vec<Event>, u32) {
+    if let Some(from) = from {
+        let [a, b, c, d] = from.to_be_bytes();
+        assert_eq!(pdu(s, 16, &[0, 0, 0, 2, 4, a, b, c, d])[0], 16);
+    }
+    let n = EVENT_SLOTS_ADDRESS - EVENT_WINDOW_ADDRESS + EVENT_SLOTS * EVENT_STRIDE;
+    let [a, b] = EVENT_WINDOW_ADDRESS.to_be_bytes();
+    let [c, d] = n.to_be_bytes();
+    let w = words(&pdu(s, 4, &[a, b, c, d]));
+    let slots = usize::from(EVENT_SLOTS_ADDRESS - EVENT_WINDOW_ADDRESS);
+    let events = w[slots..]
+        .chunks_exact(usize::from(EVENT_STRIDE))
+        .map_while(|slot| event_from_registers(slot).unwrap())
+        .collect();
+    (events, u32_at(&w, 3))
+}
+
+/// The application's part after each sample or request: new events onto flash and
+/// into the window, the master's acknowledgement made durable, the window fed from
+/// flash while it is behind, the registers told.
+fn service(s: &mut Server<Auto>, q: &mut Q) {
+    while let Some(e) = s.pop_event() {
+        block_on(q.push(e.seq, &e)).unwrap();
+        s.offer_event(e);
+    }
+    if let Some(k) = s.acknowledged_through() {
+        block_on(q.acknowledge(k)).unwrap();
+    }
+    while let Some(wanted) = s.wanted_event() {
+        let mut found = None;
+        block_on(q.read(wanted, |_, e| {
+            found = Some(e);
+            false
+        }))
+        .unwrap();
+        match found {
+            Some(e) if s.offer_stored_event(e) => {}
+            Some(_) => break,
+            None => s.end_backlog(),
+        }
+    }
+    let st = q.state();
+    s.set_storage_status(StorageStatus {
+        events_acknowledged: st.acknowledged,
+        events_stored: st.unacknowledged,
+        events_overwritten: q.dropped(),
+        ..s.storage_status()
+    });
+}
+
+fn open_queue(flash: Flash) -> Q {
+    let mut q = Q::new(BlockingFlash(flash), 0..4096).unwrap();
+    block_on(q.open()).unwrap();
+    q
+}
+
+/// A start-up: the queue read through, the monitor from its checkpoint numbering after
+/// the newest stored event, the server fed from flash.
+fn boot(flash: Flash, checkpoint: &MonitorState) -> (Server<Auto>, Q) {
+    let mut q = open_queue(flash);
+    let mut state = *checkpoint;
+    if let Some(n) = q.state().newest {
+        state.continue_events_after(n);
+    }
+    let mut s = Server::new(monitor(Some(&state)), ServerConfig::default()).unwrap();
+    s.store_events(q.state().first);
+    service(&mut s, &mut q);
+    (s, q)
+}
+
+#[test]
+fn event_ack_takes_only_numbers_given_and_moves_event_from() {
+    let mut s = Server::new(monitor(None), ServerConfig::default()).unwrap();
+    // No event yet: nothing to acknowledge.
+    assert_eq!(ack(&mut s, 0), [0x90, 3]);
+    assert_eq!(s.acknowledged_through(), None);
+    let mut i = 0;
+    while s.monitor().next_event_seq() < 5 {
+        s.process(sample(i));
+        i += 1;
+    }
+    let next = s.monitor().next_event_seq();
+    assert_eq!(ack(&mut s, next), [0x90, 3], "a number not yet given");
+    assert_eq!(ack(&mut s, 2), [16, 0, 7, 0, 2]);
+    assert_eq!(s.acknowledged_through(), Some(2));
+    // event_from moved past it; event_ack reads back.
+    assert_eq!(u32_at(&words(&pdu(&mut s, 3, &[0, 0, 0, 2])), 0), 3);
+    assert_eq!(u32_at(&words(&pdu(&mut s, 3, &[0, 7, 0, 2])), 0), 2);
+    // Half of it: 02.
+    assert_eq!(pdu(&mut s, 6, &[0, 8, 0, 1]), [0x86, 2]);
+    // The storage registers: none until the application says.
+    assert_eq!(input(&mut s, "event_acked"), u32::MAX);
+    assert_eq!(input(&mut s, "checkpoint_age"), u32::MAX);
+    assert_eq!(input(&mut s, "checkpoints"), 0);
+    let elapsed = s.monitor().elapsed_ms();
+    s.set_storage_status(StorageStatus {
+        events_acknowledged: Some(2),
+        events_stored: 3,
+        events_overwritten: 4,
+        checkpoints: 9,
+        last_checkpoint_ms: Some(elapsed - 2500),
+    });
+    assert_eq!(input(&mut s, "event_acked"), 2);
+    assert_eq!(input(&mut s, "events_stored"), 3);
+    assert_eq!(input(&mut s, "events_overwritten"), 4);
+    assert_eq!(input(&mut s, "checkpoints"), 9);
+    assert_eq!(input(&mut s, "checkpoint_age"), 2);
+}
+
+/// Events raised while the master reads slowly, resets between, the master
+/// acknowledging what it read: every event read once, in order, with its own number,
+/// none missed, none acknowledged read again.
+#[test]
+fn every_event_is_read_once_in_order_across_resets_and_beyond_the_window() {
+    let mut checkpoint = monitor(None).snapshot();
+    let (mut s, mut q) = boot(Flash::new(), &checkpoint);
+    let mut read: Vec<u32> = Vec::new();
+    let mut i = 0u32;
+    let mut resets = 0;
+    for round in 0..40u32 {
+        // A burst of samples: several windows' worth of events when the round says.
+        let burst = if round % 5 == 2 { 40 } else { 3 };
+        for _ in 0..burst {
+            s.process(sample(i));
+            service(&mut s, &mut q);
+            i += 1;
+        }
+        // The master: reads the window twice, acknowledges what it read.
+        for _ in 0..2 {
+            let (events, missed) = read_window(&mut s, read.last().map(|l| l + 1));
+            assert_eq!(missed, 0, "round {round}");
+            for e in &events {
+                if let Some(&last) = read.last() {
+                    assert_eq!(e.seq, last + 1, "round {round}: in order, none missed");
+                }
+                read.push(e.seq);
+            }
+            if let Some(last) = events.last() {
+                assert_eq!(ack(&mut s, last.seq)[0], 16);
+                service(&mut s, &mut q);
+            }
+        }
+        // A reset every few rounds, from a checkpoint taken then or one older (its
+        // numbering behind the events stored since).
+        if round % 3 == 1 {
+            if round % 2 == 0 {
+                checkpoint = s.monitor().snapshot();
+            }
+            drop(s);
+            let flash = q.into_flash().0;
+            (s, q) = boot(flash, &checkpoint);
+            resets += 1;
+            assert_eq!(
+                input(&mut s, "event_acked"),
+                *read.last().unwrap_or(&u32::MAX)
+            );
+        }
+    }
+    // Drain what is left.
+    loop {
+        let (events, _) = read_window(&mut s, read.last().map(|l| l + 1));
+        let Some(last) = events.last() else { break };
+        for e in &events {
+            assert_eq!(e.seq, read.last().map_or(0, |l| l + 1));
+            read.push(e.seq);
+        }
+        ack(&mut s, last.seq);
+        service(&mut s, &mut q);
+    }
+    let raised = s.monitor().next_event_seq();
+    assert_eq!(read, (0..raised).collect::<Vec<_>>());
+    assert!(
+        raised as usize > 4 * EVENT_WINDOW && resets > 10,
+        "{raised} events"
+    );
+    eprintln!("{raised} events read through {resets} resets");
+    assert_eq!(q.state().unacknowledged, 0);
+    assert_eq!(q.dropped(), 0);
+}
+
+type StateFlash = MockFlash<4, 4096, 4>;
+type States = Store<BlockingFlash<StateFlash>, 1024>;
+
+/// The monitor's state checkpointed at each event and once a minute, restored at
+/// start-up; `checkpoints` and `checkpoint_age` say which and how old.
+#[test]
+fn checkpoints_at_each_event_and_periodically_show_in_the_map() {
+    let mut states = States::new(BlockingFlash(StateFlash::new()), 0..4 * 4096, 60).unwrap();
+    let mut q = open_queue(Flash::new());
+    let mut s = Server::new(monitor(None), ServerConfig::default()).unwrap();
+    s.store_events(None);
+    let mut written = 0u32;
+    for i in 0..400u32 {
+        // Faults in the first 40 samples only: then a quiet run, periodic checkpoints.
+        let x = if i < 40 { sample(i) } else { sample(4 * i) };
+        let x = Sample {
+            time_ms: i * 1000,
+            ..x
+        };
+        let before = s.monitor().next_event_seq();
+        s.process(x);
+        service(&mut s, &mut q);
+        let state = s.monitor().snapshot();
+        let now_ms = s.monitor().elapsed_ms();
+        let done = if s.monitor().next_event_seq() != before {
+            Some(block_on(states.checkpoint(&state)).unwrap())
+        } else {
+            block_on(states.checkpoint_if_due(now_ms / 1000, &state)).unwrap()
+        };
+        let mut status = s.storage_status();
+        if let Some(n) = done {
+            written += 1;
+            status.checkpoints = n;
+            status.last_checkpoint_ms = Some(now_ms);
+        }
+        s.set_storage_status(status);
+        assert_eq!(input(&mut s, "checkpoints"), written);
+        let age = now_ms - status.last_checkpoint_ms.unwrap_or(now_ms);
+        assert_eq!(input(&mut s, "checkpoint_age"), (age / 1000) as u32);
+    }
+    let events = s.monitor().next_event_seq();
+    // One at each event and one a minute between (the first call starts the period).
+    assert!(
+        written >= events && written < events + 400 / 60 + 1,
+        "{written}"
+    );
+    assert!(input(&mut s, "checkpoint_age") > 0);
+    // A reset: the newest checkpoint restored, its number shown, its age 0.
+    let mut states = States::new(states.into_flash(), 0..4 * 4096, 60).unwrap();
+    let mut state = MonitorState::default();
+    let outcome = block_on(states.restore_into(&mut state)).unwrap();
+    assert_eq!(outcome, RestoreOutcome::Restored { sequence: written });
+    let mut s = Server::new(monitor(Some(&state)), ServerConfig::default()).unwrap();
+    s.set_storage_status(StorageStatus {
+        checkpoints: written,
+        last_checkpoint_ms: Some(state.elapsed_ms()),
+        ..StorageStatus::default()
+    });
+    assert_eq!(input(&mut s, "checkpoints"), written);
+    assert_eq!(input(&mut s, "checkpoint_age"), 0);
+}
+
+/// A master that stays away while the flash fills: the oldest unacknowledged events
+/// are dropped from flash, counted in `events_overwritten`; the master then reads on
+/// in order, the gap it finds (`events_missed`) no larger than that count, and never
+/// an event twice or out of order.
+#[test]
+fn a_full_flash_drops_the_oldest_and_the_master_sees_the_gap() {
+    let mut q = Q::new(BlockingFlash(Flash::new()), 0..2048).unwrap();
+    block_on(q.open()).unwrap();
+    let mut s = Server::new(monitor(None), ServerConfig::default()).unwrap();
+    s.store_events(None);
+    let mut i = 0;
+    while s.monitor().next_event_seq() < 80 {
+        s.process(sample(i));
+        service(&mut s, &mut q);
+        i += 1;
+    }
+    let overwritten = input(&mut s, "events_overwritten");
+    assert!(overwritten > 0 && overwritten == q.dropped());
+    assert_eq!(input(&mut s, "events_stored"), q.state().unacknowledged);
+    let (mut gaps, mut last) = (0, None::<u32>);
+    loop {
+        let expected = last.map_or(0, |l| l + 1);
+        let (events, missed) = read_window(&mut s, last.map(|l| l + 1));
+        // The gap before slot 0 is the one counted as missed.
+        if let Some(first) = events.first() {
+            assert_eq!(missed, first.seq - expected);
+        }
+        let Some(newest) = events.last().map(|e| e.seq) else {
+            break;
+        };
+        for e in &events {
+            // In order, once; a jump in the numbers where flash dropped events.
+            let expected = last.map_or(0, |l| l + 1);
+            assert!(e.seq >= expected, "in order, once");
+            gaps += e.seq - expected;
+            last = Some(e.seq);
+        }
+        assert_eq!(ack(&mut s, newest)[0], 16);
+        service(&mut s, &mut q);
+    }
+    assert_eq!(last, Some(s.monitor().next_event_seq() - 1));
+    // The numbers jump by no more than flash dropped (some of those the window still
+    // held in RAM, and the master read).
+    assert!(gaps > 0 && gaps <= overwritten, "{gaps} of {overwritten}");
+    assert_eq!(input(&mut s, "events_stored"), 0);
+}
