@@ -370,6 +370,9 @@ impl<E: Estimator> Core<E> {
             Field::EventFrom => self.events.from,
             Field::UnitId => u32::from(self.unit),
             Field::MapVersion => u32::from(super::map::MAP_VERSION),
+            Field::Commission(reg) => self.commissioning.value(reg, &self.monitor),
+            Field::Staged(f) => self.commissioning.staged(f),
+            Field::Active(f) => super::config::active(f, self.monitor.config()),
         }
     }
 
