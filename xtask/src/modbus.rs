@@ -376,23 +376,36 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
     let (tests, file) = if node.external {
         host::write_samples(&dir.join("samples.csv"), &host::scenario())?;
         (
-            "tests/modbus/test_external.py",
+            &["tests/modbus/test_external.py"][..],
             dir.join(format!("events-{id}.csv")),
         )
     } else {
         let expected = dir.join(format!("expected-{id}.csv"));
         host::write_registers(fpu, &expected)?;
-        ("tests/modbus/test_node.py", expected)
+        // Commissioning after the node's registers were compared: it changes them.
+        (
+            &["tests/modbus/test_node.py", "tests/modbus/test_config.py"][..],
+            expected,
+        )
     };
     let port = free_port()?;
     let booted = boot(node.machine, &elf, port, Duration::from_secs(300), false)?;
     let status = Command::new(python)
         .current_dir(crate::root())
-        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider", tests])
+        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+        .args(tests)
         .env("MODBUS_PORT", booted.port.to_string())
         .env("MODBUS_REGISTERS", registers)
         .env("MODBUS_CORE", if fpu { "f32" } else { "fixed" })
         .env("MODBUS_EXPECTED", &file)
+        .env(
+            "MODBUS_UNLOCK_CODE",
+            misalign::modbus::DEFAULT_UNLOCK_CODE.to_string(),
+        )
+        .env(
+            "MODBUS_WRONG_CODES_MAX",
+            misalign::modbus::WRONG_CODES_MAX.to_string(),
+        )
         .env("MODBUS_SAMPLES", dir.join("samples.csv"))
         .env("MODBUS_EVENTS_OUT", &file)
         .env(
@@ -403,7 +416,7 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         .map_err(|e| format!("pytest: {e}"))?;
     drop(booted);
     if !status.success() {
-        return Err(format!("pytest {tests}: {status}"));
+        return Err(format!("pytest {}: {status}", tests.join(" ")));
     }
     if node.external {
         let compared = host::compare_events(fpu, &host::scenario(), &file)?;
@@ -514,7 +527,7 @@ mod host {
     use crate::node::{self, Core};
     use misalign::Estimator;
     use misalign::modbus::map::{Table, TableMap};
-    use misalign::modbus::{Server, ServerConfig, crc16, event_from_registers};
+    use misalign::modbus::{PreparedScene, Server, ServerConfig, crc16, event_from_registers};
     use misalign::monitor::scenario::{self, Scenario};
     use misalign::monitor::{Config, Event, Monitor, Sample};
     use misalign_cli::monitor_output::event_row;
@@ -555,10 +568,12 @@ mod host {
     /// reads of at most [`READ_MAX`] from address 0 up; `read,table,address,value`.
     /// The server counts the reads (`bus_*`), and so does the node's: the same reads
     /// in the same order leave the same counts.
-    fn dump<E: Estimator>(core: E) -> Result<String, String> {
+    fn dump<E: Estimator + PreparedScene>(core: E) -> Result<String, String> {
         let monitor = Monitor::new(core, Config::default()).map_err(|e| e.to_string())?;
         let mut server =
             Server::new(monitor, ServerConfig::default()).map_err(|e| e.to_string())?;
+        // As the node: it takes scenes over the bus (`scene_bytes`, `scene_active_crc`).
+        server.accept_scenes();
         for sample in Scenario::new() {
             server.process(sample);
         }
