@@ -641,6 +641,54 @@ mod power_loss {
         (store, n)
     }
 
+    /// The image and its record as docs/formats.md lays them out.
+    #[test]
+    fn the_image_is_the_documented_one() {
+        use misalign::storage::{Checkpoint, codec, kind};
+        let spec = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/formats.md"))
+            .unwrap();
+        let row = format!(
+            "| {} (`storage::kind::COMMITTED_CONFIG`) | `storage::ConfigImage<N>` | {} | N (the Modbus server's image: {IMAGE_LEN}) |",
+            kind::COMMITTED_CONFIG,
+            Image::VERSION
+        );
+        assert!(spec.contains(&row), "docs/formats.md lacks {row}");
+        assert_eq!(Image::KIND, kind::COMMITTED_CONFIG);
+
+        let mut s = server();
+        let (_, bytes) = other_scene();
+        unlock(&mut s);
+        put(&mut s, "new_code", 0xBEEF).unwrap();
+        put(&mut s, "config_on_delay", 0x0102_0304).unwrap();
+        write(&mut s, SCENE_ADDRESS, &scene_words(&bytes)).unwrap();
+        cmd(&mut s, command::COMMIT).unwrap();
+        let mut image = ConfigImage::new();
+        assert!(s.take_committed(&mut image.0));
+        let i = &image.0;
+        assert_eq!(i[..4], [misalign::modbus::IMAGE_VERSION, 1, 0xEF, 0xBE]);
+        assert_eq!(
+            misalign::modbus::IMAGE_VERSION,
+            1,
+            "the page documents version 1"
+        );
+        // The registers from config_thresholds_on, each u16 little-endian.
+        let offset = usize::from(at("config_on_delay") - at("config_thresholds_on"));
+        assert_eq!(i[4 + 2 * offset..][..4], [0x02, 0x01, 0x04, 0x03]);
+        assert_eq!(
+            at("config_friction_delay") + 2 - at("config_thresholds_on"),
+            64
+        );
+        assert_eq!(i[132..134], (Auto::BYTES as u16).to_le_bytes());
+        assert_eq!(i[134..134 + bytes.len()], bytes[..]);
+        assert!(i[134 + bytes.len()..].iter().all(|&b| b == 0));
+        // In its record: the frame of every checkpoint record, this payload.
+        let mut record = vec![0; codec::record_len(IMAGE_LEN)];
+        codec::encode(&image, 9, &mut record).unwrap();
+        assert_eq!(&record[..6], &[b'M', b'S', b'L', b'G', 4, 1]);
+        assert_eq!(record[16..16 + IMAGE_LEN], image.0);
+        assert_eq!(codec::decode::<Image>(&record).unwrap().value, image);
+    }
+
     #[test]
     fn a_power_cut_at_every_point_of_a_commit_leaves_the_old_or_the_new() {
         let mut base = Flash::new();
@@ -681,6 +729,7 @@ mod power_loss {
             base = store.into_flash().0;
             assert_eq!(boot(base.clone()).1, n);
         }
+        eprintln!("{points_total} power cuts over 10 commits");
         assert!(points_total > 10 * IMAGE_LEN as u64, "{points_total}");
     }
 }
