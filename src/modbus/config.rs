@@ -791,3 +791,71 @@ impl<E: Estimator> Commissioning<E> {
 pub(crate) fn active(f: ConfigField, config: &Config) -> u32 {
     f.of(config)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::modbus::map::{Field, HOLDINGS};
+    use std::vec::Vec;
+
+    /// The map's `config_*` and `active_*` entries sit where [`ConfigField`] says, with
+    /// its number of registers, every field once, in one run of [`CONFIG_WORDS`].
+    #[test]
+    fn the_maps_configuration_entries_are_the_fields() {
+        for view in [Field::Staged as fn(ConfigField) -> Field, Field::Active] {
+            let entries: Vec<_> = HOLDINGS
+                .entries
+                .iter()
+                .filter(|e| ConfigField::ALL.iter().any(|&f| e.field == view(f)))
+                .collect();
+            assert_eq!(entries.len(), ConfigField::ALL.len());
+            let first = entries[0].address;
+            for (e, f) in entries.iter().zip(ConfigField::ALL) {
+                assert_eq!(e.field, view(f), "{}", e.name);
+                assert_eq!(e.address - first, u16::from(f as u8), "{}", e.name);
+                assert_eq!(usize::from(e.ty.words()), f.words(), "{}", e.name);
+            }
+            let last = entries[entries.len() - 1];
+            assert_eq!(usize::from(last.end() - first), CONFIG_WORDS);
+        }
+    }
+
+    /// Every configuration goes through the registers and back unchanged.
+    #[test]
+    fn configurations_round_trip_through_the_registers() {
+        let d = Config::default();
+        let margin = Config {
+            thresholds: Thresholds::Margin {
+                warning: 2e-4,
+                alarm: -1e-5,
+                deadband: 0.0,
+            },
+            spikes: None,
+            trend: None,
+            friction: None,
+            smoothing_tau_s: 0.0,
+            ..d
+        };
+        let extremes = Config {
+            on_delay_ms: u32::MAX,
+            off_delay_ms: 0,
+            load_min: f32::MIN,
+            load_max: f32::MAX,
+            spikes: Some(SpikeFilter {
+                window: 3,
+                k: f32::MIN_POSITIVE,
+                load_floor: f32::MAX,
+                angle_floor: 1e-30,
+            }),
+            trend: Some(TrendConfig {
+                interval_ms: 1,
+                points: 16,
+                horizon_s: f32::MAX,
+            }),
+            ..d
+        };
+        for c in [d, margin, extremes] {
+            assert_eq!(config_from_words(&config_words(&c)), Ok(c));
+        }
+    }
+}
