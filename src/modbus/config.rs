@@ -573,11 +573,7 @@ impl<E: Estimator> Commissioning<E> {
             Reg::SceneStagedCrc => self.io.map_or(0, |io| {
                 crc32(self.scene.get(..io.bytes.saturating_sub(4)).unwrap_or(&[]))
             }),
-            Reg::SceneActiveCrc => self.io.map_or(0, |io| {
-                let mut bytes = [0; SCENE_BYTES_MAX];
-                (io.save)(monitor.estimator(), &mut bytes);
-                crc32(bytes.get(..io.bytes.saturating_sub(4)).unwrap_or(&[]))
-            }),
+            Reg::SceneActiveCrc => self.io.map_or(0, |io| active_crc(io, monitor.estimator())),
         }
     }
 
@@ -657,7 +653,9 @@ impl<E: Estimator> Commissioning<E> {
         self.pending = 0;
     }
 
-    /// A value written to `command` (the guard passed).
+    /// A value written to `command` (the guard passed). Out of line: the commit's
+    /// configuration and scene are on the stack only while a command runs.
+    #[inline(never)]
     pub(crate) fn command(&mut self, v: u16, monitor: &mut Monitor<E>) -> Result<(), Exception> {
         match v {
             command::COMMIT => {
@@ -784,6 +782,14 @@ impl<E: Estimator> Commissioning<E> {
         self.code = u16::from_le_bytes(*code);
         Some(())
     }
+}
+
+/// `scene_active_crc`: the scene's bytes on the stack only while it is read.
+#[inline(never)]
+fn active_crc<E>(io: SceneIo<E>, estimator: &E) -> u32 {
+    let mut bytes = [0; SCENE_BYTES_MAX];
+    (io.save)(estimator, &mut bytes);
+    crc32(bytes.get(..io.bytes.saturating_sub(4)).unwrap_or(&[]))
 }
 
 /// An active configuration register's value.
