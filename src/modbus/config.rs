@@ -505,9 +505,10 @@ pub(crate) struct Commissioning<E> {
 }
 
 impl<E: Estimator> Commissioning<E> {
-    pub(crate) fn new(code: u16, config: &Config) -> Self {
+    /// Locked, with `code`, nothing staged.
+    pub(crate) const fn new(code: u16) -> Self {
         Commissioning {
-            staged: config_words(config),
+            staged: [0; CONFIG_WORDS],
             scene: [0; SCENE_BYTES_MAX],
             pending: 0,
             generation: 0,
@@ -520,7 +521,12 @@ impl<E: Estimator> Commissioning<E> {
             commit_error: reason::NONE,
             source: BootSource::Defaults,
             unsaved: false,
-            counts: CommissioningCounts::default(),
+            counts: CommissioningCounts {
+                unlock_failures: 0,
+                lockouts: 0,
+                refused: 0,
+                commits: 0,
+            },
             io: None,
         }
     }
@@ -555,10 +561,11 @@ impl<E: Estimator> Commissioning<E> {
         }
     }
 
-    /// The register's value.
-    #[inline(never)]
+    /// The register's value: cheap but for the scenes' CRCs (out of line).
+    #[inline]
     pub(crate) fn value(&self, reg: Reg, monitor: &Monitor<E>) -> u32 {
-        let seconds = |ms: u32| ms.div_ceil(1000);
+        // No division while locked and not locked out (a poll's usual case).
+        let seconds = |ms: u32| if ms == 0 { 0 } else { seconds(ms) };
         match reg {
             Reg::Unlock => seconds(self.unlock_ms),
             Reg::Command | Reg::NewCode | Reg::Scene => 0,
@@ -570,16 +577,19 @@ impl<E: Estimator> Commissioning<E> {
             Reg::UnlockFailures => self.counts.unlock_failures & 0xFFFF,
             Reg::Refused => self.counts.refused & 0xFFFF,
             Reg::SceneBytes => self.io.map_or(0, |io| io.bytes as u32),
-            Reg::SceneStagedCrc => self.io.map_or(0, |io| {
-                crc32(self.scene.get(..io.bytes.saturating_sub(4)).unwrap_or(&[]))
-            }),
+            Reg::SceneStagedCrc => self.io.map_or(0, |io| staged_crc(io, &self.scene)),
             Reg::SceneActiveCrc => self.io.map_or(0, |io| active_crc(io, monitor.estimator())),
         }
     }
 
-    /// A staged register's value.
-    pub(crate) fn staged(&self, f: ConfigField) -> u32 {
-        f.get(&self.staged)
+    /// A staged register's value: the active one while the configuration is not
+    /// staged (the staged words are filled at the first write).
+    pub(crate) fn staged(&self, f: ConfigField, active: &Config) -> u32 {
+        if self.pending & staged::CONFIG != 0 {
+            f.get(&self.staged)
+        } else {
+            f.of(active)
+        }
     }
 
     /// Whether a write of `v` to a protected register may go ahead: refused (01,
@@ -600,7 +610,12 @@ impl<E: Estimator> Commissioning<E> {
         self.unlock_ms = UNLOCK_TIMEOUT_S * 1000;
     }
 
-    pub(crate) fn write_staged(&mut self, f: ConfigField, v: u32) {
+    pub(crate) fn write_staged(&mut self, f: ConfigField, v: u32, active: &Config) {
+        if self.pending & staged::CONFIG == 0 {
+            for g in ConfigField::ALL {
+                g.put(&mut self.staged, g.of(active));
+            }
+        }
         f.put(&mut self.staged, v);
         self.touched(staged::CONFIG);
     }
@@ -646,8 +661,7 @@ impl<E: Estimator> Commissioning<E> {
     }
 
     /// The staged copy back to the active configuration and scene.
-    fn revert(&mut self, config: &Config) {
-        self.staged = config_words(config);
+    fn revert(&mut self) {
         self.scene = [0; SCENE_BYTES_MAX];
         self.new_code = self.code;
         self.pending = 0;
@@ -664,7 +678,7 @@ impl<E: Estimator> Commissioning<E> {
                 result.map_err(|_| Exception::IllegalDataValue)
             }
             command::REVERT => {
-                self.revert(monitor.config());
+                self.revert();
                 self.unlock_ms = UNLOCK_TIMEOUT_S * 1000;
                 Ok(())
             }
@@ -703,7 +717,7 @@ impl<E: Estimator> Commissioning<E> {
         if self.pending & staged::CODE != 0 {
             self.code = self.new_code;
         }
-        self.revert(monitor.config());
+        self.revert();
         self.unlock_ms = 0;
         self.source = BootSource::Committed;
         self.unsaved = true;
@@ -748,7 +762,7 @@ impl<E: Estimator> Commissioning<E> {
                 None => BootSource::DefaultsDamaged,
             },
         };
-        self.revert(monitor.config());
+        self.revert();
         self.source
     }
 
@@ -782,6 +796,18 @@ impl<E: Estimator> Commissioning<E> {
         self.code = u16::from_le_bytes(*code);
         Some(())
     }
+}
+
+/// Whole seconds in `ms`, rounded up.
+#[inline(never)]
+fn seconds(ms: u32) -> u32 {
+    ms.div_ceil(1000)
+}
+
+/// `scene_staged_crc`.
+#[inline(never)]
+fn staged_crc<E>(io: SceneIo<E>, scene: &[u8; SCENE_BYTES_MAX]) -> u32 {
+    crc32(scene.get(..io.bytes.saturating_sub(4)).unwrap_or(&[]))
 }
 
 /// `scene_active_crc`: the scene's bytes on the stack only while it is read.

@@ -261,9 +261,8 @@ impl<E: Estimator> Server<E> {
         } else {
             config.ident.model_name
         };
-        let commissioning = Commissioning::new(config.unlock_code, monitor.config());
         let mut core = Core {
-            commissioning,
+            commissioning: Commissioning::new(config.unlock_code),
             monitor,
             step,
             unit: config.unit_id,

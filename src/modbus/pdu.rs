@@ -513,7 +513,7 @@ impl<E: Estimator> Core<E> {
             Field::AcknowledgeAlarms => self.annunciator.acknowledge(bits),
             Field::LatchingAlarms => self.annunciator.set_latching(bits),
             Field::ExternalMode => self.external = v != 0,
-            Field::Staged(f) => c.write_staged(f, v),
+            Field::Staged(f) => c.write_staged(f, v, self.monitor.config()),
             Field::Commission(Reg::NewCode) => c.write_new_code(v as u16),
             Field::Commission(Reg::Unlock) => c.unlock(v as u16)?,
             Field::Commission(Reg::Command) => c.command(v as u16, &mut self.monitor)?,

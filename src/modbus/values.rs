@@ -292,6 +292,8 @@ impl<E: Estimator> Core<E> {
             Field::ExternalMode => u32::from(self.external),
             Field::UnitId => u32::from(self.unit),
             Field::MapVersion => u32::from(super::map::MAP_VERSION),
+            Field::Commission(reg) => self.commissioning.value(reg, &self.monitor),
+            Field::Staged(f) => self.commissioning.staged(f, self.monitor.config()),
             _ => self.value_other(field, record),
         }
     }
@@ -371,7 +373,7 @@ impl<E: Estimator> Core<E> {
             Field::UnitId => u32::from(self.unit),
             Field::MapVersion => u32::from(super::map::MAP_VERSION),
             Field::Commission(reg) => self.commissioning.value(reg, &self.monitor),
-            Field::Staged(f) => self.commissioning.staged(f),
+            Field::Staged(f) => self.commissioning.staged(f, self.monitor.config()),
             Field::Active(f) => super::config::active(f, self.monitor.config()),
         }
     }
