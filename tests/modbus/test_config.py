@@ -9,6 +9,9 @@ MODBUS_WRONG_CODES_MAX.
 
 import os
 import struct
+import subprocess
+import sys
+import time
 
 from conftest import UNIT, read_table, register_map, words
 
@@ -115,6 +118,38 @@ def test_bytes_that_are_not_a_scene_are_refused(client):
     assert not write(client, "command", 2).isError()
     assert not write(client, "command", 3).isError()  # lock
     assert get(client, "unlock") == 0
+
+
+def commission(client, *args):
+    """Runs tools/commission.py against the node (the pymodbus client steps aside:
+    QEMU's serial socket takes one client at a time); its exit status and stderr."""
+    client.close()
+    time.sleep(0.1)
+    done = subprocess.run(
+        [sys.executable, "tools/commission.py", "--port", os.environ["MODBUS_PORT"],
+         "--registers", os.environ["MODBUS_REGISTERS"], *args],
+        capture_output=True, text=True, timeout=60)
+    time.sleep(0.1)
+    assert client.connect()
+    return done.returncode, done.stderr
+
+
+def test_the_commissioning_tool_writes_a_scene_the_node_was_not_built_with(client):
+    scene = open(os.environ["MODBUS_SCENE"], "rb").read()
+    crc = int.from_bytes(scene[-4:], "little")
+    assert get(client, "scene_active_crc") != crc
+    status, err = commission(client, "--code", str((code() + 1) & 0xFFFF), "--scene", os.environ["MODBUS_SCENE"])
+    assert status == 1 and "wrong code" in err, err
+    status, err = commission(client, "--code", str(code()), "--set", "config_warning=2.5")
+    assert status == 1 and "commit refused" in err and "0x11" in err, err
+    assert get(client, "staged") == 0 and get(client, "unlock") == 0  # reverted and locked
+    status, err = commission(client, "--code", str(code()), "--scene", os.environ["MODBUS_SCENE"],
+                             "--set", "config_off_delay=45000", "--set", "config_alarm=1.1")
+    assert status == 0, err
+    assert get(client, "scene_active_crc") == crc
+    assert get(client, "active_off_delay") == 45000
+    assert get(client, "active_alarm") == f32(1.1)
+    assert get(client, "config_source") == 1
 
 
 # Last: the lock-out lasts minutes of the node's time.

@@ -382,6 +382,7 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
     } else {
         let expected = dir.join(format!("expected-{id}.csv"));
         host::write_registers(fpu, &expected)?;
+        host::write_other_scene(fpu, &dir.join(format!("scene-{id}.bin")))?;
         // Commissioning after the node's registers were compared: it changes them.
         (
             &["tests/modbus/test_node.py", "tests/modbus/test_config.py"][..],
@@ -398,6 +399,7 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         .env("MODBUS_REGISTERS", registers)
         .env("MODBUS_CORE", if fpu { "f32" } else { "fixed" })
         .env("MODBUS_EXPECTED", &file)
+        .env("MODBUS_SCENE", dir.join(format!("scene-{id}.bin")))
         .env(
             "MODBUS_UNLOCK_CODE",
             misalign::modbus::DEFAULT_UNLOCK_CODE.to_string(),
@@ -607,6 +609,26 @@ mod host {
             }
         }
         Ok(out)
+    }
+
+    /// A scene the node was not built with, prepared for its core (`fpu`: the f32
+    /// core's `Auto`, else `FixedAuto`), as `examples/prepare.rs --out` writes it: what
+    /// tests/modbus/test_config.py commissions with tools/commission.py.
+    pub fn write_other_scene(fpu: bool, out: &Path) -> Result<(), String> {
+        fn bytes<C: scenario::Core + PreparedScene>() -> Result<Vec<u8>, String> {
+            let scene =
+                misalign::Scene::new(0.04, 0.08, 79.3e9, 0.3, 0.25).map_err(|e| e.to_string())?;
+            let core: C = scenario::estimator_for(&scene, 5e3).map_err(|e| e.to_string())?;
+            let mut out = [0; misalign::modbus::SCENE_BYTES_MAX];
+            core.to_prepared(&mut out);
+            Ok(out[..C::BYTES].to_vec())
+        }
+        let bytes = if fpu {
+            bytes::<misalign::float::Auto>()?
+        } else {
+            bytes::<misalign::fixed::FixedAuto>()?
+        };
+        std::fs::write(out, bytes).map_err(|e| format!("{}: {e}", out.display()))
     }
 
     /// The expected registers of the node on its own samples (`fpu`: the f32 core).
