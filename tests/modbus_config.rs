@@ -733,3 +733,56 @@ mod power_loss {
         assert!(points_total > 10 * IMAGE_LEN as u64, "{points_total}");
     }
 }
+
+/// Without the code, no write changes the configuration, the scene or the code:
+/// thousands of random writes (functions 6 and 16, any address of the holding table,
+/// any values, wrong codes among them) to a locked node, each answered.
+#[test]
+fn random_writes_without_the_code_change_nothing() {
+    let mut s = server();
+    let before = view(&mut s, "active");
+    let scene = s.monitor().estimator().to_bytes();
+    let end = TableMap::of(Table::Holding).end();
+    let unlock_at = at("unlock");
+    let mut x = 0x9E37_79B9_7F4A_7C15u64;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    for i in 0..5000 {
+        let r = next();
+        let mut address = (r % u64::from(end)) as u16;
+        let value = (r >> 20) as u16;
+        // Never the right code.
+        let value = if address == unlock_at && value == DEFAULT_UNLOCK_CODE {
+            value ^ 1
+        } else {
+            value
+        };
+        let result = if r >> 60 & 1 == 0 {
+            write1(&mut s, address, value)
+        } else {
+            let n = 1 + (r >> 40) as u16 % 8;
+            address = address.min(end - n);
+            let words: Vec<u16> = (0..n).map(|k| value.wrapping_add(k * 7919)).collect();
+            write(&mut s, address, &words)
+        };
+        // Refusals are typed; a write the table allows without the code may pass.
+        if let Err(code) = result {
+            assert!((1..=3).contains(&code), "{i}: exception {code}");
+        }
+        s.tick(i * 10);
+    }
+    assert_eq!(view(&mut s, "active"), before);
+    assert_eq!(s.monitor().config(), &Config::default());
+    assert_eq!(s.monitor().estimator().to_bytes(), scene);
+    assert_eq!(get(&mut s, "staged"), 0);
+    assert_eq!(get(&mut s, "config_source"), 0);
+    assert!(s.commissioning().refused > 0);
+    assert_eq!(s.commissioning().commits, 0);
+    // The code is still the one it was.
+    s.tick(5000 * 10 + LOCKOUT_S * 1000);
+    unlock(&mut s);
+}
