@@ -7,8 +7,9 @@
 //! The configuration's registers (staged `config_*`, active `active_*`) are [`Config`]
 //! field by field, in [`ConfigField`]'s order; an option that is off reads 0 in its
 //! switch (`spike_window`, `trend_interval`, `friction`) and in its values. The staged
-//! copy is held as those registers' words and decoded at the commit; the active view
-//! is computed from the monitor's [`Config`] when it is read.
+//! copy is held as those registers' words (filled from the active configuration at its
+//! first write; until then it reads as the active one) and decoded at the commit; the
+//! active view is computed from the monitor's [`Config`] when it is read.
 //!
 //! Time is the application's: [`Server::tick`](super::Server::tick) with a
 //! millisecond counter (u32, wrapping). Without ticks no unlock expires and no lock-out
@@ -592,8 +593,8 @@ impl<E: Estimator> Commissioning<E> {
         }
     }
 
-    /// Whether a write of `v` to a protected register may go ahead: refused (01,
-    /// counted) while locked.
+    /// Whether a write to a protected register may go ahead: refused (01, counted)
+    /// while locked.
     pub(crate) fn guard(&mut self) -> Result<(), Exception> {
         if self.unlocked() {
             Ok(())
