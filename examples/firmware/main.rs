@@ -108,6 +108,8 @@ fn main() -> ! {
                     total
                 },
                 silence: uart.silence_ticks(),
+                // `silence_ticks` is one second of ticks.
+                per_ms: uart.silence_ticks() / 1000,
             }
         };
         let served = if fpu {

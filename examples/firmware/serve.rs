@@ -5,7 +5,7 @@
 
 use embedded_io::{ErrorType, Read, ReadReady, Write};
 use misalign::Estimator;
-use misalign::modbus::{Identification, Server, ServerConfig};
+use misalign::modbus::{Identification, PreparedScene, Server, ServerConfig};
 use misalign::monitor::scenario::Scenario;
 use misalign::monitor::{Config, Monitor};
 
@@ -24,6 +24,8 @@ pub const EXTERNAL_SAMPLES: bool = option_env!("MISALIGN_MODBUS_EXTERNAL").is_so
 pub struct LineClock<T: FnMut() -> u32> {
     pub ticks: T,
     pub silence: u32,
+    /// Ticks in a millisecond: the commissioning's clock (`Server::tick`).
+    pub per_ms: u32,
 }
 
 /// The Modbus node: a `misalign::modbus::Server` over the monitor of `core`
@@ -33,7 +35,7 @@ pub struct LineClock<T: FnMut() -> u32> {
 /// holds the end of the shift, the state a host replay of the same samples reaches;
 /// with external samples it starts fresh and monitors what a master writes. `None` if
 /// the monitor refuses its configuration.
-pub fn node<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32>(
+pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut() -> u32>(
     core: E,
     model: &'static str,
     uart: &mut U,
@@ -61,6 +63,8 @@ pub fn node<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32>(
             return None;
         }
     };
+    // Commissioning takes scenes of the node's core type over the bus.
+    server.accept_scenes();
     if !EXTERNAL_SAMPLES {
         for sample in Scenario::new() {
             server.process(sample);
@@ -81,6 +85,9 @@ pub fn node<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32>(
     // server drops or answers it then).
     let (mut last_byte, mut waiting) = ((clock.ticks)(), false);
     let mut uart = Watched { uart, seen: false };
+    // The commissioning's milliseconds, from the line's ticks.
+    let (mut ms, mut ticked) = (0u32, last_byte);
+    let per_ms = clock.per_ms.max(1);
     loop {
         if server.poll(&mut uart).is_err() {
             // A framing, parity or overrun error: bytes lost, which the framer's CRC
@@ -88,6 +95,12 @@ pub fn node<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32>(
             defmt::warn!("modbus: a UART error");
         }
         let now = (clock.ticks)();
+        let step = now.wrapping_sub(ticked);
+        if step >= per_ms {
+            ms = ms.wrapping_add(step / per_ms);
+            ticked = ticked.wrapping_add(step - step % per_ms);
+            server.tick(ms);
+        }
         if core::mem::take(&mut uart.seen) {
             (last_byte, waiting) = (now, true);
         } else if waiting && now.wrapping_sub(last_byte) >= clock.silence {

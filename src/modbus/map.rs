@@ -5,6 +5,7 @@
 //! hole, then blocks of repeated records (the event window's slots, the external
 //! samples). A 32-bit value takes two registers, the high word first.
 
+use super::config::{ConfigField, Reg};
 use crate::monitor::annunciation::AlarmSet;
 use core::fmt;
 
@@ -154,6 +155,12 @@ pub(crate) enum Field {
     EventsOverwritten,
     Checkpoints,
     CheckpointAge,
+    /// A commissioning register (`unlock`, `command`, the scene block, ...).
+    Commission(Reg),
+    /// A staged configuration register.
+    Staged(ConfigField),
+    /// An active configuration register.
+    Active(ConfigField),
 
     /// An external sample's field (the basic or the full record).
     Sample(SampleField),
@@ -495,7 +502,7 @@ static EVENT_FIELDS: [Entry; 15] = [
 ];
 
 /// Where the basic external samples start (holding registers).
-pub const SAMPLES_ADDRESS: u16 = 9;
+pub const SAMPLES_ADDRESS: u16 = 152;
 /// Records of the basic block: the most one function-16 write carries.
 pub const SAMPLES: u16 = 20;
 /// Registers per basic record (time, P, phi).
@@ -506,7 +513,20 @@ pub const SAMPLES_FULL_ADDRESS: u16 = SAMPLES_ADDRESS + SAMPLES * SAMPLE_STRIDE;
 pub const SAMPLES_FULL: u16 = 11;
 /// Registers per full record (flags, time, P, phi, V, F).
 pub const SAMPLE_FULL_STRIDE: u16 = 11;
+/// Where the scene block starts (holding registers): the prepared scene's bytes, two
+/// a register, the first the high byte.
+pub const SCENE_ADDRESS: u16 = SAMPLES_FULL_ADDRESS + SAMPLES_FULL * SAMPLE_FULL_STRIDE;
+/// Registers of the scene block.
+pub const SCENE_WORDS: u16 = (super::config::SCENE_BYTES_MAX / 2) as u16;
 
+#[rustfmt::skip]
+static SCENE_FIELDS: [Entry; 1] = [
+    e!(Holding, 0, "word", U16, "", Rw, F::Commission(K::Scene),
+        "needs the unlock: two bytes of the staged prepared scene (high byte first), from byte 0 at scene_0_word; reads 0"),
+];
+
+use ConfigField as G;
+use Reg as K;
 use SampleField as X;
 
 #[rustfmt::skip]
@@ -553,6 +573,168 @@ pub static HOLDINGS: TableMap = TableMap {
             "the version of this register map (read only): a change of an address, type or meaning increments it"),
         e!(Holding, 7, "event_ack", U32, "", Rw, F::EventAck,
             "write n: acknowledge events through n (below event_seq_next), freeing them on flash; event_from moves past n; 0xFFFFFFFF none"),
+        e!(Holding, 9, "unlock", U16, "s", Rw, F::Commission(K::Unlock),
+            "write the site's code: commissioning writes are allowed until a commit, the command lock or 300 s after the last of them; 3 wrong codes in a row lock out every code for 300 s; reads the seconds the unlock has left (0 locked)"),
+        e!(Holding, 10, "command", U16, "", Rw, F::Commission(K::Command),
+            "needs the unlock: 1 commit the staged copy (validated, applied whole, then locked; refused with exception 03 and commit_error), 2 revert (discard it), 3 lock; reads 0"),
+        e!(Holding, 11, "commit_error", U16, "", R, F::Commission(K::CommitError),
+            "the last commit's reason: 0 applied, 1 nothing staged, 0x10 + the configuration's error, 0x20 + the scene's error (docs/modbus.md)"),
+        e!(Holding, 12, "config_source", U16, "", R, F::Commission(K::Source),
+            "the configuration running: 0 the build-time defaults (none stored), 1 the committed one, 2 the build-time defaults because the stored one was damaged"),
+        e!(Holding, 13, "staged", U16, "", R, F::Commission(K::Staged),
+            "what is staged: bit 0 the configuration, bit 1 the scene, bit 2 a new code (0: the staged copy is the active one)"),
+        e!(Holding, 14, "staged_generation", U16, "", R, F::Commission(K::Generation),
+            "values written into the staged copy (modulo 2^16): a change between a master's writes and its commit is another master's"),
+        e!(Holding, 15, "lockout", U16, "s", R, F::Commission(K::Lockout),
+            "seconds left of the lock-out after wrong codes (0 none)"),
+        e!(Holding, 16, "unlock_failures", U16, "", R, F::Commission(K::UnlockFailures),
+            "wrong codes, and codes written during a lock-out (modulo 2^16)"),
+        e!(Holding, 17, "refused_writes", U16, "", R, F::Commission(K::Refused),
+            "commissioning writes refused while locked (modulo 2^16)"),
+        e!(Holding, 18, "new_code", U16, "", Rw, F::Commission(K::NewCode),
+            "needs the unlock: stages a new site code, in force after the commit; reads 0"),
+        e!(Holding, 19, "scene_bytes", U16, "", R, F::Commission(K::SceneBytes),
+            "bytes of the prepared scene this node takes in the scene block (0: it takes none)"),
+        e!(Holding, 20, "scene_staged_crc", U32, "", R, F::Commission(K::SceneStagedCrc),
+            "the CRC-32 of the staged scene's bytes before their own CRC: equal to the prepared file's last four bytes when it was written whole"),
+        e!(Holding, 22, "scene_active_crc", U32, "", R, F::Commission(K::SceneActiveCrc),
+            "the same of the active scene (0: this node takes no scene)"),
+        e!(Holding, 24, "config_thresholds_on", U16, "", Rw, F::Staged(G::ThresholdsOn),
+            "needs the unlock; staged: what the thresholds are on: 0 the slip ratio d/b (eq 16; eq 23 for line contact), 1 the margin phi0 - |phi| (rad)"),
+        e!(Holding, 25, "config_warning", F32, "", Rw, F::Staged(G::Warning),
+            "needs the unlock; staged: warning threshold (microslip): d/b, or the margin (rad) at or below which it is raised"),
+        e!(Holding, 27, "config_alarm", F32, "", Rw, F::Staged(G::Alarm),
+            "needs the unlock; staged: alarm threshold (gross slip): d/b, or the margin (rad)"),
+        e!(Holding, 29, "config_deadband", F32, "", Rw, F::Staged(G::Deadband),
+            "needs the unlock; staged: clearing deadband of the thresholds (d/b, or rad)"),
+        e!(Holding, 31, "config_on_delay", U32, "ms", Rw, F::Staged(G::OnDelay),
+            "needs the unlock; staged: on-delay: a more severe state holds this long before it is entered"),
+        e!(Holding, 33, "config_off_delay", U32, "ms", Rw, F::Staged(G::OffDelay),
+            "needs the unlock; staged: off-delay: a less severe state holds this long before it is entered"),
+        e!(Holding, 35, "config_fault_delay", U32, "ms", Rw, F::Staged(G::FaultDelay),
+            "needs the unlock; staged: delay before a sensor fault is reported (0: at once)"),
+        e!(Holding, 37, "config_inhibit", U32, "ms", Rw, F::Staged(G::Inhibit),
+            "needs the unlock; staged: start-up inhibit: no warning or alarm this long after the machine starts"),
+        e!(Holding, 39, "config_stop_load", F32, "N", Rw, F::Staged(G::StopLoad),
+            "needs the unlock; staged: below this load the machine stands (state stopped)"),
+        e!(Holding, 41, "config_stop_speed", F32, "m/s", Rw, F::Staged(G::StopSpeed),
+            "needs the unlock; staged: below this measured speed the machine stands"),
+        e!(Holding, 43, "config_nominal_speed", F32, "m/s", Rw, F::Staged(G::NominalSpeed),
+            "needs the unlock; staged: rolling speed for the wear integral when a sample has none"),
+        e!(Holding, 45, "config_load_min", F32, "N", Rw, F::Staged(G::LoadMin),
+            "needs the unlock; staged: lowest accepted load"),
+        e!(Holding, 47, "config_load_max", F32, "N", Rw, F::Staged(G::LoadMax),
+            "needs the unlock; staged: highest accepted load"),
+        e!(Holding, 49, "config_angle_max", F32, "rad", Rw, F::Staged(G::AngleMax),
+            "needs the unlock; staged: highest accepted |phi|"),
+        e!(Holding, 51, "config_speed_max", F32, "m/s", Rw, F::Staged(G::SpeedMax),
+            "needs the unlock; staged: highest accepted speed"),
+        e!(Holding, 53, "config_force_max", F32, "N", Rw, F::Staged(G::ForceMax),
+            "needs the unlock; staged: highest accepted |F| of a measured axial force"),
+        e!(Holding, 55, "config_spike_window", U16, "", Rw, F::Staged(G::SpikeWindow),
+            "needs the unlock; staged: spike filter: window (samples, 3 to 7); 0: off"),
+        e!(Holding, 56, "config_spike_k", F32, "", Rw, F::Staged(G::SpikeK),
+            "needs the unlock; staged: spike filter: a spike is beyond k scaled MADs plus the floor from the median"),
+        e!(Holding, 58, "config_spike_load_floor", F32, "N", Rw, F::Staged(G::SpikeLoadFloor),
+            "needs the unlock; staged: spike filter: the load test's floor"),
+        e!(Holding, 60, "config_spike_angle_floor", F32, "rad", Rw, F::Staged(G::SpikeAngleFloor),
+            "needs the unlock; staged: spike filter: the angle test's floor"),
+        e!(Holding, 62, "config_smoothing_tau", F32, "s", Rw, F::Staged(G::SmoothingTau),
+            "needs the unlock; staged: time constant of the smoothing of load and angle; 0: off"),
+        e!(Holding, 64, "config_stuck", U32, "ms", Rw, F::Staged(G::Stuck),
+            "needs the unlock; staged: a value unchanged this long while running is a stuck sensor; 0: off"),
+        e!(Holding, 66, "config_gap", U32, "ms", Rw, F::Staged(G::Gap),
+            "needs the unlock; staged: a step between samples longer than this is a gap; 0: off"),
+        e!(Holding, 68, "config_trend_interval", U32, "ms", Rw, F::Staged(G::TrendInterval),
+            "needs the unlock; staged: time to critical: one trend point every this long; 0: the trend is off"),
+        e!(Holding, 70, "config_trend_points", U16, "", Rw, F::Staged(G::TrendPoints),
+            "needs the unlock; staged: time to critical: points in the fit (3 to 16)"),
+        e!(Holding, 71, "config_trend_horizon", F32, "s", Rw, F::Staged(G::TrendHorizon),
+            "needs the unlock; staged: time to critical: approaching is raised below this"),
+        e!(Holding, 73, "config_friction", U16, "", Rw, F::Staged(G::Friction),
+            "needs the unlock; staged: 1: friction tracking from a measured axial force on, 0: off"),
+        e!(Holding, 74, "config_friction_sensitivity", F32, "", Rw, F::Staged(G::FrictionSensitivity),
+            "needs the unlock; staged: friction: the highest sensitivity d ln mu / d ln F of an estimate that counts"),
+        e!(Holding, 76, "config_friction_tau", F32, "s", Rw, F::Staged(G::FrictionTau),
+            "needs the unlock; staged: friction: time constant of the filter of mu"),
+        e!(Holding, 78, "config_friction_baseline_after", U32, "ms", Rw, F::Staged(G::FrictionBaselineAfter),
+            "needs the unlock; staged: friction: the baseline is captured after running this long"),
+        e!(Holding, 80, "config_friction_baseline_estimates", U32, "", Rw, F::Staged(G::FrictionBaselineEstimates),
+            "needs the unlock; staged: friction: and after this many accepted estimates (at least 1)"),
+        e!(Holding, 82, "config_friction_band", F32, "", Rw, F::Staged(G::FrictionBand),
+            "needs the unlock; staged: friction: relative band around the baseline"),
+        e!(Holding, 84, "config_friction_deadband", F32, "", Rw, F::Staged(G::FrictionDeadband),
+            "needs the unlock; staged: friction: clearing deadband (below the band)"),
+        e!(Holding, 86, "config_friction_delay", U32, "ms", Rw, F::Staged(G::FrictionDelay),
+            "needs the unlock; staged: friction: a change is raised or cleared after this long"),
+        e!(Holding, 88, "active_thresholds_on", U16, "", R, F::Active(G::ThresholdsOn),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 89, "active_warning", F32, "", R, F::Active(G::Warning),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 91, "active_alarm", F32, "", R, F::Active(G::Alarm),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 93, "active_deadband", F32, "", R, F::Active(G::Deadband),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 95, "active_on_delay", U32, "ms", R, F::Active(G::OnDelay),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 97, "active_off_delay", U32, "ms", R, F::Active(G::OffDelay),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 99, "active_fault_delay", U32, "ms", R, F::Active(G::FaultDelay),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 101, "active_inhibit", U32, "ms", R, F::Active(G::Inhibit),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 103, "active_stop_load", F32, "N", R, F::Active(G::StopLoad),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 105, "active_stop_speed", F32, "m/s", R, F::Active(G::StopSpeed),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 107, "active_nominal_speed", F32, "m/s", R, F::Active(G::NominalSpeed),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 109, "active_load_min", F32, "N", R, F::Active(G::LoadMin),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 111, "active_load_max", F32, "N", R, F::Active(G::LoadMax),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 113, "active_angle_max", F32, "rad", R, F::Active(G::AngleMax),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 115, "active_speed_max", F32, "m/s", R, F::Active(G::SpeedMax),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 117, "active_force_max", F32, "N", R, F::Active(G::ForceMax),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 119, "active_spike_window", U16, "", R, F::Active(G::SpikeWindow),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 120, "active_spike_k", F32, "", R, F::Active(G::SpikeK),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 122, "active_spike_load_floor", F32, "N", R, F::Active(G::SpikeLoadFloor),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 124, "active_spike_angle_floor", F32, "rad", R, F::Active(G::SpikeAngleFloor),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 126, "active_smoothing_tau", F32, "s", R, F::Active(G::SmoothingTau),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 128, "active_stuck", U32, "ms", R, F::Active(G::Stuck),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 130, "active_gap", U32, "ms", R, F::Active(G::Gap),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 132, "active_trend_interval", U32, "ms", R, F::Active(G::TrendInterval),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 134, "active_trend_points", U16, "", R, F::Active(G::TrendPoints),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 135, "active_trend_horizon", F32, "s", R, F::Active(G::TrendHorizon),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 137, "active_friction", U16, "", R, F::Active(G::Friction),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 138, "active_friction_sensitivity", F32, "", R, F::Active(G::FrictionSensitivity),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 140, "active_friction_tau", F32, "s", R, F::Active(G::FrictionTau),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 142, "active_friction_baseline_after", U32, "ms", R, F::Active(G::FrictionBaselineAfter),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 144, "active_friction_baseline_estimates", U32, "", R, F::Active(G::FrictionBaselineEstimates),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 146, "active_friction_band", F32, "", R, F::Active(G::FrictionBand),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 148, "active_friction_deadband", F32, "", R, F::Active(G::FrictionDeadband),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
+        e!(Holding, 150, "active_friction_delay", U32, "ms", R, F::Active(G::FrictionDelay),
+            "the value the monitor runs (read only); config_ with the same field name is its staged copy"),
     ],
     blocks: &[
         Block {
@@ -570,6 +752,14 @@ pub static HOLDINGS: TableMap = TableMap {
             count: SAMPLES_FULL,
             stride: SAMPLE_FULL_STRIDE,
             fields: &SAMPLE_FULL_FIELDS,
+        },
+        Block {
+            table: Table::Holding,
+            address: SCENE_ADDRESS,
+            prefix: "scene",
+            count: SCENE_WORDS,
+            stride: 1,
+            fields: &SCENE_FIELDS,
         },
     ],
 };
@@ -820,12 +1010,17 @@ mod tests {
     }
 
     /// The read of holding registers writes the blocks' words as 0 without asking each
-    /// field (`Core::fill`): they are all external samples' fields, which read 0.
+    /// field (`Core::fill`): they are all external samples' fields or the scene's,
+    /// which read 0.
     #[test]
-    fn holding_blocks_are_external_samples() {
+    fn holding_blocks_read_zero() {
         for b in HOLDINGS.blocks {
             for e in b.fields {
-                assert!(matches!(e.field, Field::Sample(_)), "{}", e.name);
+                assert!(
+                    matches!(e.field, Field::Sample(_) | Field::Commission(Reg::Scene)),
+                    "{}",
+                    e.name
+                );
             }
         }
     }

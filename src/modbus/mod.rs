@@ -41,10 +41,13 @@
 //! `counters`, `into_monitor`; for events kept on flash until acknowledged
 //! (store-and-forward, docs/modbus.md) `store_events`, `pop_event`, `offer_event`,
 //! `wanted_event`, `offer_stored_event`, `end_backlog`, `acknowledged_through`,
-//! `set_storage_status` ([`StorageStatus`]), `storage_status`. The server stores
-//! nothing itself (it does not depend on `misalign::storage`): the application moves
-//! the events between it and its flash. Beside it: [`registers_csv`], [`silence_us`],
-//! the map's addresses in [`map`], and for a master written in Rust [`event_from_registers`]
+//! `set_storage_status` ([`StorageStatus`]), `storage_status`; for commissioning
+//! `accept_scenes`, `tick`, `unlocked`, `commissioning`, `config_source`,
+//! `take_committed`, `restore` (see below). The server stores nothing itself (it does
+//! not depend on `misalign::storage`): the application moves the events and the
+//! committed image between it and its flash. Beside it: [`registers_csv`],
+//! [`silence_us`], the map's addresses in [`map`], and for a master written in Rust
+//! [`event_from_registers`]
 //! and [`fault_from_code`].
 //!
 //! **External samples** written by a master over the bus (holding blocks `sample_*`,
@@ -55,6 +58,17 @@
 //! ([`ServerConfig::external_samples`]) and at run time by the coil
 //! `external_samples` or the holding register `external_mode`; while off, such a write
 //! is refused with exception 01 and counted (`external_refused`).
+//!
+//! **Commissioning** (the `config_*`, `active_*` and `scene_*` holding registers,
+//! `unlock`, `command`): writes go to a staged copy of the monitor's configuration and
+//! scene, shown beside the active one; a commit validates it (`ConfigError`,
+//! `PreparedError`: exception 03 and the reason in `commit_error`) and applies it whole
+//! between two samples; every such write needs the site's code written to `unlock`
+//! first, which lasts until the commit or [`UNLOCK_TIMEOUT_S`] on the application's
+//! clock ([`Server::tick`]), with a lock-out after [`WRONG_CODES_MAX`] wrong codes. The
+//! committed configuration goes to the application as bytes
+//! ([`Server::take_committed`]) to persist (the storage layer's `ConfigImage`), and
+//! comes back at boot through [`Server::restore`], which `config_source` reports.
 //!
 //! **The map** ([`map`]) is one table in code: the server reads and writes through it,
 //! and [`registers_csv`] writes it as `docs/modbus/registers.csv`
@@ -76,6 +90,7 @@
 //! a copy of every register, where this map computes each value from the monitor when
 //! it is read (no second copy to keep in step, no RAM for it).
 
+mod config;
 mod crc;
 mod events;
 mod exception;
@@ -88,6 +103,11 @@ pub mod rtu;
 mod values;
 
 pub use crate::monitor::annunciation::{AlarmSet, Annunciator};
+pub use config::{
+    BootSource, CONFIG_WORDS, CommissioningCounts, DEFAULT_UNLOCK_CODE, IMAGE_LEN, IMAGE_VERSION,
+    LOCKOUT_S, PreparedScene, SCENE_BYTES_MAX, Stored, UNLOCK_TIMEOUT_S, WRONG_CODES_MAX, command,
+    reason, staged,
+};
 pub use crc::crc16;
 pub use events::{EVENT_WINDOW, StorageStatus};
 pub use exception::Exception;
@@ -98,6 +118,7 @@ pub use values::{DecodeError, event_from_registers, fault_code, fault_from_code}
 
 use crate::monitor::{Event, Monitor, RiskState, Sample};
 use crate::{Estimator, FrictionInverse};
+use config::Commissioning;
 use core::fmt;
 use events::EventWindow;
 use rtu::Framer;
@@ -134,6 +155,9 @@ pub struct ServerConfig {
     pub external_samples: bool,
     /// The alarms that latch from the start (the coils `latch_*` change it).
     pub latching: AlarmSet,
+    /// The site's code that `unlock` takes before any commissioning write, until a
+    /// committed `new_code` replaces it (default [`DEFAULT_UNLOCK_CODE`]).
+    pub unlock_code: u16,
 }
 
 impl Default for ServerConfig {
@@ -143,6 +167,7 @@ impl Default for ServerConfig {
             ident: Identification::default(),
             external_samples: false,
             latching: AlarmSet::NONE,
+            unlock_code: DEFAULT_UNLOCK_CODE,
         }
     }
 }
@@ -217,6 +242,8 @@ struct Core<E> {
     storage: StorageStatus,
     response: [u8; ADU_MAX],
     monitor: Monitor<E>,
+    /// The staged configuration, the unlock, the commits.
+    commissioning: Commissioning<E>,
 }
 
 impl<E: Estimator> Server<E> {
@@ -245,6 +272,7 @@ impl<E: Estimator> Server<E> {
             config.ident.model_name
         };
         let mut core = Core {
+            commissioning: Commissioning::new(config.unlock_code),
             monitor,
             step,
             unit: config.unit_id,
@@ -352,6 +380,50 @@ impl<E: Estimator> Server<E> {
         }
     }
 
+    /// The application's clock for commissioning: `now_ms` a free-running millisecond
+    /// counter (u32, wrapping). The unlock's timeout ([`UNLOCK_TIMEOUT_S`]) and the
+    /// lock-out ([`LOCKOUT_S`]) run on it alone; call it at least once a second (without
+    /// it, neither ends by itself).
+    pub fn tick(&mut self, now_ms: u32) {
+        self.core.commissioning.tick(now_ms);
+    }
+
+    /// Whether commissioning writes are unlocked now.
+    pub fn unlocked(&self) -> bool {
+        self.core.commissioning.unlocked()
+    }
+
+    /// What commissioning has counted.
+    pub fn commissioning(&self) -> CommissioningCounts {
+        self.core.commissioning.counts()
+    }
+
+    /// Where the configuration the monitor runs came from (the register
+    /// `config_source`).
+    pub fn config_source(&self) -> BootSource {
+        self.core.commissioning.source()
+    }
+
+    /// The image of the configuration committed over the bus ([`IMAGE_LEN`] bytes: its
+    /// configuration, the site's code and, with [`accept_scenes`](Self::accept_scenes),
+    /// the scene's prepared bytes) into `out`, once per commit: `true` when a commit
+    /// awaits being persisted. Call it after each request, and store `out` (the storage
+    /// layer's `ConfigImage` record) before the next commit.
+    pub fn take_committed(&mut self, out: &mut [u8; IMAGE_LEN]) -> bool {
+        let c = &mut self.core;
+        c.commissioning.take_committed(&c.monitor, out)
+    }
+
+    /// At boot: applies the configuration the application restored from its storage,
+    /// or says why the build-time defaults run. A stored image that does not decode,
+    /// whose configuration fails `Config::validate` or whose scene fails to load, changes
+    /// nothing and gives [`BootSource::DefaultsDamaged`]. Returns what `config_source`
+    /// reads after it.
+    pub fn restore(&mut self, stored: Stored<'_>) -> BootSource {
+        let c = &mut self.core;
+        c.commissioning.restore(stored, &mut c.monitor)
+    }
+
     /// The monitor back, the server given up.
     pub fn into_monitor(self) -> Monitor<E> {
         self.core.monitor
@@ -431,6 +503,15 @@ impl<E: Estimator> Server<E> {
     /// What [`set_storage_status`](Self::set_storage_status) set last.
     pub fn storage_status(&self) -> StorageStatus {
         self.core.storage
+    }
+}
+
+impl<E: Estimator + PreparedScene> Server<E> {
+    /// Takes scenes over the bus: the scene block and a commit load `E`'s prepared
+    /// bytes ([`PreparedScene`]); without it the scene block refuses writes (exception
+    /// 01) and a scene is never part of a committed image.
+    pub fn accept_scenes(&mut self) {
+        self.core.commissioning.accept_scenes(config::SceneIo::of());
     }
 }
 

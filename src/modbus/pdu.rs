@@ -2,6 +2,7 @@
 //! the checks in the specification's order (function, quantity, address, value),
 //! exceptions, broadcasts.
 
+use super::config::{ConfigField, Reg};
 use super::exception::Exception;
 use super::map::{Access, Block, Field, Located, Table, TableMap};
 use super::{ADU_MAX, Core, crc, ident};
@@ -339,12 +340,18 @@ impl<E: Estimator> Core<E> {
     fn write_register(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
         let (address, value) = head(pdu)?;
         let l = Self::writable(TableMap::of(Table::Holding), address)?;
+        if l.entry.field == Field::Commission(Reg::Scene) {
+            let data = pdu.get(3..5).unwrap_or(&[]);
+            return self
+                .write_scene(address, data)
+                .and_then(|()| self.echo(pdu));
+        }
         if l.entry.ty.words() != 1 || matches!(l.entry.field, Field::Sample(_)) {
             // Half of a 32-bit value, or part of a sample record.
             return Err(Exception::IllegalDataAddress);
         }
-        self.check_word(l.entry.field, u32::from(value))?;
-        self.write_word(l.entry.field, u32::from(value));
+        self.check_word(l.entry.field, u32::from(value), true)?;
+        self.write_word(l.entry.field, u32::from(value))?;
         self.echo(pdu)
     }
 
@@ -369,6 +376,9 @@ impl<E: Estimator> Core<E> {
                 .iter()
                 .find(|b| start < b.end())
                 .ok_or(Exception::IllegalDataAddress)?;
+            if start >= super::map::SCENE_ADDRESS {
+                return self.write_scene(start, data).and_then(|()| self.echo(pdu));
+            }
             return self
                 .write_samples(block, start, quantity, data)
                 .and_then(|()| self.echo(pdu));
@@ -394,9 +404,9 @@ impl<E: Estimator> Core<E> {
                     u32::from(word(i))
                 };
                 if pass {
-                    self.write_word(l.entry.field, v);
+                    self.write_word(l.entry.field, v)?;
                 } else {
-                    self.check_word(l.entry.field, v)?;
+                    self.check_word(l.entry.field, v, quantity == 1)?;
                 }
                 a = a.wrapping_add(n);
             }
@@ -457,8 +467,10 @@ impl<E: Estimator> Core<E> {
         Ok(usize::from(quantity / stride))
     }
 
-    /// Whether `v` is in the domain of the writable register `field`.
-    fn check_word(&self, field: Field, v: u32) -> Result<(), Exception> {
+    /// Whether `v` is in the domain of the writable register `field`, and a
+    /// commissioning write is unlocked (`alone`: the request writes this register
+    /// only, as `unlock` and `command` must be written).
+    fn check_word(&mut self, field: Field, v: u32, alone: bool) -> Result<(), Exception> {
         let ok = match field {
             Field::AcknowledgeAlarms | Field::LatchingAlarms => v <= 15,
             Field::ExternalMode => v <= 1,
@@ -468,6 +480,17 @@ impl<E: Estimator> Core<E> {
             Field::EventAck => {
                 let newest = self.monitor.next_event_seq().wrapping_sub(1);
                 super::events::at_or_after(newest, v)
+            }
+            Field::Commission(Reg::Unlock | Reg::Command) if !alone => {
+                return Err(Exception::IllegalDataAddress);
+            }
+            Field::Commission(Reg::Unlock) => true,
+            Field::Commission(Reg::Command | Reg::NewCode) | Field::Staged(_) => {
+                self.commissioning.guard()?;
+                !matches!(
+                    field,
+                    Field::Staged(ConfigField::ThresholdsOn | ConfigField::Friction)
+                ) || v <= 1
             }
             _ => false,
         };
@@ -488,8 +511,9 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    fn write_word(&mut self, field: Field, v: u32) {
+    fn write_word(&mut self, field: Field, v: u32) -> Result<(), Exception> {
         let bits = super::AlarmSet::from_bits(v as u8);
+        let c = &mut self.commissioning;
         match field {
             Field::EventFrom => self.events.from = v,
             Field::EventAck => {
@@ -501,7 +525,21 @@ impl<E: Estimator> Core<E> {
             Field::AcknowledgeAlarms => self.annunciator.acknowledge(bits),
             Field::LatchingAlarms => self.annunciator.set_latching(bits),
             Field::ExternalMode => self.external = v != 0,
+            Field::Staged(f) => c.write_staged(f, v, self.monitor.config()),
+            Field::Commission(Reg::NewCode) => c.write_new_code(v as u16),
+            Field::Commission(Reg::Unlock) => c.unlock(v as u16)?,
+            Field::Commission(Reg::Command) => c.command(v as u16, &mut self.monitor)?,
             _ => {}
         }
+        Ok(())
+    }
+
+    /// Registers written into the scene block from `start` (big-endian words, the
+    /// prepared scene's bytes in order).
+    fn write_scene(&mut self, start: u16, data: &[u8]) -> Result<(), Exception> {
+        let at = start
+            .checked_sub(super::map::SCENE_ADDRESS)
+            .ok_or(Exception::IllegalDataAddress)?;
+        self.commissioning.write_scene(2 * usize::from(at), data)
     }
 }

@@ -293,6 +293,8 @@ impl<E: Estimator> Core<E> {
             Field::UnitId => u32::from(self.unit),
             Field::MapVersion => u32::from(super::map::MAP_VERSION),
             Field::EventAck => self.ack.unwrap_or(u32::MAX),
+            Field::Commission(reg) => self.commissioning.value(reg, &self.monitor),
+            Field::Staged(f) => self.commissioning.staged(f, self.monitor.config()),
             _ => self.value_other(field, record),
         }
     }
@@ -379,6 +381,9 @@ impl<E: Estimator> Core<E> {
             Field::CheckpointAge => self.storage.last_checkpoint_ms.map_or(u32::MAX, |t| {
                 u32::try_from(m.elapsed_ms().saturating_sub(t) / 1000).unwrap_or(u32::MAX - 1)
             }),
+            Field::Commission(reg) => self.commissioning.value(reg, &self.monitor),
+            Field::Staged(f) => self.commissioning.staged(f, self.monitor.config()),
+            Field::Active(f) => super::config::active(f, self.monitor.config()),
         }
     }
 

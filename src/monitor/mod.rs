@@ -213,6 +213,31 @@ impl<E: Estimator> Monitor<E> {
         &self.estimator
     }
 
+    /// Replaces the configuration between two samples, checked first: on an error
+    /// nothing changes. State, statistics and events go on; the conditioning and the
+    /// trend start afresh, their windows being formed under the old configuration.
+    ///
+    /// # Errors
+    /// The [`ConfigError`] of an inconsistent configuration.
+    pub fn set_config(&mut self, config: Config) -> Result<(), ConfigError> {
+        config.validate()?;
+        self.limits = checks::Limits::new(&config);
+        self.levels = risk::Levels::new(&config.thresholds);
+        self.conditioning = conditioning::Conditioning::new(&config);
+        self.trend = trend::Trend::new();
+        self.config = config;
+        Ok(())
+    }
+
+    /// Replaces the scene between two samples. State, statistics and events go on; the
+    /// conditioning and the trend start afresh (the trend's margins are the old
+    /// scene's).
+    pub fn set_estimator(&mut self, estimator: E) {
+        self.estimator = estimator;
+        self.conditioning.restart();
+        self.trend = trend::Trend::new();
+    }
+
     /// What the monitor has counted and integrated.
     pub fn statistics(&self) -> &Statistics {
         &self.stats

@@ -28,6 +28,9 @@
 //! [`RestoreOutcome::Rejected`] with [`StorageEvent::CorruptRegion`],
 //! [`StorageEvent::ForeignRegion`] or [`StorageEvent::OversizedRecord`] the region was
 //! erased: checkpoint every kind held in RAM again.
+//! - [`ConfigImage`]: a configuration committed over the fieldbus (the Modbus server's
+//!   image of its configuration, site code and scene) under [`kind::COMMITTED_CONFIG`],
+//!   old or new after a power loss, never a mix.
 //! - `SensorCalibration` (with the feature `sensors`): the sensors' calibration (load
 //!   cell, misalignment probes, tachometer) as one record of [`kind::CALIBRATION`],
 //!   put back only if every part passes its `validate`.
@@ -69,6 +72,7 @@ pub mod blocking;
 #[cfg(feature = "sensors")]
 mod calibration;
 pub mod codec;
+mod config;
 pub mod endurance;
 mod event_queue;
 #[cfg(feature = "_mock-flash")]
@@ -79,6 +83,7 @@ pub use blocking::{BlockingFlash, block_on};
 #[cfg(feature = "sensors")]
 pub use calibration::SensorCalibration;
 pub use codec::{CodecError, Reader, Writer};
+pub use config::ConfigImage;
 pub use event_queue::{EventQueue, Pushed, QueueStats, Recovered};
 #[cfg(feature = "_mock-flash")]
 pub use mock_flash::{MockError, MockFlash};
@@ -101,6 +106,9 @@ pub mod kind {
     /// An acknowledgement in the flash event queue: every record up to its sequence
     /// number is acknowledged.
     pub const EVENT_ACK: u8 = 9;
+    /// A configuration committed over a fieldbus, as its server's image
+    /// ([`ConfigImage`](super::ConfigImage)).
+    pub const COMMITTED_CONFIG: u8 = 4;
 }
 
 /// A value stored as a checkpoint: a fixed-size, versioned payload.

@@ -376,23 +376,38 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
     let (tests, file) = if node.external {
         host::write_samples(&dir.join("samples.csv"), &host::scenario())?;
         (
-            "tests/modbus/test_external.py",
+            &["tests/modbus/test_external.py"][..],
             dir.join(format!("events-{id}.csv")),
         )
     } else {
         let expected = dir.join(format!("expected-{id}.csv"));
         host::write_registers(fpu, &expected)?;
-        ("tests/modbus/test_node.py", expected)
+        host::write_other_scene(fpu, &dir.join(format!("scene-{id}.bin")))?;
+        // Commissioning after the node's registers were compared: it changes them.
+        (
+            &["tests/modbus/test_node.py", "tests/modbus/test_config.py"][..],
+            expected,
+        )
     };
     let port = free_port()?;
     let booted = boot(node.machine, &elf, port, Duration::from_secs(300), false)?;
     let status = Command::new(python)
         .current_dir(crate::root())
-        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider", tests])
+        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+        .args(tests)
         .env("MODBUS_PORT", booted.port.to_string())
         .env("MODBUS_REGISTERS", registers)
         .env("MODBUS_CORE", if fpu { "f32" } else { "fixed" })
         .env("MODBUS_EXPECTED", &file)
+        .env("MODBUS_SCENE", dir.join(format!("scene-{id}.bin")))
+        .env(
+            "MODBUS_UNLOCK_CODE",
+            misalign::modbus::DEFAULT_UNLOCK_CODE.to_string(),
+        )
+        .env(
+            "MODBUS_WRONG_CODES_MAX",
+            misalign::modbus::WRONG_CODES_MAX.to_string(),
+        )
         .env("MODBUS_SAMPLES", dir.join("samples.csv"))
         .env("MODBUS_EVENTS_OUT", &file)
         .env(
@@ -403,7 +418,7 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         .map_err(|e| format!("pytest: {e}"))?;
     drop(booted);
     if !status.success() {
-        return Err(format!("pytest {tests}: {status}"));
+        return Err(format!("pytest {}: {status}", tests.join(" ")));
     }
     if node.external {
         let compared = host::compare_events(fpu, &host::scenario(), &file)?;
@@ -514,7 +529,7 @@ mod host {
     use crate::node::{self, Core};
     use misalign::Estimator;
     use misalign::modbus::map::{Table, TableMap};
-    use misalign::modbus::{Server, ServerConfig, crc16, event_from_registers};
+    use misalign::modbus::{PreparedScene, Server, ServerConfig, crc16, event_from_registers};
     use misalign::monitor::scenario::{self, Scenario};
     use misalign::monitor::{Config, Event, Monitor, Sample};
     use misalign_cli::monitor_output::event_row;
@@ -555,10 +570,12 @@ mod host {
     /// reads of at most [`READ_MAX`] from address 0 up; `read,table,address,value`.
     /// The server counts the reads (`bus_*`), and so does the node's: the same reads
     /// in the same order leave the same counts.
-    fn dump<E: Estimator>(core: E) -> Result<String, String> {
+    fn dump<E: Estimator + PreparedScene>(core: E) -> Result<String, String> {
         let monitor = Monitor::new(core, Config::default()).map_err(|e| e.to_string())?;
         let mut server =
             Server::new(monitor, ServerConfig::default()).map_err(|e| e.to_string())?;
+        // As the node: it takes scenes over the bus (`scene_bytes`, `scene_active_crc`).
+        server.accept_scenes();
         for sample in Scenario::new() {
             server.process(sample);
         }
@@ -592,6 +609,26 @@ mod host {
             }
         }
         Ok(out)
+    }
+
+    /// A scene the node was not built with, prepared for its core (`fpu`: the f32
+    /// core's `Auto`, else `FixedAuto`), as `examples/prepare.rs --out` writes it: what
+    /// tests/modbus/test_config.py commissions with tools/commission.py.
+    pub fn write_other_scene(fpu: bool, out: &Path) -> Result<(), String> {
+        fn bytes<C: scenario::Core + PreparedScene>() -> Result<Vec<u8>, String> {
+            let scene =
+                misalign::Scene::new(0.04, 0.08, 79.3e9, 0.3, 0.25).map_err(|e| e.to_string())?;
+            let core: C = scenario::estimator_for(&scene, 5e3).map_err(|e| e.to_string())?;
+            let mut out = [0; misalign::modbus::SCENE_BYTES_MAX];
+            core.to_prepared(&mut out);
+            Ok(out[..C::BYTES].to_vec())
+        }
+        let bytes = if fpu {
+            bytes::<misalign::float::Auto>()?
+        } else {
+            bytes::<misalign::fixed::FixedAuto>()?
+        };
+        std::fs::write(out, bytes).map_err(|e| format!("{}: {e}", out.display()))
     }
 
     /// The expected registers of the node on its own samples (`fpu`: the f32 core).

@@ -105,6 +105,8 @@ fn main() -> ! {
         let clock = serve::LineClock {
             ticks: || embassy_time::Instant::now().as_micros() as u32,
             silence: misalign::modbus::silence_us(BAUD),
+            // Microseconds.
+            per_ms: 1000,
         };
         serve::node(core, serve::MODEL_FIXED, &mut line, clock)
     });

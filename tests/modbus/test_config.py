@@ -1,0 +1,165 @@
+"""Commissioning over the bus, through pymodbus: the staged and active views, the
+unlock and wrong codes, a commit and a refused one with its reason, a scene that is
+not one, and last a burst of wrong codes that locks the node out.
+
+Run after test_node.py (whose first test must see the node untouched). The
+environment adds MODBUS_UNLOCK_CODE (the node's code, the library's default) and
+MODBUS_WRONG_CODES_MAX.
+"""
+
+import os
+import struct
+import subprocess
+import sys
+import time
+
+from conftest import UNIT, read_table, register_map, words
+
+ILLEGAL_FUNCTION, ILLEGAL_DATA_VALUE = 1, 3
+
+
+def code():
+    return int(os.environ["MODBUS_UNLOCK_CODE"])
+
+
+def holding():
+    return {r["name"]: r for r in register_map() if r["table"] == "holding"}
+
+
+def get(client, name):
+    r = holding()[name]
+    values = read_table(client, "holding", r["address"], words(r))
+    return values[0] << 16 | values[1] if len(values) == 2 else values[0]
+
+
+def write(client, name, value):
+    """Writes a holding value (u16 or two registers, high word first); the answer."""
+    r = holding()[name]
+    if words(r) == 2:
+        return client.write_registers(r["address"], [value >> 16, value & 0xFFFF], device_id=UNIT)
+    return client.write_register(r["address"], value, device_id=UNIT)
+
+
+def refused(answer, code):
+    assert answer.isError(), answer
+    assert answer.exception_code == code, answer
+
+
+def f32(x):
+    return struct.unpack(">I", struct.pack(">f", x))[0]
+
+
+def view(client, prefix):
+    start = holding()[f"{prefix}_thresholds_on"]["address"]
+    return read_table(client, "holding", start, 64)
+
+
+def test_staged_and_active_views_agree_and_writes_need_the_code(client):
+    assert view(client, "config") == view(client, "active")
+    assert get(client, "config_source") == 0
+    assert get(client, "unlock") == 0
+    before = get(client, "refused_writes")
+    refused(write(client, "config_warning", f32(0.7)), ILLEGAL_FUNCTION)
+    refused(write(client, "command", 1), ILLEGAL_FUNCTION)
+    assert get(client, "refused_writes") == before + 2
+    assert get(client, "staged") == 0
+
+
+def test_a_wrong_code_is_refused_and_counted(client):
+    before = get(client, "unlock_failures")
+    refused(write(client, "unlock", (code() + 1) & 0xFFFF), ILLEGAL_DATA_VALUE)
+    assert get(client, "unlock_failures") == before + 1
+    assert not write(client, "unlock", code()).isError()
+    assert get(client, "unlock") > 0
+
+
+def test_a_commit_applies_the_staged_copy(client):
+    assert not write(client, "unlock", code()).isError()
+    assert not write(client, "config_on_delay", 7000).isError()
+    assert get(client, "config_on_delay") == 7000
+    assert get(client, "active_on_delay") != 7000
+    assert get(client, "staged") == 1
+    assert not write(client, "command", 1).isError()
+    assert get(client, "active_on_delay") == 7000
+    assert view(client, "config") == view(client, "active")
+    assert get(client, "commit_error") == 0
+    assert get(client, "config_source") == 1
+    assert get(client, "unlock") == 0
+
+
+def test_a_refused_commit_says_why_and_changes_nothing(client):
+    assert not write(client, "unlock", code()).isError()
+    active = view(client, "active")
+    alarm = struct.unpack(">f", struct.pack(">I", get(client, "active_alarm")))[0]
+    assert not write(client, "config_warning", f32(alarm + 1.0)).isError()
+    refused(write(client, "command", 1), ILLEGAL_DATA_VALUE)
+    assert get(client, "commit_error") == 0x11  # the warning not before the alarm
+    assert view(client, "active") == active
+    assert not write(client, "command", 2).isError()  # revert
+    assert view(client, "config") == active
+    # Nothing staged.
+    refused(write(client, "command", 1), ILLEGAL_DATA_VALUE)
+    assert get(client, "commit_error") == 1
+    # A switch outside its domain, at the write.
+    refused(write(client, "config_thresholds_on", 2), ILLEGAL_DATA_VALUE)
+
+
+def test_bytes_that_are_not_a_scene_are_refused(client):
+    assert not write(client, "unlock", code()).isError()
+    n = get(client, "scene_bytes")
+    assert n > 0
+    active_crc = get(client, "scene_active_crc")
+    start = next(r["address"] for r in register_map() if r["name"] == "scene_0_word")
+    assert not client.write_registers(start, [0] * ((n + 1) // 2), device_id=UNIT).isError()
+    assert get(client, "staged") == 2
+    refused(write(client, "command", 1), ILLEGAL_DATA_VALUE)
+    assert get(client, "commit_error") == 0x21  # not a prepared scene (magic)
+    assert get(client, "scene_active_crc") == active_crc
+    assert not write(client, "command", 2).isError()
+    assert not write(client, "command", 3).isError()  # lock
+    assert get(client, "unlock") == 0
+
+
+def commission(client, *args):
+    """Runs tools/commission.py against the node (the pymodbus client steps aside:
+    QEMU's serial socket takes one client at a time); its exit status and stderr."""
+    client.close()
+    time.sleep(0.1)
+    done = subprocess.run(
+        [sys.executable, "tools/commission.py", "--port", os.environ["MODBUS_PORT"],
+         "--registers", os.environ["MODBUS_REGISTERS"], *args],
+        capture_output=True, text=True, timeout=60)
+    time.sleep(0.1)
+    assert client.connect()
+    return done.returncode, done.stderr
+
+
+def test_the_commissioning_tool_writes_a_scene_the_node_was_not_built_with(client):
+    scene = open(os.environ["MODBUS_SCENE"], "rb").read()
+    crc = int.from_bytes(scene[-4:], "little")
+    assert get(client, "scene_active_crc") != crc
+    status, err = commission(client, "--code", str((code() + 1) & 0xFFFF), "--scene", os.environ["MODBUS_SCENE"])
+    assert status == 1 and "wrong code" in err, err
+    status, err = commission(client, "--code", str(code()), "--set", "config_warning=2.5")
+    assert status == 1 and "commit refused" in err and "0x11" in err, err
+    assert get(client, "staged") == 0 and get(client, "unlock") == 0  # reverted and locked
+    status, err = commission(client, "--code", str(code()), "--scene", os.environ["MODBUS_SCENE"],
+                             "--set", "config_off_delay=45000", "--set", "config_alarm=1.1")
+    assert status == 0, err
+    assert get(client, "scene_active_crc") == crc
+    assert get(client, "active_off_delay") == 45000
+    assert get(client, "active_alarm") == f32(1.1)
+    assert get(client, "config_source") == 1
+
+
+# Last: the lock-out lasts minutes of the node's time.
+def test_a_burst_of_wrong_codes_locks_out(client):
+    wrong = (code() + 1) & 0xFFFF
+    lockouts_before = get(client, "lockout")
+    assert lockouts_before == 0
+    for _ in range(int(os.environ["MODBUS_WRONG_CODES_MAX"])):
+        refused(write(client, "unlock", wrong), ILLEGAL_DATA_VALUE)
+    assert get(client, "lockout") > 0
+    refused(write(client, "unlock", code()), ILLEGAL_FUNCTION)
+    refused(write(client, "config_warning", f32(0.5)), ILLEGAL_FUNCTION)
+    assert get(client, "unlock") == 0
