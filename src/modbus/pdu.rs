@@ -3,7 +3,7 @@
 //! exceptions, broadcasts.
 
 use super::exception::Exception;
-use super::map::{Access, Block, Field, Located, Table, TableMap};
+use super::map::{Access, Field, Located, Served, SlotBlock, Table};
 use super::{ADU_MAX, Core, crc, ident};
 use crate::Estimator;
 
@@ -31,8 +31,8 @@ fn head(pdu: &[u8]) -> Result<(u16, u16), Exception> {
 }
 
 /// Whether `start..start + quantity` lies in `map`.
-fn in_map(map: &TableMap, start: u16, quantity: u16) -> Result<(), Exception> {
-    if u32::from(start) + u32::from(quantity) <= u32::from(map.end()) {
+fn in_map(map: &Served, start: u16, quantity: u16) -> Result<(), Exception> {
+    if u32::from(start) + u32::from(quantity) <= u32::from(map.end) {
         Ok(())
     } else {
         Err(Exception::IllegalDataAddress)
@@ -172,7 +172,7 @@ impl<E: Estimator> Core<E> {
         if quantity == 0 || quantity > READ_BITS_MAX {
             return Err(Exception::IllegalDataValue);
         }
-        let map = TableMap::of(table_of(function));
+        let map = Served::of(table_of(function));
         in_map(map, start, quantity)?;
         // At most 2000 bits: 250 bytes, from response[3].
         let bytes = usize::from(quantity.div_ceil(8)).min(250);
@@ -199,7 +199,7 @@ impl<E: Estimator> Core<E> {
         if quantity == 0 || quantity > READ_REGISTERS_MAX {
             return Err(Exception::IllegalDataValue);
         }
-        let map = TableMap::of(table_of(function));
+        let map = Served::of(table_of(function));
         in_map(map, start, quantity)?;
         // At most 125 registers: 250 bytes, from response[3].
         let bytes = 2 * quantity.min(125) as u8;
@@ -232,7 +232,7 @@ impl<E: Estimator> Core<E> {
     #[inline(always)]
     fn fill<const ZERO_BLOCKS: bool>(
         &mut self,
-        map: &TableMap,
+        map: &Served,
         start: u16,
         out: &mut Words,
         value: impl Fn(&Self, Field, u16) -> u32,
@@ -294,7 +294,7 @@ impl<E: Estimator> Core<E> {
     }
 
     /// The coil at `address`, if a master may write it.
-    fn writable(map: &TableMap, address: u16) -> Result<Located, Exception> {
+    fn writable(map: &Served, address: u16) -> Result<Located, Exception> {
         match map.locate(address) {
             Some(l) if l.entry.access == Access::Rw => Ok(l),
             _ => Err(Exception::IllegalDataAddress),
@@ -308,7 +308,7 @@ impl<E: Estimator> Core<E> {
             0x0000 => false,
             _ => return Err(Exception::IllegalDataValue),
         };
-        let l = Self::writable(TableMap::of(Table::Coil), address)?;
+        let l = Self::writable(Served::of(Table::Coil), address)?;
         self.write_bit(l.entry.field, on);
         self.echo(pdu)
     }
@@ -321,7 +321,7 @@ impl<E: Estimator> Core<E> {
         if quantity == 0 || quantity > WRITE_BITS_MAX || declared != bytes || data.len() != bytes {
             return Err(Exception::IllegalDataValue);
         }
-        let map = TableMap::of(Table::Coil);
+        let map = Served::of(Table::Coil);
         in_map(map, start, quantity)?;
         for i in 0..quantity {
             Self::writable(map, start.wrapping_add(i))?;
@@ -338,7 +338,7 @@ impl<E: Estimator> Core<E> {
 
     fn write_register(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
         let (address, value) = head(pdu)?;
-        let l = Self::writable(TableMap::of(Table::Holding), address)?;
+        let l = Self::writable(Served::of(Table::Holding), address)?;
         if l.entry.ty.words() != 1 || matches!(l.entry.field, Field::Sample(_)) {
             // Half of a 32-bit value, or part of a sample record.
             return Err(Exception::IllegalDataAddress);
@@ -360,10 +360,10 @@ impl<E: Estimator> Core<E> {
         {
             return Err(Exception::IllegalDataValue);
         }
-        let map = TableMap::of(Table::Holding);
+        let map = Served::of(Table::Holding);
         in_map(map, start, quantity)?;
         let word = |i: u16| be(data, 2 * usize::from(i)).unwrap_or(0);
-        if start >= map.entries_end() {
+        if start >= map.entries_end {
             let block = map
                 .blocks
                 .iter()
@@ -376,7 +376,7 @@ impl<E: Estimator> Core<E> {
         // Single entries only, each whole and writable: checked, then written.
         // Inside the map (checked above): no u16 below wraps.
         let end = start.wrapping_add(quantity);
-        if end > map.entries_end() {
+        if end > map.entries_end {
             return Err(Exception::IllegalDataAddress);
         }
         for pass in [false, true] {
@@ -408,7 +408,7 @@ impl<E: Estimator> Core<E> {
     /// order. A refused write processes none and is counted.
     fn write_samples(
         &mut self,
-        block: &Block,
+        block: &SlotBlock,
         start: u16,
         quantity: u16,
         data: &[u8],
@@ -433,7 +433,7 @@ impl<E: Estimator> Core<E> {
     /// The number of whole records of a write to `block`, or why it is refused.
     fn check_samples(
         &self,
-        block: &Block,
+        block: &SlotBlock,
         start: u16,
         quantity: u16,
         data: &[u8],
