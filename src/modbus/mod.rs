@@ -236,25 +236,25 @@ impl<E: Estimator> Server<E> {
         } else {
             config.ident.model_name
         };
-        let mut core = Core {
-            monitor,
-            step,
-            unit: config.unit_id,
-            ident: config.ident,
-            model_name,
-            annunciator: Annunciator::new(config.latching),
-            events: EventWindow::new(from),
-            external: config.external_samples,
-            last_time_ms: 0,
-            counters: Counters::default(),
-            response: [0; ADU_MAX],
-            response_len: 0,
-        };
-        core.drain();
-        Ok(Server {
+        let mut server = Server {
             framer: Framer::new(),
-            core,
-        })
+            core: Core {
+                monitor,
+                step,
+                unit: config.unit_id,
+                ident: config.ident,
+                model_name,
+                annunciator: Annunciator::new(config.latching),
+                events: EventWindow::new(from),
+                external: config.external_samples,
+                last_time_ms: 0,
+                counters: Counters::default(),
+                response: [0; ADU_MAX],
+                response_len: 0,
+            },
+        };
+        server.core.drain();
+        Ok(server)
     }
 
     /// Takes one received byte; a request it completes is answered at once (see
