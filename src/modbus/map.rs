@@ -598,7 +598,8 @@ impl TableMap {
 pub(crate) struct Slot {
     /// The 0-based address (in a block: the offset in the record).
     pub address: u16,
-    pub ty: Type,
+    /// Registers the value takes ([`Type::words`]).
+    pub words: u16,
     pub access: Access,
     pub field: Field,
 }
@@ -607,7 +608,7 @@ impl Slot {
     const fn of(e: &Entry) -> Slot {
         Slot {
             address: e.address,
-            ty: e.ty,
+            words: e.ty.words(),
             access: e.access,
             field: e.field,
         }
@@ -615,7 +616,7 @@ impl Slot {
 
     /// The address after the value.
     pub const fn end(&self) -> u16 {
-        self.address.saturating_add(self.ty.words())
+        self.address.saturating_add(self.words)
     }
 }
 
@@ -668,7 +669,7 @@ pub(crate) struct Served {
 const fn slots<const N: usize>(entries: &[Entry]) -> [Slot; N] {
     let mut out = [Slot {
         address: 0,
-        ty: Type::U16,
+        words: 1,
         access: Access::R,
         field: Field::Acknowledge,
     }; N];
@@ -975,7 +976,7 @@ mod tests {
             let s = Served::of(table);
             for a in 0..s.end {
                 let l = s.locate(a).expect("inside the table");
-                assert!(l.word < l.entry.ty.words());
+                assert!(l.word < l.entry.words);
             }
             assert!(s.locate(s.end).is_none());
             // The walk from 0 steps through every value, as locating each does.
@@ -983,7 +984,7 @@ mod tests {
             for l in s.walk(0) {
                 let found = s.locate(at).unwrap();
                 assert_eq!((l.entry, l.record, l.word), (found.entry, found.record, 0));
-                at += l.entry.ty.words();
+                at += l.entry.words;
             }
             assert_eq!(at, t.end());
         }

@@ -220,7 +220,7 @@ pub(crate) fn sample_from_record(block: &SlotBlock, record: &[u8]) -> Option<Sam
             let b = record.get(at + 2 * i..at + 2 * i + 2)?;
             Some(u32::from(u16::from_be_bytes([b[0], b[1]])))
         };
-        let v = match e.ty.words() {
+        let v = match e.words {
             2 => word(0)? << 16 | word(1)?,
             _ => word(0)?,
         };
@@ -298,7 +298,7 @@ impl<E: Estimator> Core<E> {
 
     /// [`value`](Self::value) of the other fields.
     #[inline(never)]
-    fn value_other(&self, field: Field, record: u16) -> u32 {
+    pub(super) fn value_other(&self, field: Field, record: u16) -> u32 {
         let m = &self.monitor;
         let s = m.statistics();
         // The reading's values, copied only where one is read.
