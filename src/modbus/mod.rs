@@ -260,9 +260,15 @@ impl<E: Estimator> Server<E> {
     /// Takes one received byte; a request it completes is answered at once (see
     /// [`response`](Self::response)).
     pub fn receive(&mut self, byte: u8) {
-        if self.framer.push_waiting(byte) {
-            return;
+        if !self.framer.push_waiting(byte) {
+            self.receive_deciding(byte);
         }
+    }
+
+    /// [`receive`](Self::receive) of a byte that can decide the candidate: out of
+    /// line, so that the usual byte of a frame costs no set-up of the frame's handling.
+    #[inline(never)]
+    fn receive_deciding(&mut self, byte: u8) {
         self.framer.push(byte);
         while let Some(range) = self.framer.next(self.core.unit, false) {
             self.core.counters.framing = self.framer.counters();

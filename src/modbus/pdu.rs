@@ -89,6 +89,7 @@ impl Words {
 
 impl<E: Estimator> Core<E> {
     /// Answers one frame for this unit or a broadcast (CRC checked by the framer).
+    #[inline(never)]
     pub(super) fn handle(&mut self, frame: &[u8]) {
         let (Some(&unit), Some(pdu)) = (frame.first(), frame.get(1..frame.len().saturating_sub(2)))
         else {
