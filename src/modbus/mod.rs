@@ -260,7 +260,7 @@ impl<E: Estimator> Server<E> {
     /// Takes one received byte; a request it completes is answered at once (see
     /// [`response`](Self::response)).
     pub fn receive(&mut self, byte: u8) {
-        if !self.framer.push_waiting(byte) {
+        if !self.framer.push_waiting(byte) && !self.framer.push_request_head(byte, self.core.unit) {
             self.receive_deciding(byte);
         }
     }
