@@ -267,7 +267,7 @@ impl Framer {
             }
             let len = self.len.min(ADU_MAX);
             let start = self.start.min(len);
-            self.buf.copy_within(start..len, 0);
+            self.shift_down(start, len);
             self.overflowed |= self.consumed < start;
             self.len = len - start;
             self.consumed = self.consumed.saturating_sub(start);
@@ -276,6 +276,24 @@ impl Framer {
         if let Some(slot) = self.buf.get_mut(self.len) {
             *slot = byte;
             self.len = self.len.saturating_add(1);
+        }
+    }
+
+    /// Moves `buf[start..len]` to the buffer's start, in pieces of at most `start`
+    /// bytes, none of which overlaps its destination: a copy (memcpy, which the
+    /// image links anyway), not a move (memmove, 1.3 KB more on a Cortex-M0).
+    fn shift_down(&mut self, start: usize, len: usize) {
+        let mut at: usize = 0;
+        while start > 0 && at.saturating_add(start) < len {
+            let Some((dest, src)) = self.buf.split_at_mut_checked(at.saturating_add(start)) else {
+                return;
+            };
+            let n = start.min(len.saturating_sub(dest.len()));
+            let s = src.get(..n).unwrap_or(&[]);
+            if let Some(d) = dest.get_mut(at..).and_then(|d| d.get_mut(..s.len())) {
+                d.copy_from_slice(s);
+            }
+            at = at.saturating_add(n);
         }
     }
 
@@ -436,6 +454,23 @@ mod tests {
                 "{stream:02x?}"
             );
             assert_eq!(plain.counters(), server.counters(), "{stream:02x?}");
+        }
+    }
+
+    /// The buffer's compaction moves what `copy_within` moves, for every cut.
+    #[test]
+    fn shifting_down_is_copy_within() {
+        for len in [0, 1, 7, 128, 255, ADU_MAX] {
+            for start in 0..=len {
+                let mut f = Framer::new();
+                for (i, b) in f.buf.iter_mut().enumerate() {
+                    *b = i as u8 ^ 0x5A;
+                }
+                let mut expected = f.buf;
+                expected.copy_within(start..len, 0);
+                f.shift_down(start, len);
+                assert_eq!(f.buf, expected, "{start}..{len}");
+            }
         }
     }
 
