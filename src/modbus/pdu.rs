@@ -58,8 +58,8 @@ enum Reply {
 }
 
 /// The register words of a read being written into the response, high word first:
-/// each value whole, from byte `at`. Positions are `u8`, so that every index into the
-/// 256-byte response is in bounds without a check. A read writes its data from byte 3
+/// each value whole, from byte `at`, as one slice (one bounds check, not one index per
+/// byte). A read writes its data from byte 3
 /// to at most byte 252; a value begun before the end runs at most two bytes past it
 /// (into the CRC's place, written after), and a read that starts at the low word of a
 /// 32-bit value writes that value from byte 1 (the head's place, written after).
@@ -71,18 +71,18 @@ impl Words {
     /// Writes the `n`-word value `v` (high word first).
     #[inline(always)]
     fn put(&mut self, response: &mut [u8; ADU_MAX], v: u32, n: u16) {
-        let at = self.at;
-        let [b0, b1, b2, b3] = v.to_be_bytes();
+        let at = usize::from(self.at);
+        // At most byte 251 (see above): always in the buffer.
         if n == 2 {
-            response[usize::from(at)] = b0;
-            response[usize::from(at.wrapping_add(1))] = b1;
-            response[usize::from(at.wrapping_add(2))] = b2;
-            response[usize::from(at.wrapping_add(3))] = b3;
-            self.at = at.wrapping_add(4);
+            if let Some(bytes) = response.get_mut(at..at + 4) {
+                bytes.copy_from_slice(&v.to_be_bytes());
+            }
+            self.at = self.at.wrapping_add(4);
         } else {
-            response[usize::from(at)] = b2;
-            response[usize::from(at.wrapping_add(1))] = b3;
-            self.at = at.wrapping_add(2);
+            if let Some(bytes) = response.get_mut(at..at + 2) {
+                bytes.copy_from_slice(&(v as u16).to_be_bytes());
+            }
+            self.at = self.at.wrapping_add(2);
         }
     }
 }
