@@ -258,9 +258,10 @@ impl<E: Estimator> Core<E> {
             return;
         };
         if ZERO_BLOCKS {
-            // Inside the map (checked): the words left are the blocks'.
-            if let Some(rest) = self.response.get_mut(usize::from(out.at)..usize::from(end)) {
-                rest.fill(0);
+            // Inside the map (checked): the words left are the blocks', two at a time
+            // (the last pair may run into the CRC's place, as a 32-bit value does).
+            while out.at < end {
+                out.put(&mut self.response, 0, 2);
             }
             return;
         }
