@@ -95,6 +95,10 @@ enum Class {
 }
 
 /// The candidate at the start of `b` for unit `unit`.
+/// Out of line: most bytes, and a poll's last, are decided without it
+/// ([`Framer::push_waiting`], [`Framer::push_request_head`], a known candidate's CRC),
+/// and its set-up would otherwise be theirs.
+#[inline(never)]
 fn classify(b: &[u8], unit: u8) -> Class {
     let Some(&address) = b.first() else {
         return Class::Need(1);
