@@ -12,6 +12,10 @@
 //! code, a declared length above 256 bytes, a complete candidate with a wrong CRC)
 //! drops its first byte, and the next byte becomes the candidate. Each byte is a
 //! candidate's first byte at most once, and a candidate is checked once per length.
+//! The server takes two shortcuts that decide as the classification would: a byte that
+//! cannot decide the candidate is only appended ([`Framer::push_waiting`]), and a
+//! poll's second byte (functions 1 to 6, for this unit or a broadcast) gives its length
+//! at once ([`Framer::push_request_head`]), after which its CRC alone decides it.
 //!
 //! The silence ([`Framer::silence`]) ends whatever waits: the bytes since the last
 //! frame, whole, are a frame if their CRC holds (the specification's rule, which also
