@@ -241,7 +241,7 @@ impl Framer {
 
     /// Appends the byte after the candidate's address when the two begin a request of
     /// functions 1 to 6 for `unit` or a broadcast: a poll's second byte. Its length (8
-    /// bytes) is then known, as [`classify`] finds it, without classifying. Returns
+    /// bytes) is then known, as the classification finds it, without it. Returns
     /// whether it did; if not, call [`push`](Self::push) and [`next`](Self::next).
     #[inline]
     pub fn push_request_head(&mut self, byte: u8, unit: u8) -> bool {
