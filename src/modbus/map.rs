@@ -1,5 +1,6 @@
-//! The register map: one table in code, from which the server reads and writes and
-//! [`registers_csv`] writes `docs/modbus/registers.csv`.
+//! The register map: one table in code, which [`registers_csv`] writes as
+//! `docs/modbus/registers.csv` and from which the server reads and writes (through a
+//! copy made at compile time without the text, so that a node links none of it).
 //!
 //! Each of the four Modbus tables is a run of single entries from address 0 without a
 //! hole, then blocks of repeated records (the event window's slots, the external
@@ -764,6 +765,133 @@ pub static HOLDINGS: TableMap = TableMap {
     ],
 };
 
+/// The four tables in the CSV's order.
+pub static MAP: [&TableMap; 4] = [&COILS, &DISCRETES, &INPUTS, &HOLDINGS];
+
+impl TableMap {
+    /// The map of `table`.
+    pub fn of(table: Table) -> &'static TableMap {
+        match table {
+            Table::Coil => &COILS,
+            Table::Discrete => &DISCRETES,
+            Table::Input => &INPUTS,
+            Table::Holding => &HOLDINGS,
+        }
+    }
+
+    /// The address after the single entries.
+    pub const fn entries_end(&self) -> u16 {
+        match self.entries.last() {
+            Some(e) => e.end(),
+            None => 0,
+        }
+    }
+
+    /// The address after the table.
+    pub const fn end(&self) -> u16 {
+        match self.blocks.last() {
+            Some(b) => b.end(),
+            None => self.entries_end(),
+        }
+    }
+}
+
+// What the server reads and writes by: the tables above without their text.
+//
+// The server answers from the tables below, made from the ones above at compile time
+// and holding no `name`, `unit`, `scale` or `description`. Only `registers_csv`, run on
+// a PC, reads the tables above, so that a node's image links none of their text (about
+// 6 KB) and none of their 40-byte entries.
+
+/// An entry as the server holds it: where it is, its type, whether a master may write
+/// it, and what it holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Slot {
+    /// The 0-based address (in a block: the offset in the record).
+    pub address: u16,
+    /// Registers the value takes ([`Type::words`]).
+    pub words: u16,
+    pub access: Access,
+    pub field: Field,
+}
+
+impl Slot {
+    const fn of(e: &Entry) -> Slot {
+        Slot {
+            address: e.address,
+            words: e.ty.words(),
+            access: e.access,
+            field: e.field,
+        }
+    }
+
+    /// The address after the value.
+    pub const fn end(&self) -> u16 {
+        self.address.saturating_add(self.words)
+    }
+}
+
+/// A [`Block`] as the server holds it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SlotBlock {
+    pub address: u16,
+    pub count: u16,
+    pub stride: u16,
+    pub fields: &'static [Slot],
+}
+
+impl SlotBlock {
+    /// `b` with `fields`, which must be `b`'s fields as slots (checked at compile time).
+    const fn of(b: &Block, fields: &'static [Slot]) -> SlotBlock {
+        assert!(
+            fields.len() == b.fields.len(),
+            "a block's slots are its fields"
+        );
+        SlotBlock {
+            address: b.address,
+            count: b.count,
+            stride: b.stride,
+            fields,
+        }
+    }
+
+    /// The address after the block.
+    pub const fn end(&self) -> u16 {
+        self.address
+            .saturating_add(self.count.saturating_mul(self.stride))
+    }
+}
+
+/// A [`TableMap`] as the server holds it, with the index of its single entries by
+/// address and its ends.
+#[derive(Debug)]
+pub(crate) struct Served {
+    pub entries: &'static [Slot],
+    pub blocks: &'static [SlotBlock],
+    /// The single entries' index by address.
+    index: &'static [u8],
+    /// The address after the single entries.
+    pub entries_end: u16,
+    /// The address after the table.
+    pub end: u16,
+}
+
+/// The entries of a table as slots.
+const fn slots<const N: usize>(entries: &[Entry]) -> [Slot; N] {
+    let mut out = [Slot {
+        address: 0,
+        words: 1,
+        access: Access::R,
+        field: Field::Acknowledge,
+    }; N];
+    let mut i = 0;
+    while i < N {
+        out[i] = Slot::of(&entries[i]);
+        i += 1;
+    }
+    out
+}
+
 /// The index of the single entry that holds each address of `entries` (sorted,
 /// without a hole from 0), formed at compile time: a read finds its first value by one
 /// load, not a search.
@@ -783,72 +911,81 @@ const fn index<const N: usize>(entries: &[Entry]) -> [u8; N] {
     out
 }
 
-/// The address after the last of `entries`.
-const fn entries_end(entries: &[Entry]) -> usize {
-    match entries.last() {
-        Some(e) => e.end() as usize,
-        None => 0,
-    }
+/// `map`'s ends: its blocks must be `blocks` (checked at compile time).
+const fn ends(map: &TableMap, blocks: &[SlotBlock]) -> (u16, u16) {
+    assert!(
+        blocks.len() == map.blocks.len(),
+        "a table's served blocks are its blocks"
+    );
+    (map.entries_end(), map.end())
 }
 
-static COIL_INDEX: [u8; entries_end(COILS.entries)] = index(COILS.entries);
-static DISCRETE_INDEX: [u8; entries_end(DISCRETES.entries)] = index(DISCRETES.entries);
-static INPUT_INDEX: [u8; entries_end(INPUTS.entries)] = index(INPUTS.entries);
-static HOLDING_INDEX: [u8; entries_end(HOLDINGS.entries)] = index(HOLDINGS.entries);
+static SAMPLE_SLOTS: [Slot; SAMPLE_FIELDS.len()] = slots(&SAMPLE_FIELDS);
+static SAMPLE_FULL_SLOTS: [Slot; SAMPLE_FULL_FIELDS.len()] = slots(&SAMPLE_FULL_FIELDS);
+static EVENT_FIELD_SLOTS: [Slot; EVENT_FIELDS.len()] = slots(&EVENT_FIELDS);
+static SCENE_SLOTS: [Slot; SCENE_FIELDS.len()] = slots(&SCENE_FIELDS);
 
-/// The four tables in the CSV's order.
-pub static MAP: [&TableMap; 4] = [&COILS, &DISCRETES, &INPUTS, &HOLDINGS];
+/// One table as the server holds it: `$map`'s entries as slots, its index, its blocks
+/// with their fields' slots.
+macro_rules! served {
+    ($map:ident, [$($block:expr),*]) => {{
+        const N: usize = $map.entries.len();
+        static ENTRIES: [Slot; N] = slots($map.entries);
+        static INDEX: [u8; $map.entries_end() as usize] = index($map.entries);
+        const BLOCKS: &[SlotBlock] = &[$($block),*];
+        const ENDS: (u16, u16) = ends(&$map, BLOCKS);
+        Served {
+            entries: &ENTRIES,
+            blocks: BLOCKS,
+            index: &INDEX,
+            entries_end: ENDS.0,
+            end: ENDS.1,
+        }
+    }};
+}
 
-impl TableMap {
-    /// The map of `table`.
-    pub fn of(table: Table) -> &'static TableMap {
+static COILS_SERVED: Served = served!(COILS, []);
+static DISCRETES_SERVED: Served = served!(DISCRETES, []);
+static INPUTS_SERVED: Served = served!(
+    INPUTS,
+    [SlotBlock::of(&INPUTS.blocks[0], &EVENT_FIELD_SLOTS)]
+);
+static HOLDINGS_SERVED: Served = served!(
+    HOLDINGS,
+    [
+        SlotBlock::of(&HOLDINGS.blocks[0], &SAMPLE_SLOTS),
+        SlotBlock::of(&HOLDINGS.blocks[1], &SAMPLE_FULL_SLOTS),
+        SlotBlock::of(&HOLDINGS.blocks[2], &SCENE_SLOTS)
+    ]
+);
+
+impl Served {
+    /// The served map of `table`.
+    pub(crate) fn of(table: Table) -> &'static Served {
         match table {
-            Table::Coil => &COILS,
-            Table::Discrete => &DISCRETES,
-            Table::Input => &INPUTS,
-            Table::Holding => &HOLDINGS,
+            Table::Coil => &COILS_SERVED,
+            Table::Discrete => &DISCRETES_SERVED,
+            Table::Input => &INPUTS_SERVED,
+            Table::Holding => &HOLDINGS_SERVED,
         }
     }
 
     /// The single entry that holds `address` (its index) and the word of it, if a
     /// single entry does.
     pub(crate) fn single(&self, address: u16) -> Option<(usize, u16)> {
-        let i = usize::from(*self.index().get(usize::from(address))?);
+        let i = usize::from(*self.index.get(usize::from(address))?);
         let entry = self.entries.get(i)?;
         Some((i, address.checked_sub(entry.address)?))
-    }
-
-    /// The single entries' index by address.
-    fn index(&self) -> &'static [u8] {
-        match self.entries.first().map(|e| e.table) {
-            Some(Table::Coil) => &COIL_INDEX,
-            Some(Table::Discrete) => &DISCRETE_INDEX,
-            Some(Table::Input) => &INPUT_INDEX,
-            Some(Table::Holding) => &HOLDING_INDEX,
-            None => &[],
-        }
-    }
-
-    /// The address after the single entries.
-    pub fn entries_end(&self) -> u16 {
-        self.entries.last().map_or(0, Entry::end)
-    }
-
-    /// The address after the table.
-    pub fn end(&self) -> u16 {
-        self.blocks.last().map_or(self.entries_end(), Block::end)
     }
 
     /// The entry that holds `address`: the entry, the record's index (0 for a single
     /// entry), and the register's word within the value (0 high, 1 low).
     pub(crate) fn locate(&self, address: u16) -> Option<Located> {
-        if address < self.entries_end() {
-            let index = usize::from(*self.index().get(usize::from(address))?);
-            let entry = self.entries.get(index)?;
+        if let Some((index, word)) = self.single(address) {
             return Some(Located {
-                entry,
+                entry: self.entries.get(index)?,
                 record: 0,
-                word: address.checked_sub(entry.address)?,
+                word,
                 block: None,
                 index,
             });
@@ -926,7 +1063,7 @@ impl TableMap {
 /// An address located in the map.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Located {
-    pub entry: &'static Entry,
+    pub entry: &'static Slot,
     pub record: u16,
     pub word: u16,
     /// The block's index in the table, `None` for a single entry.
@@ -1025,29 +1162,56 @@ mod tests {
         }
     }
 
+    /// The served tables are the documented ones, slot for slot.
+    #[test]
+    fn served_tables_are_the_maps() {
+        for (table, t) in [Table::Coil, Table::Discrete, Table::Input, Table::Holding]
+            .into_iter()
+            .zip(MAP)
+        {
+            let s = Served::of(table);
+            let slots: std::vec::Vec<Slot> = t.entries.iter().map(Slot::of).collect();
+            assert_eq!(s.entries, &slots[..]);
+            assert_eq!((s.entries_end, s.end), (t.entries_end(), t.end()));
+            assert_eq!(s.blocks.len(), t.blocks.len());
+            for (sb, b) in s.blocks.iter().zip(t.blocks) {
+                assert_eq!(
+                    (sb.address, sb.count, sb.stride),
+                    (b.address, b.count, b.stride)
+                );
+                let slots: std::vec::Vec<Slot> = b.fields.iter().map(Slot::of).collect();
+                assert_eq!(sb.fields, &slots[..], "{}", b.prefix);
+            }
+        }
+    }
+
     #[test]
     fn every_address_locates_its_entry() {
-        for t in MAP {
-            for a in 0..t.end() {
-                let l = t.locate(a).expect("inside the table");
-                assert!(l.word < l.entry.ty.words());
+        for (table, t) in [Table::Coil, Table::Discrete, Table::Input, Table::Holding]
+            .into_iter()
+            .zip(MAP)
+        {
+            let s = Served::of(table);
+            for a in 0..s.end {
+                let l = s.locate(a).expect("inside the table");
+                assert!(l.word < l.entry.words);
             }
-            assert!(t.locate(t.end()).is_none());
+            assert!(s.locate(s.end).is_none());
             // The walk from 0 steps through every value, as locating each does.
             let mut at = 0;
-            for l in t.walk(0) {
-                let found = t.locate(at).unwrap();
-                assert_eq!(
-                    (l.entry.name, l.record, l.word),
-                    (found.entry.name, found.record, 0)
-                );
-                at += l.entry.ty.words();
+            for l in s.walk(0) {
+                let found = s.locate(at).unwrap();
+                assert_eq!((l.entry, l.record, l.word), (found.entry, found.record, 0));
+                at += l.entry.words;
             }
             assert_eq!(at, t.end());
         }
-        let l = INPUTS
+        let l = Served::of(Table::Input)
             .locate(EVENT_SLOTS_ADDRESS + EVENT_STRIDE + 12)
             .unwrap();
-        assert_eq!((l.entry.name, l.record, l.word), ("value", 1, 1));
+        assert_eq!(
+            (l.entry.field, l.record, l.word),
+            (Field::Event(EventField::Value), 1, 1)
+        );
     }
 }

@@ -271,36 +271,42 @@ impl<E: Estimator> Server<E> {
         } else {
             config.ident.model_name
         };
-        let mut core = Core {
-            commissioning: Commissioning::new(config.unlock_code),
-            monitor,
-            step,
-            unit: config.unit_id,
-            ident: config.ident,
-            model_name,
-            annunciator: Annunciator::new(config.latching),
-            events: EventWindow::new(from),
-            external: config.external_samples,
-            last_time_ms: 0,
-            counters: Counters::default(),
-            ack: None,
-            storage: StorageStatus::default(),
-            response: [0; ADU_MAX],
-            response_len: 0,
-        };
-        core.drain();
-        Ok(Server {
+        let mut server = Server {
             framer: Framer::new(),
-            core,
-        })
+            core: Core {
+                commissioning: Commissioning::new(config.unlock_code),
+                monitor,
+                step,
+                unit: config.unit_id,
+                ident: config.ident,
+                model_name,
+                annunciator: Annunciator::new(config.latching),
+                events: EventWindow::new(from),
+                external: config.external_samples,
+                last_time_ms: 0,
+                counters: Counters::default(),
+                ack: None,
+                storage: StorageStatus::default(),
+                response: [0; ADU_MAX],
+                response_len: 0,
+            },
+        };
+        server.core.drain();
+        Ok(server)
     }
 
     /// Takes one received byte; a request it completes is answered at once (see
     /// [`response`](Self::response)).
     pub fn receive(&mut self, byte: u8) {
-        if self.framer.push_waiting(byte) {
-            return;
+        if !self.framer.push_waiting(byte) && !self.framer.push_request_head(byte, self.core.unit) {
+            self.receive_deciding(byte);
         }
+    }
+
+    /// [`receive`](Self::receive) of a byte that can decide the candidate: out of
+    /// line, so that the usual byte of a frame costs no set-up of the frame's handling.
+    #[inline(never)]
+    fn receive_deciding(&mut self, byte: u8) {
         self.framer.push(byte);
         while let Some(range) = self.framer.next(self.core.unit, false) {
             self.core.counters.framing = self.framer.counters();

@@ -4,7 +4,7 @@
 
 use super::config::{ConfigField, Reg};
 use super::exception::Exception;
-use super::map::{Access, Block, Field, Located, Table, TableMap};
+use super::map::{Access, Field, Located, Served, SlotBlock, Table};
 use super::{ADU_MAX, Core, crc, ident};
 use crate::Estimator;
 
@@ -32,8 +32,8 @@ fn head(pdu: &[u8]) -> Result<(u16, u16), Exception> {
 }
 
 /// Whether `start..start + quantity` lies in `map`.
-fn in_map(map: &TableMap, start: u16, quantity: u16) -> Result<(), Exception> {
-    if u32::from(start) + u32::from(quantity) <= u32::from(map.end()) {
+fn in_map(map: &Served, start: u16, quantity: u16) -> Result<(), Exception> {
+    if u32::from(start) + u32::from(quantity) <= u32::from(map.end) {
         Ok(())
     } else {
         Err(Exception::IllegalDataAddress)
@@ -58,34 +58,31 @@ enum Reply {
     Adu(usize),
 }
 
-/// The register words of a read being written: the next byte, the end, the CRC of
-/// what is written so far. Positions are `u8`: every index into the 256-byte response
-/// is in bounds without a check.
+/// The register words of a read being written into the response, high word first:
+/// each value whole, from byte `at`, as one slice (one bounds check, not one index per
+/// byte). A read writes its data from byte 3
+/// to at most byte 252; a value begun before the end runs at most two bytes past it
+/// (into the CRC's place, written after), and a read that starts at the low word of a
+/// 32-bit value writes that value from byte 1 (the head's place, written after).
 struct Words {
     at: u8,
-    end: u8,
-    crc: u16,
 }
 
 impl Words {
-    /// Writes the words `from..n` of the `n`-word value `v` (high word first) while
-    /// below `end`.
+    /// Writes the `n`-word value `v` (high word first).
     #[inline(always)]
-    fn put(&mut self, response: &mut [u8; ADU_MAX], v: u32, n: u16, from: u16) {
-        if n == 2 && from == 0 {
-            self.word(response, (v >> 16) as u16);
-        }
-        self.word(response, v as u16);
-    }
-
-    /// Writes `word` (big-endian) while below `end`, into the CRC as it is written.
-    #[inline(always)]
-    fn word(&mut self, response: &mut [u8; ADU_MAX], word: u16) {
-        if self.at < self.end {
-            let [hi, lo] = word.to_be_bytes();
-            response[usize::from(self.at)] = hi;
-            response[usize::from(self.at.wrapping_add(1))] = lo;
-            self.crc = crc::word(self.crc, word);
+    fn put(&mut self, response: &mut [u8; ADU_MAX], v: u32, n: u16) {
+        let at = usize::from(self.at);
+        // At most byte 251 (see above): always in the buffer.
+        if n == 2 {
+            if let Some(bytes) = response.get_mut(at..at + 4) {
+                bytes.copy_from_slice(&v.to_be_bytes());
+            }
+            self.at = self.at.wrapping_add(4);
+        } else {
+            if let Some(bytes) = response.get_mut(at..at + 2) {
+                bytes.copy_from_slice(&(v as u16).to_be_bytes());
+            }
             self.at = self.at.wrapping_add(2);
         }
     }
@@ -93,6 +90,7 @@ impl Words {
 
 impl<E: Estimator> Core<E> {
     /// Answers one frame for this unit or a broadcast (CRC checked by the framer).
+    #[inline(never)]
     pub(super) fn handle(&mut self, frame: &[u8]) {
         let (Some(&unit), Some(pdu)) = (frame.first(), frame.get(1..frame.len().saturating_sub(2)))
         else {
@@ -173,7 +171,7 @@ impl<E: Estimator> Core<E> {
         if quantity == 0 || quantity > READ_BITS_MAX {
             return Err(Exception::IllegalDataValue);
         }
-        let map = TableMap::of(table_of(function));
+        let map = Served::of(table_of(function));
         in_map(map, start, quantity)?;
         // At most 2000 bits: 250 bytes, from response[3].
         let bytes = usize::from(quantity.div_ceil(8)).min(250);
@@ -193,88 +191,90 @@ impl<E: Estimator> Core<E> {
         Ok(2 + bytes)
     }
 
-    /// The whole answer to a read of registers (the unit, the PDU, the CRC computed as
-    /// the words are written); its length.
+    /// The whole answer to a read of registers (the unit, the PDU, the CRC); its
+    /// length.
     fn read_registers(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
         let (start, quantity) = head(pdu)?;
         if quantity == 0 || quantity > READ_REGISTERS_MAX {
             return Err(Exception::IllegalDataValue);
         }
-        let map = TableMap::of(table_of(function));
+        let map = Served::of(table_of(function));
         in_map(map, start, quantity)?;
         // At most 125 registers: 250 bytes, from response[3].
         let bytes = 2 * quantity.min(125) as u8;
-        let head = [self.unit, function, bytes];
-        self.response[..3].copy_from_slice(&head);
-        let mut out = Words {
-            at: 3,
-            end: 3 + bytes,
-            crc: head.iter().fold(crc::INIT, |c, &b| crc::step(c, b)),
-        };
+        let end = 3 + bytes;
         // Each table's values from a function of its own (small enough to inline).
         if function == 3 {
-            self.fill::<true>(map, start, &mut out, Self::value_holding);
+            self.fill::<true>(map, start, end, Self::value_holding);
         } else {
-            self.fill::<false>(map, start, &mut out, Self::value);
+            self.fill::<false>(map, start, end, Self::value);
         }
+        // After the values: the first may have begun in the head's place.
+        self.response[..3].copy_from_slice(&[self.unit, function, bytes]);
+        let body = self.response.get(..usize::from(end)).unwrap_or(&[]);
+        let [lo, hi] = crc::crc16(body).to_le_bytes();
         // At most 253 bytes written: the CRC's two fit.
-        let Words { at, crc, .. } = out;
-        let [lo, hi] = crc.to_le_bytes();
-        self.response[usize::from(at)] = lo;
-        self.response[usize::from(at.wrapping_add(1))] = hi;
-        Ok(usize::from(at) + 2)
+        self.response[usize::from(end)] = lo;
+        self.response[usize::from(end.wrapping_add(1))] = hi;
+        Ok(usize::from(end) + 2)
     }
 
-    /// The words of `map` from `start` into the response until `out.end`, each value
-    /// computed once by `value`: inside the map (checked), from the word that holds
-    /// `start`; the single entries one after the other, the blocks' records field by
-    /// field. `ZERO_BLOCKS`: every word of the blocks reads 0 (the holding blocks are
-    /// the external samples, which are written, not read back), written as such.
+    /// The words of `map` from `start` into the response from byte 3 until byte
+    /// `end`, each value computed once by `value` and written whole (see [`Words`]):
+    /// inside the map (checked), from the value that holds `start`; the single
+    /// entries one after the other, the blocks' records field by field.
+    /// `ZERO_BLOCKS`: every word of the blocks reads 0 (the holding blocks are the
+    /// external samples, which are written, not read back), written as such.
     #[inline(always)]
     fn fill<const ZERO_BLOCKS: bool>(
         &mut self,
-        map: &TableMap,
+        map: &Served,
         start: u16,
-        out: &mut Words,
+        end: u8,
         value: impl Fn(&Self, Field, u16) -> u32,
     ) {
         // Where the blocks' part starts: the first block's first record when the
         // single entries lead into it.
         let mut from = None;
-        if let Some((mut i, mut word)) = map.single(start) {
-            while out.at < out.end {
+        let mut out = Words { at: 3 };
+        if let Some((mut i, word)) = map.single(start) {
+            // A read from a value's low word: the value from the byte before.
+            out.at = 3 - 2 * (word as u8 & 1);
+            while out.at < end {
                 let Some(e) = map.entries.get(i) else {
-                    from = Some((0, 0, 0, 0));
+                    from = Some((0, 0, 0));
                     break;
                 };
                 let v = value(self, e.field, 0);
-                out.put(&mut self.response, v, e.ty.words(), word);
-                (i, word) = (i + 1, 0);
+                out.put(&mut self.response, v, e.words);
+                i += 1;
             }
         } else if let Some(l) = map.locate(start)
             && let Some(b) = l.block
         {
-            from = Some((b, l.record, l.index, l.word));
+            out.at = 3 - 2 * (l.word as u8 & 1);
+            from = Some((b, l.record, l.index));
         }
-        let Some((mut b, mut record, mut i, mut word)) = from else {
+        let Some((mut b, mut record, mut i)) = from else {
             return;
         };
         if ZERO_BLOCKS {
-            // Inside the map (checked): the words left are the blocks'.
-            while out.at < out.end {
-                out.word(&mut self.response, 0);
+            // Inside the map (checked): the words left are the blocks', two at a time
+            // (the last pair may run into the CRC's place, as a 32-bit value does).
+            while out.at < end {
+                out.put(&mut self.response, 0, 2);
             }
             return;
         }
         'blocks: while let Some(block) = map.blocks.get(b) {
             while record < block.count {
                 while let Some(e) = block.fields.get(i) {
-                    if out.at >= out.end {
+                    if out.at >= end {
                         break 'blocks;
                     }
                     let v = value(self, e.field, record);
-                    out.put(&mut self.response, v, e.ty.words(), word);
-                    (i, word) = (i + 1, 0);
+                    out.put(&mut self.response, v, e.words);
+                    i += 1;
                 }
                 (record, i) = (record + 1, 0);
             }
@@ -295,7 +295,7 @@ impl<E: Estimator> Core<E> {
     }
 
     /// The coil at `address`, if a master may write it.
-    fn writable(map: &TableMap, address: u16) -> Result<Located, Exception> {
+    fn writable(map: &Served, address: u16) -> Result<Located, Exception> {
         match map.locate(address) {
             Some(l) if l.entry.access == Access::Rw => Ok(l),
             _ => Err(Exception::IllegalDataAddress),
@@ -309,7 +309,7 @@ impl<E: Estimator> Core<E> {
             0x0000 => false,
             _ => return Err(Exception::IllegalDataValue),
         };
-        let l = Self::writable(TableMap::of(Table::Coil), address)?;
+        let l = Self::writable(Served::of(Table::Coil), address)?;
         self.write_bit(l.entry.field, on);
         self.echo(pdu)
     }
@@ -322,7 +322,7 @@ impl<E: Estimator> Core<E> {
         if quantity == 0 || quantity > WRITE_BITS_MAX || declared != bytes || data.len() != bytes {
             return Err(Exception::IllegalDataValue);
         }
-        let map = TableMap::of(Table::Coil);
+        let map = Served::of(Table::Coil);
         in_map(map, start, quantity)?;
         for i in 0..quantity {
             Self::writable(map, start.wrapping_add(i))?;
@@ -339,14 +339,14 @@ impl<E: Estimator> Core<E> {
 
     fn write_register(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
         let (address, value) = head(pdu)?;
-        let l = Self::writable(TableMap::of(Table::Holding), address)?;
+        let l = Self::writable(Served::of(Table::Holding), address)?;
         if l.entry.field == Field::Commission(Reg::Scene) {
             let data = pdu.get(3..5).unwrap_or(&[]);
             return self
                 .write_scene(address, data)
                 .and_then(|()| self.echo(pdu));
         }
-        if l.entry.ty.words() != 1 || matches!(l.entry.field, Field::Sample(_)) {
+        if l.entry.words != 1 || matches!(l.entry.field, Field::Sample(_)) {
             // Half of a 32-bit value, or part of a sample record.
             return Err(Exception::IllegalDataAddress);
         }
@@ -367,10 +367,10 @@ impl<E: Estimator> Core<E> {
         {
             return Err(Exception::IllegalDataValue);
         }
-        let map = TableMap::of(Table::Holding);
+        let map = Served::of(Table::Holding);
         in_map(map, start, quantity)?;
         let word = |i: u16| be(data, 2 * usize::from(i)).unwrap_or(0);
-        if start >= map.entries_end() {
+        if start >= map.entries_end {
             let block = map
                 .blocks
                 .iter()
@@ -386,14 +386,14 @@ impl<E: Estimator> Core<E> {
         // Single entries only, each whole and writable: checked, then written.
         // Inside the map (checked above): no u16 below wraps.
         let end = start.wrapping_add(quantity);
-        if end > map.entries_end() {
+        if end > map.entries_end {
             return Err(Exception::IllegalDataAddress);
         }
         for pass in [false, true] {
             let mut a = start;
             while a < end {
                 let l = Self::writable(map, a)?;
-                let n = l.entry.ty.words();
+                let n = l.entry.words;
                 if l.word != 0 || a.wrapping_add(n) > end {
                     return Err(Exception::IllegalDataAddress);
                 }
@@ -418,7 +418,7 @@ impl<E: Estimator> Core<E> {
     /// order. A refused write processes none and is counted.
     fn write_samples(
         &mut self,
-        block: &Block,
+        block: &SlotBlock,
         start: u16,
         quantity: u16,
         data: &[u8],
@@ -443,7 +443,7 @@ impl<E: Estimator> Core<E> {
     /// The number of whole records of a write to `block`, or why it is refused.
     fn check_samples(
         &self,
-        block: &Block,
+        block: &SlotBlock,
         start: u16,
         quantity: u16,
         data: &[u8],
@@ -541,5 +541,65 @@ impl<E: Estimator> Core<E> {
             .checked_sub(super::map::SCENE_ADDRESS)
             .ok_or(Exception::IllegalDataAddress)?;
         self.commissioning.write_scene(2 * usize::from(at), data)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Server, ServerConfig};
+    use super::*;
+    use crate::monitor::{Config, Monitor, Sample, model_for_range};
+    use crate::{Scene, float::Auto};
+    use std::vec::Vec;
+
+    /// Every read of registers, from every address and of every length the table
+    /// allows (up to 125), answers each register as the value that holds it, located
+    /// alone and computed alone, with the head and the CRC of a valid frame.
+    #[test]
+    fn every_read_of_registers_is_each_registers_value() {
+        let scene = Scene::DEMO;
+        let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5).unwrap()).unwrap();
+        let monitor = Monitor::new(core, Config::default()).unwrap();
+        let mut server = Server::new(monitor, ServerConfig::default()).unwrap();
+        for i in 0..200u32 {
+            let load = 2e3 + 10.0 * i as f32;
+            server.process(Sample::new(i * 1000, load, 1e-4 * (i % 7) as f32).with_speed(2.0));
+        }
+        for function in [3u8, 4] {
+            let map = Served::of(table_of(function));
+            let expected: Vec<u16> = (0..map.end)
+                .map(|a| {
+                    let l = map.locate(a).unwrap();
+                    let v = server.core.value_other(l.entry.field, l.record);
+                    let low = l.entry.words == 1 || l.word == 1;
+                    (if low { v } else { v >> 16 }) as u16
+                })
+                .collect();
+            for start in 0..map.end {
+                for quantity in 1..=(map.end - start).min(READ_REGISTERS_MAX) {
+                    let [a, b] = start.to_be_bytes();
+                    let [c, d] = quantity.to_be_bytes();
+                    let n = server
+                        .core
+                        .read_registers(function, &[function, a, b, c, d])
+                        .unwrap();
+                    let answer = &server.core.response[..n];
+                    let bytes = 2 * usize::from(quantity);
+                    assert_eq!(n, bytes + 5);
+                    assert_eq!(answer[..3], [1, function, bytes as u8]);
+                    assert!(crc::valid(answer), "{function} {start}+{quantity}");
+                    let words: Vec<u16> = answer[3..3 + bytes]
+                        .chunks(2)
+                        .map(|w| u16::from_be_bytes([w[0], w[1]]))
+                        .collect();
+                    let s = usize::from(start);
+                    assert_eq!(
+                        words,
+                        expected[s..s + usize::from(quantity)],
+                        "{function} {start}+{quantity}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -2,7 +2,7 @@
 //! states, event kinds and faults; external sample records decoded; and the decoding
 //! of an event slot for a master written in Rust.
 
-use super::map::{Block, EventField, Field, SampleField};
+use super::map::{EventField, Field, SampleField, SlotBlock};
 use super::{AlarmSet, Core, NONE};
 use crate::Estimator;
 use crate::monitor::{Channel, Event, EventKind, FaultCause, Reading, RiskState, Sample};
@@ -209,7 +209,7 @@ pub fn event_from_registers(regs: &[u16]) -> Result<Option<Event>, DecodeError> 
 
 /// The sample in one record of an external samples block (big-endian register
 /// bytes); `None` for flags with bits other than speed (0) and axial force (1).
-pub(crate) fn sample_from_record(block: &Block, record: &[u8]) -> Option<Sample> {
+pub(crate) fn sample_from_record(block: &SlotBlock, record: &[u8]) -> Option<Sample> {
     let mut sample = Sample::new(0, 0.0, 0.0);
     let mut flags = 0u16;
     let mut speed = None;
@@ -220,7 +220,7 @@ pub(crate) fn sample_from_record(block: &Block, record: &[u8]) -> Option<Sample>
             let b = record.get(at + 2 * i..at + 2 * i + 2)?;
             Some(u32::from(u16::from_be_bytes([b[0], b[1]])))
         };
-        let v = match e.ty.words() {
+        let v = match e.words {
             2 => word(0)? << 16 | word(1)?,
             _ => word(0)?,
         };
@@ -301,7 +301,7 @@ impl<E: Estimator> Core<E> {
 
     /// [`value`](Self::value) of the other fields.
     #[inline(never)]
-    fn value_other(&self, field: Field, record: u16) -> u32 {
+    pub(super) fn value_other(&self, field: Field, record: u16) -> u32 {
         let m = &self.monitor;
         let s = m.statistics();
         // The reading's values, copied only where one is read.

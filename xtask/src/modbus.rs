@@ -950,6 +950,20 @@ fn cost_tables(costs: &[Cost]) -> (String, String, Vec<String>) {
         .unwrap();
     }
     md.push('\n');
+    for c in costs.iter().filter(|c| c.cpu.id == "cortex-m0") {
+        let (flash, statics, stack) = c.node;
+        let left = |value: u64, target: u64| target as i64 - value as i64;
+        writeln!(
+            md,
+            "{}: left under the targets, {} B of flash, {} B of RAM, {} instructions of \
+             a function-3 read of 16 registers.\n",
+            c.cpu.name,
+            left(flash, M0_FLASH_TARGET),
+            left(statics + stack, M0_RAM_TARGET),
+            left(c.requests[0], M0_FC3_TARGET)
+        )
+        .unwrap();
+    }
     for c in costs {
         writeln!(
             md,

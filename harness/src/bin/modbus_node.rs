@@ -123,12 +123,16 @@ fn run<E: Estimator>(
     uart: &mut uart::Uart,
     sp: usize,
 ) -> Option<Costs> {
-    let monitor = Monitor::new(core, Config::default()).ok()?;
     let config = ServerConfig {
         external_samples: true,
         ..ServerConfig::default()
     };
-    let mut server = Server::new(monitor, config).ok()?;
+    let Ok(monitor) = Monitor::new(core, Config::default()) else {
+        return None;
+    };
+    let Ok(mut server) = Server::new(monitor, config) else {
+        return None;
+    };
     let stack_built = support::stack::used(sp);
     let mut time_ms = 0;
     for i in 0..SAMPLES {
