@@ -21,9 +21,13 @@ pub enum Error {
     Length,
     /// Load P is NaN, infinite or negative.
     Load,
-    /// Misalignment angle phi is NaN or infinite, or |phi| >= pi/2 (rad): the angle
-    /// between two axes is below a right angle, and eq (4) maps it to theta < pi/2,
-    /// where m(theta), n(theta) are defined.
+    /// Misalignment angle phi is NaN or infinite, or |phi| above pi/2 (rad) as the
+    /// input's precision rounds it: the angle between two axes is at most a right
+    /// angle, and eq (4) maps it to theta <= pi/2, where m(theta), n(theta) are defined
+    /// (theta = pi/2: m = n = 1, crossed cylinders). f64 input: every |phi| up to
+    /// `f64::consts::FRAC_PI_2` (just below the true pi/2); f32 input: up to
+    /// `f32::consts::FRAC_PI_2` (just above it, standing for pi/2); fixed-point input:
+    /// angle counts whose product with the LSB is at most `f64::consts::FRAC_PI_2`.
     Angle,
     /// The elliptic solution was asked for a plane (R2 = infinity): its contact is a
     /// strip for every phi (section 8); use the line-contact model.
@@ -47,7 +51,10 @@ impl fmt::Display for Error {
             Error::Friction => "friction coefficient mu must be finite and positive",
             Error::Length => "contact length must be finite and positive",
             Error::Load => "load P must be finite and >= 0",
-            Error::Angle => "misalignment phi must be finite with |phi| < pi/2 rad",
+            Error::Angle => {
+                "misalignment phi must be finite with |phi| <= pi/2 rad (pi/2 as the input's \
+                 float type rounds it)"
+            }
             Error::PlaneHasNoEllipse => {
                 "a plane (R2 = inf) has no contact ellipse: use line contact"
             }

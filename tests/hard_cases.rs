@@ -189,36 +189,77 @@ fn theta_at_a_right_angle_and_its_neighbours() {
     let half_pi = core::f64::consts::FRAC_PI_2;
     let below = f64::from_bits(half_pi.to_bits() - 1);
     let above = f64::from_bits(half_pi.to_bits() + 1);
-    // The angle between two axes is below a right angle: pi/2 itself is refused, its
-    // lower neighbour is the last angle in.
-    assert_eq!(
-        elliptic_case("theta = pi/2", &s, 1e3, half_pi).err(),
-        Some(Error::Angle)
-    );
-    // (Its f32 rounding is f32's FRAC_PI_2, above pi/2: the cores see it below.)
-    reference::elliptic(&s, 1e3, below).unwrap();
+    // The angle between two axes is at most a right angle. f64's FRAC_PI_2 lies below
+    // the true pi/2 and is accepted (theta = pi/2: m = n = 1, crossed cylinders) in
+    // every model; the f64 above it lies above pi/2 and is refused.
+    for phi in [half_pi, -half_pi, below] {
+        let a = elliptic_case(&format!("phi = {phi}"), &s, 1e3, phi).unwrap();
+        assert!(a.s.is_finite() && a.s > 0.0 && a.f.is_finite());
+        line_case(&format!("line phi = {phi}"), &s, 1e5, phi);
+    }
     assert_eq!(
         elliptic_case("theta = pi/2 + ulp", &s, 1e3, above).err(),
         Some(Error::Angle)
     );
+    assert_eq!(reference::line(&s, 1e5, above).err(), Some(Error::Angle));
     let shape = reference::normal::ellipse_shape(half_pi).unwrap();
     assert!((shape.m - 1.0).abs() < 1e-15 && (shape.n - 1.0).abs() < 1e-15);
-    // The f32 neighbours of pi/2: the one below is inside; f32's FRAC_PI_2 lies above
-    // pi/2 by 4.4e-8 and is refused.
-    let f32_below = f32::from_bits(core::f32::consts::FRAC_PI_2.to_bits() - 1);
-    elliptic_case("theta = f32 below pi/2", &s, 1e3, f32_below as f64).unwrap();
-    let r = reference::elliptic(&s, 1e3, f32_below as f64).unwrap();
-    let got = EllipticScene::new(&s)
+    // The f32 core reads f32: f32's FRAC_PI_2 (the rounding of f64's, above pi/2 by
+    // 4.4e-8) stands for pi/2 and answers as the reference at pi/2; its lower
+    // neighbour as the reference at that value; the f32 above is refused.
+    let f32_half_pi = core::f32::consts::FRAC_PI_2;
+    let f32_below = f32_half_pi.next_down();
+    let core = EllipticScene::new(&s).unwrap();
+    let line = LineScene::new(&s).unwrap();
+    for (phi, at) in [(f32_half_pi, half_pi), (f32_below, f32_below as f64)] {
+        let want = reference::elliptic(&s, 1e3, at).unwrap();
+        let got = core.estimate(1e3, phi).unwrap();
+        let what = format!("f32 phi = {phi}");
+        close(
+            &what,
+            from_f32(got),
+            Answer {
+                s: want.slip_ratio,
+                f: want.axial_force,
+                phi0: want.critical_angle,
+                regime: want.regime,
+            },
+            F32_BOUND,
+        );
+        let d = core.details(1e3, phi).unwrap();
+        assert!(
+            rel(d.m as f64, want.shape.m) < F32_BOUND,
+            "{what}: m {}",
+            d.m
+        );
+        let want = reference::line(&s, 1e5, at).unwrap();
+        let got = line.estimate(1e5, phi).unwrap();
+        assert!(
+            rel(got.slip_ratio as f64, want.slip_ratio) <= F32_BOUND,
+            "{what}"
+        );
+        assert!(
+            rel(got.axial_force as f64, want.axial_force) <= F32_BOUND,
+            "{what}"
+        );
+    }
+    let f32_above = f32_half_pi.next_up();
+    assert_eq!(core.estimate(1e3, f32_above), Err(Error::Angle));
+    assert_eq!(line.estimate(1e5, f32_above), Err(Error::Angle));
+    // Section 9's choosers and the inverses take it too.
+    let long = s.with_length(0.3).unwrap();
+    reference::estimate(&long, 1e3, half_pi).unwrap();
+    misalign::float::Auto::new(&long)
         .unwrap()
-        .estimate(1e3, f32_below)
+        .estimate(1e3, f32_half_pi)
         .unwrap();
-    assert!(rel(got.slip_ratio as f64, r.slip_ratio) <= F32_BOUND);
-    assert_eq!(
-        EllipticScene::new(&s)
-            .unwrap()
-            .estimate(1e3, core::f32::consts::FRAC_PI_2),
-        Err(Error::Angle)
-    );
+    let (load_lsb, p) = exact_lsb(1e3, 1 << 30, 0.0);
+    let (angle_lsb, a) = exact_lsb(half_pi, 1 << 30, 0.0);
+    misalign::fixed::FixedAuto::new(&long, load_lsb, angle_lsb)
+        .unwrap()
+        .estimate(p, a as i32)
+        .unwrap();
+    misalign::reference::inverse::friction_estimate(&long, 1e3, half_pi, 100.0).unwrap();
 }
 
 #[test]

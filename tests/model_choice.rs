@@ -1,6 +1,6 @@
 //! Section 9's model choice per sample, the same in the reference, the f32 core and the
 //! fixed-point core: which model answers, one meaning of P with a length,
-//! the flag and the jump at the switch, |phi| < pi/2, nu = 0.5, line-contact details,
+//! the flag and the jump at the switch, |phi| <= pi/2, nu = 0.5, line-contact details,
 //! rolling resistance and power.
 
 use misalign::fixed::{FixedAuto, FixedContactDetails, FixedLineScene, exact_lsb};
@@ -243,16 +243,18 @@ fn the_jump_at_the_switch_is_the_documented_one() {
     }
 }
 
-/// The angle between two axes is below a right angle: |phi| >= pi/2 is refused in every
-/// model, also when unequal radii keep theta = c |phi| below pi/2.
+/// The angle between two axes is at most a right angle: |phi| above pi/2 (as the
+/// input's precision rounds it) is refused in every model, also when unequal radii keep
+/// theta = c |phi| below pi/2; f64's FRAC_PI_2 and f32's are accepted.
 #[test]
-fn a_right_angle_is_refused_in_every_model() {
+fn beyond_a_right_angle_is_refused_in_every_model() {
     let unequal = Scene::new(0.05, 0.5, 79.3e9, 0.3, 0.3).unwrap();
     let equal = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
     let half_pi = core::f64::consts::FRAC_PI_2;
+    let above = half_pi.next_up();
+    let above32 = core::f32::consts::FRAC_PI_2.next_up();
     for scene in [unequal, equal] {
-        for phi in [half_pi, -half_pi, 2.0, 3.0] {
-            let phi32 = phi as f32; // f32's pi/2 lies above pi/2
+        for (phi, phi32) in [(above, above32), (-above, -above32), (2.0, 2.0), (3.0, 3.0)] {
             let answers = [
                 reference::elliptic(&scene, 1e3, phi).err(),
                 reference::line(&scene, 1e3, phi).err(),
@@ -271,17 +273,38 @@ fn a_right_angle_is_refused_in_every_model() {
             ];
             assert_eq!(answers, [Some(Error::Angle); 8], "phi = {phi}");
         }
-        let below = f64::from_bits(half_pi.to_bits() - 1);
-        assert!(reference::elliptic(&scene, 1e3, below).is_ok());
-        assert!(reference::line(&scene, 1e3, below).is_ok());
-        // Fixed point: an LSB of pi/2 / 1000 accepts 999 counts, not 1000.
+        for phi in [half_pi, half_pi.next_down()] {
+            assert!(reference::elliptic(&scene, 1e3, phi).is_ok());
+            assert!(reference::line(&scene, 1e3, phi).is_ok());
+            assert!(reference::estimate(&scene, 1e3, phi).is_ok());
+        }
+        let phi32 = core::f32::consts::FRAC_PI_2;
+        assert!(
+            EllipticScene::new(&scene)
+                .unwrap()
+                .estimate(1e3, phi32)
+                .is_ok()
+        );
+        assert!(LineScene::new(&scene).unwrap().estimate(1e3, phi32).is_ok());
+        assert!(Auto::new(&scene).unwrap().estimate(1e3, phi32).is_ok());
+        // Fixed point: the last count is the largest whose angle is at most pi/2 in f64.
         let lsb = half_pi / 1000.0;
         let fixed = misalign::fixed::FixedEllipticScene::new(&scene, 1.0, lsb).unwrap();
-        assert_eq!(fixed.input_range().angle_max, 999);
-        assert_eq!(fixed.estimate(1000, 1000).err(), Some(Error::Angle));
-        assert!(fixed.estimate(1000, 999).is_ok());
+        let last = fixed.input_range().angle_max;
+        assert!(last as f64 * lsb <= half_pi && (last + 1) as f64 * lsb > half_pi);
+        assert!(last >= 999, "{last}");
+        assert_eq!(
+            fixed.estimate(1000, last as i32 + 1).err(),
+            Some(Error::Angle)
+        );
+        assert!(fixed.estimate(1000, last as i32).is_ok());
         let line = FixedLineScene::new(&scene, 1.0, lsb).unwrap();
-        assert_eq!(line.estimate(1000, -1000).err(), Some(Error::Angle));
+        assert_eq!(line.input_range().angle_max, last);
+        assert_eq!(
+            line.estimate(1000, -(last as i32) - 1).err(),
+            Some(Error::Angle)
+        );
+        assert!(line.estimate(1000, -(last as i32)).is_ok());
     }
 }
 

@@ -310,8 +310,8 @@ fn fixed_row(f: &FixedCore, load: f64, phi: f64) -> Result<Row, Error> {
     if !(load.is_finite() && load >= 0.0) {
         return Err(Error::Load);
     }
-    // As the reference: the angle between two axes is below a right angle.
-    if phi.is_nan() || libm::fabs(phi) >= core::f64::consts::FRAC_PI_2 {
+    // As the reference: |phi| up to FRAC_PI_2 (the f64 below the true pi/2).
+    if phi.is_nan() || libm::fabs(phi) > core::f64::consts::FRAC_PI_2 {
         return Err(Error::Angle);
     }
     let counts = libm::round(load / f.load_lsb);

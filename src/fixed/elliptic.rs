@@ -66,7 +66,7 @@ impl FixedEllipticScene {
         let slip_gain = PI * scene.shear_modulus() * v * v / (3.0 * scene.friction() * c);
         let cbrt_lsb = libm::cbrt(load_lsb);
         // One count must give a theta on the tables: from 2^-40 up to pi/2 (eq 4), and
-        // a |phi| below pi/2.
+        // a |phi| up to pi/2.
         let angle_counts = angle_max(angle_lsb);
         if angle_counts == 0 {
             return Err(Error::OutOfRange);
@@ -100,7 +100,7 @@ impl FixedEllipticScene {
             units: Units::new(load_lsb, angle_lsb)?,
             range: InputRange {
                 load_min,
-                // |phi| < pi/2; then theta = c |phi| < pi/2 too (c <= 1).
+                // |phi| <= pi/2; then theta = c |phi| <= pi/2 too (c <= 1).
                 angle_max: angle_counts,
             },
         };

@@ -62,7 +62,7 @@ impl FixedLineScene {
         let root_lsb = libm::sqrt(load_lsb);
         let angle_counts = angle_max(angle_lsb);
         if angle_counts == 0 {
-            return Err(Error::OutOfRange); // no angle count but 0 below pi/2
+            return Err(Error::OutOfRange); // no angle count but 0 up to pi/2
         }
         // sqrt((1 - nu) R / (pi G l)), as a product of roots (no overflow).
         let sq = libm::sqrt;
@@ -81,7 +81,7 @@ impl FixedLineScene {
             log_pressure: constant(root_lsb / (PI * compliance * length))?,
             range: InputRange {
                 load_min: 1,
-                angle_max: angle_counts, // |phi| < pi/2
+                angle_max: angle_counts, // |phi| <= pi/2
             },
         };
         scene.check_sums()?;

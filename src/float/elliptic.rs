@@ -201,7 +201,7 @@ impl<'t> EllipticScene<'t> {
     ///
     /// # Errors
     /// [`Error::Load`] for a NaN, infinite or negative load; [`Error::Angle`] for a
-    /// non-finite angle or |phi| >= pi/2; [`Error::OutOfRange`] for a theta below
+    /// non-finite angle or |phi| above pi/2; [`Error::OutOfRange`] for a theta below
     /// narrowed tables, a load above 2^120 N whose mu P overflows f32, or a load so
     /// light that phi0 would underflow f32 (below its smallest normal value).
     #[inline(always)]
@@ -275,7 +275,9 @@ impl<'t> EllipticScene<'t> {
     #[inline(never)]
     fn general_parts(&self, load: f32, phi: f32) -> Result<Parts, Error> {
         let abs_phi = phi.abs();
-        if abs_phi.to_bits() >= FRAC_PI_2.to_bits() {
+        // f32's nearest pi/2 (above the true pi/2 by 4e-8) stands for pi/2: the
+        // rounding of f64's, accepted by the reference.
+        if abs_phi.to_bits() > FRAC_PI_2.to_bits() {
             return Err(Error::Angle);
         }
         let theta = self.radius_factor * abs_phi;
@@ -390,7 +392,7 @@ impl<'t> EllipticScene<'t> {
         Err(Error::OutOfRange)
     }
 
-    /// 2a / length for a checked sample (load finite and >= 0, |phi| < pi/2), with
+    /// 2a / length for a checked sample (load finite and >= 0, |phi| <= pi/2), with
     /// `two_over_length` = 2 / length (1/m): section 9's measure, from a = m L (eqs 2,
     /// 5-6) with 1/m from its table. 0 at zero load, +inf at zero angle.
     #[inline]
@@ -415,7 +417,7 @@ impl<'t> EllipticScene<'t> {
     /// As [`EllipticScene::estimate`].
     pub fn details(&self, load: f32, phi: f32) -> Result<Details, Error> {
         check(load, phi)?;
-        if phi.abs() >= FRAC_PI_2 {
+        if phi.abs() > FRAC_PI_2 {
             return Err(Error::Angle);
         }
         let theta = self.radius_factor * phi.abs();

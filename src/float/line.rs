@@ -120,7 +120,7 @@ impl LineScene {
     ///
     /// # Errors
     /// [`Error::Load`] for a NaN, infinite or negative load; [`Error::Angle`] for a
-    /// non-finite angle or |phi| >= pi/2; [`Error::OutOfRange`] for a load outside
+    /// non-finite angle or |phi| above pi/2; [`Error::OutOfRange`] for a load outside
     /// [`LineScene::load_range`] (other than 0), where a result would not fit f32.
     #[inline]
     pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
@@ -130,8 +130,9 @@ impl LineScene {
             return self.outside_load(load, phi);
         }
         let abs_phi = phi.abs();
-        // On the bits: above pi/2, and also inf and NaN, whose patterns lie above.
-        if abs_phi.to_bits() >= FRAC_PI_2.to_bits() {
+        // On the bits: above f32's pi/2 (which stands for pi/2), and also inf and NaN,
+        // whose patterns lie above.
+        if abs_phi.to_bits() > FRAC_PI_2.to_bits() {
             return Err(Error::Angle);
         }
         let y = inv_sqrt(load); // P^(-1/2), subnormal loads included
@@ -162,7 +163,7 @@ impl LineScene {
     fn outside_load(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
         check(load, phi)?;
         let abs_phi = phi.abs();
-        if abs_phi >= FRAC_PI_2 {
+        if abs_phi > FRAC_PI_2 {
             return Err(Error::Angle);
         }
         if load != 0.0 {
@@ -195,7 +196,7 @@ impl LineScene {
     /// As [`LineScene::estimate`].
     pub fn details(&self, load: f32, phi: f32) -> Result<LineDetails, Error> {
         check(load, phi)?;
-        if phi.abs() >= FRAC_PI_2 {
+        if phi.abs() > FRAC_PI_2 {
             return Err(Error::Angle);
         }
         let root = if load == 0.0 {

@@ -283,8 +283,10 @@ fn check_sample(load: f64, phi: f64) -> Result<(), Error> {
     if !(load.is_finite() && load >= 0.0) {
         return Err(Error::Load);
     }
-    // The angle between two axes is below a right angle (NaN fails the compare).
-    if phi.is_nan() || libm::fabs(phi) >= FRAC_PI_2 {
+    // The angle between two axes is at most a right angle (theta = pi/2 at c = 1: m = n
+    // = 1, crossed cylinders). Every f64 up to FRAC_PI_2, which lies below the true
+    // pi/2, is accepted (NaN fails the compare).
+    if phi.is_nan() || libm::fabs(phi) > FRAC_PI_2 {
         return Err(Error::Angle);
     }
     Ok(())
@@ -406,7 +408,7 @@ fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64
 /// zero load gives a = b = p0 = F = 0, d/b = inf (gross slip), phi0 = 0.
 ///
 /// # Errors
-/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| >= pi/2,
+/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| above pi/2,
 /// [`Error::PlaneHasNoEllipse`] for a plane.
 pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
     check_sample(load, phi)?;
@@ -511,7 +513,7 @@ impl Elliptic {
 /// Zero angle: d/b = 0, F = 0. Zero load: b = p0 = F = phi0 = 0, d/b = inf.
 ///
 /// # Errors
-/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| >= pi/2.
+/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| above pi/2.
 pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
     check_sample(load, phi)?;
     let (g_mod, nu, mu) = (
