@@ -19,6 +19,11 @@ pub enum Error {
     Friction,
     /// Roller contact length not finite and positive.
     Length,
+    /// Roller contact length below [`Scene::shortest_length`](crate::Scene::shortest_length):
+    /// the contact strip would be wider than the rollers are long at every working
+    /// load (beyond a peak pressure of [`crate::SHORT_ROLLER_PRESSURE`] G), where the
+    /// paper's model of the contact means nothing; often a length in the wrong unit.
+    LengthTooShort,
     /// Load P is NaN, infinite or negative.
     Load,
     /// Misalignment angle phi is NaN or infinite, or |phi| above pi/2 (rad) as the
@@ -50,6 +55,11 @@ impl fmt::Display for Error {
             Error::PoissonRatio => "Poisson's ratio nu must be in [0, 0.5]",
             Error::Friction => "friction coefficient mu must be finite and positive",
             Error::Length => "contact length must be finite and positive",
+            Error::LengthTooShort => {
+                "contact length too short for the radii: below 2 (1 - nu) R x 1e-5 (R = R1 R2 / \
+                 (R1 + R2)) the contact is wider than the rollers are long at any working \
+                 load; is the length in m?"
+            }
             Error::Load => "load P must be finite and >= 0",
             Error::Angle => {
                 "misalignment phi must be finite with |phi| <= pi/2 rad (pi/2 as the input's \

@@ -129,7 +129,7 @@ fn line_case(what: &str, scene: &Scene, load: f64, phi: f64) -> Answer {
     let want = Answer {
         s: r.slip_ratio,
         f: r.axial_force,
-        phi0: Some(r.critical_angle),
+        phi0: r.critical_angle,
         regime: r.regime,
     };
     let got = LineScene::new(scene)
@@ -273,7 +273,12 @@ fn slip_ratio_at_one_from_both_sides() {
         }
         let l = reference::line(&s, 1e5, 1e-3).unwrap();
         for k in [1.0 - 1e-9, 1.0, 1.0 + 1e-9] {
-            line_case(&format!("line phi0 x {k}"), &s, 1e5, l.critical_angle * k);
+            line_case(
+                &format!("line phi0 x {k}"),
+                &s,
+                1e5,
+                l.critical_angle.unwrap() * k,
+            );
         }
     }
 }
@@ -408,4 +413,47 @@ fn undefined_input_gets_a_typed_error_everywhere() {
     assert!(e.slip_ratio.is_finite() && e.axial_force.is_finite());
     let r = reference::elliptic(&s, tiny, tiny).unwrap();
     assert!(r.slip_ratio.is_finite() && r.axial_force.is_finite() && r.critical_angle.is_some());
+}
+
+/// phi0 beyond pi/2 is no critical angle (`None`, no margin) in every model, never a
+/// number: eq (4) with unequal radii gives phi0 = theta0 / c, which passes pi/2 while
+/// theta0 is still below it, and eq (28) passes it at extreme loads per length.
+#[test]
+fn a_critical_angle_beyond_a_right_angle_is_none_in_every_model() {
+    let half_pi = core::f64::consts::FRAC_PI_2;
+    // c = 0.198: phi0 reaches pi/2 at theta0 = 0.311. The load where it does, by
+    // bisection in log P on the reference (phi0 grows with P).
+    let s = steel(0.01, 1.0, 0.3, 0.3);
+    let (mut lo, mut hi) = (1e-3f64, 1e12f64);
+    for _ in 0..100 {
+        let mid = (lo * hi).sqrt();
+        match reference::critical_angle(&s, mid) {
+            Some(_) => lo = mid,
+            None => hi = mid,
+        }
+    }
+    let (phi0, theta0) = reference::critical_angle(&s, lo).unwrap();
+    assert!(
+        rel(phi0, half_pi) < 1e-9 && theta0 < 0.32,
+        "{phi0} {theta0}"
+    );
+    let core = EllipticScene::new(&s).unwrap();
+    for (load, none) in [(lo / 1.1, false), (hi * 1.1, true), (hi * 1e3, true)] {
+        let a = elliptic_case(&format!("P = {load:e}"), &s, load, 0.01).unwrap();
+        assert_eq!(a.phi0.is_none(), none, "P = {load:e}: {:?}", a.phi0);
+        assert!(a.phi0.is_none_or(|p| p <= half_pi));
+        let e = core.estimate(load as f32, 0.01).unwrap();
+        assert_eq!(e.margin.is_none(), none, "P = {load:e}");
+    }
+    // A cylinder on a plane, per unit length: eq (28) reaches pi/2 near 6e10 N/m.
+    let plane = steel(0.05, f64::INFINITY, 0.3, 0.3);
+    for (load, none) in [(1e10, false), (1e11, true), (1e14, true)] {
+        let a = line_case(&format!("line P = {load:e}"), &plane, load, 1e-3);
+        assert_eq!(a.phi0.is_none(), none, "P = {load:e}: {:?}", a.phi0);
+        let e = LineScene::new(&plane)
+            .unwrap()
+            .estimate(load as f32, 1e-3)
+            .unwrap();
+        assert_eq!(e.margin.is_none(), none, "P = {load:e}");
+    }
 }

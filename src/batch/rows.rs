@@ -182,10 +182,10 @@ fn reference_row(
             Row {
                 slip_ratio: l.slip_ratio,
                 axial_force: force,
-                critical_angle: Some(l.critical_angle),
+                critical_angle: l.critical_angle,
                 regime: l.regime,
                 model: ContactModel::Line,
-                flags: flag_bits(&l.validity, false),
+                flags: flag_bits(&l.validity, l.critical_angle.is_none()),
             },
             [
                 f64::NAN,

@@ -195,12 +195,16 @@ impl FixedEllipticScene {
             (None, None)
         } else {
             let log_theta0 = lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z)?;
-            // Both within the tables' theta range, 2^-42 .. pi/2.
-            let counts = margin_counts(log_theta0.wrapping_sub(self.log_theta_lsb), a);
-            (
-                Some(Log2(log_theta0.wrapping_sub(self.log_radius_factor))),
-                Some(counts),
-            )
+            // Within the tables' theta range, 2^-42 .. pi/2, and c < 1: no wrap.
+            let log_phi0 = log_theta0.wrapping_sub(self.log_radius_factor);
+            if log_phi0 > LOG2_HALF_PI {
+                // phi0 = theta0 / c beyond pi/2 (unequal radii): no angle between two
+                // axes reaches gross slip.
+                (None, None)
+            } else {
+                let counts = margin_counts(log_theta0.wrapping_sub(self.log_theta_lsb), a);
+                (Some(Log2(log_phi0)), Some(counts))
+            }
         };
         if a == 0 {
             return Ok(zero_angle(critical, margin));

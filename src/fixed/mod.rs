@@ -138,7 +138,8 @@ pub struct FixedEstimate {
     /// True when F is negative (it has the sign of phi).
     pub axial_force_negative: bool,
     /// log2 of the critical angle phi0 in rad at this load; `None` when no theta <= pi/2
-    /// reaches d/b = 1.
+    /// reaches d/b = 1 or phi0 would pass pi/2 (log2 above log2(pi/2) in Q8.24): no
+    /// angle between two axes reaches gross slip.
     pub critical_angle: Option<Log2>,
     /// `phi0 - |phi|` in angle counts, saturating at the i32 range.
     pub margin: Option<i32>,

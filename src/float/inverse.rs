@@ -192,11 +192,10 @@ impl EllipticScene<'_> {
         // eq (16): g = s P^(1/3) / A = s g0, g0 formed as the forward estimate has it.
         let g_per_slip = self.critical_g(load);
         let answer = if abs_force >= saturated {
-            // Gross slip: only |phi| >= phi0 (eq 18 at d/b = 1).
-            match self.theta_of_g(g_per_slip)? {
-                Some(theta0) => Inverse::AtLeast {
-                    value: theta0 * self.inv_radius_factor,
-                },
+            // Gross slip: only |phi| >= phi0 (eq 18 at d/b = 1); none within a right
+            // angle: F stays below mu P.
+            match self.critical_angle_of(g_per_slip)? {
+                Some(phi0) => Inverse::AtLeast { value: phi0 },
                 None => Inverse::Inconsistent(Inconsistency::AboveModel),
             }
         } else {
@@ -212,7 +211,10 @@ impl EllipticScene<'_> {
                     force,
                 ));
             }
-            match self.theta_of_g(g_per_slip * s)? {
+            match self
+                .theta_of_g(g_per_slip * s)?
+                .filter(|theta| (theta * self.inv_radius_factor).to_bits() <= FRAC_PI_2.to_bits())
+            {
                 Some(theta) => Inverse::Exact {
                     value: theta * self.inv_radius_factor,
                     // S = f / (s f' E), E = d ln g / d ln theta (eq 16).
@@ -291,7 +293,10 @@ impl LineScene {
         }
         let phi0 = self.critical_gain * (load * inv_sqrt(load)); // eq (28)
         let answer = if abs_force >= saturated {
-            Inverse::AtLeast { value: phi0 }
+            match super::line::within_right_angle(phi0) {
+                Some(phi0) => Inverse::AtLeast { value: phi0 },
+                None => Inverse::Inconsistent(Inconsistency::AboveModel),
+            }
         } else {
             let r = abs_force / saturated;
             let s = r / (1.0 + sqrt(1.0 - r));

@@ -143,7 +143,7 @@ impl LineScene {
         Ok(Estimate::new(
             s,
             force,
-            Some(critical),
+            within_right_angle(critical),
             abs_phi,
             self.risk_slip_ratio,
         ))
@@ -219,6 +219,14 @@ pub struct LineDetails {
     pub b: f32,
     /// Peak pressure p0 = 2 P / (pi b) (Pa), P per unit length.
     pub p0: f32,
+}
+
+/// phi0 if it is an angle between two axes (at most f32's pi/2, which stands for pi/2),
+/// else `None`: eq (28) passes pi/2 only at extreme loads per length, where no angle
+/// reaches gross slip. One compare on the bits.
+#[inline(always)]
+pub(super) fn within_right_angle(phi0: f32) -> Option<f32> {
+    (phi0.to_bits() <= FRAC_PI_2.to_bits()).then_some(phi0)
 }
 
 fn square(x: f64) -> f64 {

@@ -129,7 +129,14 @@ pub fn measure() -> Result<Vec<AccuracyRow>, String> {
         let s = scene(row);
         let (p, phi) = (num(row, "P"), num(row, "phi"));
         let r = reference::line(&s, p, phi).map_err(err)?;
-        reference_line.add3((r.slip_ratio, r.axial_force, r.critical_angle), row);
+        reference_line.add3(
+            (
+                r.slip_ratio,
+                r.axial_force,
+                r.critical_angle.unwrap_or(f64::NAN),
+            ),
+            row,
+        );
         reference_line.add("b", r.b, row);
         reference_line.add("p0", r.p0, row);
         let core = LineScene::new(&s).map_err(err)?;

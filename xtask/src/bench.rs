@@ -208,9 +208,13 @@ fn monitor_errors(e: &mut Errors) -> Result<(), String> {
     let worst = |reading: &Reading| -> f64 {
         let (p, phi) = (f64::from(reading.load), f64::from(reading.phi));
         let want = match choice {
-            ModelChoice::Line => {
-                reference::line(&s, p, phi).map(|r| (r.slip_ratio, r.axial_force, r.critical_angle))
-            }
+            ModelChoice::Line => reference::line(&s, p, phi).map(|r| {
+                (
+                    r.slip_ratio,
+                    r.axial_force,
+                    r.critical_angle.unwrap_or(f64::NAN),
+                )
+            }),
             _ => reference::elliptic(&s, p, phi).map(|r| {
                 let c = r.critical_angle.unwrap_or(f64::NAN);
                 (r.slip_ratio, r.axial_force, c)
@@ -297,7 +301,11 @@ fn line_errors(e: &mut Errors, row: &Record) -> Result<(), String> {
     let s = scene(row);
     let (p, phi) = (num(row, "P"), num(row, "phi"));
     let r = reference::line(&s, p, phi).map_err(|e| e.to_string())?;
-    let r3 = (r.slip_ratio, r.axial_force, r.critical_angle);
+    let r3 = (
+        r.slip_ratio,
+        r.axial_force,
+        r.critical_angle.unwrap_or(f64::NAN),
+    );
     put(
         e,
         Model::Reference,
