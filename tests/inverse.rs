@@ -915,6 +915,10 @@ fn overflowing_critical_angle_gives_an_answer_not_a_nan() {
 fn float_line_inverse_refuses_loads_the_estimate_refuses() {
     use misalign::float::LineScene;
     let s = Scene::new(0.05, 1e-45, 1e3, 0.0, 7.93e10).unwrap();
+    // (mu = 8e10 on R = 1e-45 m puts phi0 beyond pi/2 at every load: the f32 scene is
+    // refused when prepared, as no load has all its results in range.)
+    assert_eq!(LineScene::new(&s).err(), Some(Error::OutOfRange));
+    let s = Scene::new(0.05, 1e-45, 1e3, 0.0, 2.0).unwrap();
     let core = LineScene::new(&s).unwrap();
     let (load, force) = (3.4e38f32, 1.57f32);
     assert!(load > core.load_range().1, "{:?}", core.load_range());

@@ -309,7 +309,7 @@ impl LineScene {
         }
         // Refused as the forward estimate refuses it: outside the load range, phi0 or
         // mu P leaves f32 (phi0 = inf times s = 0 would give a NaN).
-        if !self.load_in_range(load) {
+        if !self.accepts(load) {
             return Err(Error::OutOfRange);
         }
         let saturated = self.friction * (load * 1.0);
