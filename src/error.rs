@@ -19,11 +19,20 @@ pub enum Error {
     Friction,
     /// Roller contact length not finite and positive.
     Length,
+    /// Roller contact length below [`Scene::shortest_length`](crate::Scene::shortest_length):
+    /// the contact strip would be wider than the rollers are long at every working
+    /// load (beyond a peak pressure of [`crate::SHORT_ROLLER_PRESSURE`] G), where the
+    /// paper's model of the contact means nothing; often a length in the wrong unit.
+    LengthTooShort,
     /// Load P is NaN, infinite or negative.
     Load,
-    /// Misalignment angle phi is NaN or infinite, or |phi| >= pi/2 (rad): the angle
-    /// between two axes is below a right angle, and eq (4) maps it to theta < pi/2,
-    /// where m(theta), n(theta) are defined.
+    /// Misalignment angle phi is NaN or infinite, or |phi| above pi/2 (rad) as the
+    /// input's precision rounds it: the angle between two axes is at most a right
+    /// angle, and eq (4) maps it to theta <= pi/2, where m(theta), n(theta) are defined
+    /// (theta = pi/2: m = n = 1, crossed cylinders). f64 input: every |phi| up to
+    /// `f64::consts::FRAC_PI_2` (just below the true pi/2); f32 input: up to
+    /// `f32::consts::FRAC_PI_2` (just above it, standing for pi/2); fixed-point input:
+    /// angle counts whose product with the LSB is at most `f64::consts::FRAC_PI_2`.
     Angle,
     /// The elliptic solution was asked for a plane (R2 = infinity): its contact is a
     /// strip for every phi (section 8); use the line-contact model.
@@ -46,8 +55,16 @@ impl fmt::Display for Error {
             Error::PoissonRatio => "Poisson's ratio nu must be in [0, 0.5]",
             Error::Friction => "friction coefficient mu must be finite and positive",
             Error::Length => "contact length must be finite and positive",
+            Error::LengthTooShort => {
+                "contact length too short for the radii: below 2 (1 - nu) R x 1e-5 (R = R1 R2 / \
+                 (R1 + R2)) the contact is wider than the rollers are long at any working \
+                 load; is the length in m?"
+            }
             Error::Load => "load P must be finite and >= 0",
-            Error::Angle => "misalignment phi must be finite with |phi| < pi/2 rad",
+            Error::Angle => {
+                "misalignment phi must be finite with |phi| <= pi/2 rad (pi/2 as the input's \
+                 float type rounds it)"
+            }
             Error::PlaneHasNoEllipse => {
                 "a plane (R2 = inf) has no contact ellipse: use line contact"
             }

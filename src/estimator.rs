@@ -47,7 +47,10 @@ pub struct Estimate {
     /// Axial force F with the sign of phi (eqs 21, 27, 29).
     pub axial_force: f32,
     /// Critical angle phi0 at this load (rad), where d/b = 1; `None` when no
-    /// theta <= pi/2 reaches d/b = 1 (elliptic contact at very high load).
+    /// theta <= pi/2 reaches d/b = 1 (elliptic contact at very high load) or phi0
+    /// would pass pi/2 (unequal radii, an extreme load per length): no angle between
+    /// two axes reaches gross slip. Never a number above pi/2 (f32's, which stands
+    /// for it).
     pub critical_angle: Option<f32>,
     /// `phi0 - |phi|` (rad): positive while part of the contact sticks.
     pub margin: Option<f32>,

@@ -44,7 +44,7 @@ pub mod storage;
 pub use error::Error;
 pub use estimator::{Estimate, Estimator, FrictionInverse};
 
-pub use scene::{Scene, ThetaRelation};
+pub use scene::{SHORT_ROLLER_PRESSURE, Scene, ThetaRelation};
 
 /// The firmware guide's examples run as doctests, as the README's do.
 #[cfg(doctest)]

@@ -3,6 +3,11 @@
 
 use crate::Error;
 
+/// The peak contact pressure, as a fraction of the shear modulus G, at which a roller
+/// length must still hold section 8's contact strip ([`Scene::shortest_length`]):
+/// 0.8 MPa in steel, a five-hundredth of the paper's example (p0 / G = 0.005).
+pub const SHORT_ROLLER_PRESSURE: f64 = 1e-5;
+
 /// How the auxiliary angle theta follows from the misalignment phi.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -94,13 +99,29 @@ impl Scene {
     /// choice of section 9 switch to line contact when the ellipse is longer.
     ///
     /// # Errors
-    /// [`Error::Length`] unless `length` is finite and positive.
+    /// [`Error::Length`] unless `length` is finite and positive;
+    /// [`Error::LengthTooShort`] for a length below [`Scene::shortest_length`], at which
+    /// the contact is wider than the rollers are long at every working load (a length
+    /// in the wrong unit, say).
     pub fn with_length(mut self, length: f64) -> Result<Self, Error> {
         if !(length.is_finite() && length > 0.0) {
             return Err(Error::Length);
         }
+        if length < self.shortest_length() {
+            return Err(Error::LengthTooShort);
+        }
         self.length = Some(length);
         Ok(self)
+    }
+
+    /// The shortest contact length (m) [`Scene::with_length`] accepts,
+    /// `2 (1 - nu) R x` [`SHORT_ROLLER_PRESSURE`] with R of eq (31): the half-width b
+    /// of section 8's strip, `b / R = 2 (1 - nu) p0 / G` (eq 22 with p0 = 2 P / (pi b)),
+    /// reaches it at a peak pressure of `SHORT_ROLLER_PRESSURE x G`. Shorter rollers
+    /// are narrower than their contact at every working load; docs/physics.md derives
+    /// it.
+    pub fn shortest_length(&self) -> f64 {
+        2.0 * (1.0 - self.poisson_ratio) * self.effective_radius() * SHORT_ROLLER_PRESSURE
     }
 
     /// The same scene with another theta(phi) relation.

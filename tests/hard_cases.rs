@@ -129,7 +129,7 @@ fn line_case(what: &str, scene: &Scene, load: f64, phi: f64) -> Answer {
     let want = Answer {
         s: r.slip_ratio,
         f: r.axial_force,
-        phi0: Some(r.critical_angle),
+        phi0: r.critical_angle,
         regime: r.regime,
     };
     let got = LineScene::new(scene)
@@ -189,36 +189,77 @@ fn theta_at_a_right_angle_and_its_neighbours() {
     let half_pi = core::f64::consts::FRAC_PI_2;
     let below = f64::from_bits(half_pi.to_bits() - 1);
     let above = f64::from_bits(half_pi.to_bits() + 1);
-    // The angle between two axes is below a right angle: pi/2 itself is refused, its
-    // lower neighbour is the last angle in.
-    assert_eq!(
-        elliptic_case("theta = pi/2", &s, 1e3, half_pi).err(),
-        Some(Error::Angle)
-    );
-    // (Its f32 rounding is f32's FRAC_PI_2, above pi/2: the cores see it below.)
-    reference::elliptic(&s, 1e3, below).unwrap();
+    // The angle between two axes is at most a right angle. f64's FRAC_PI_2 lies below
+    // the true pi/2 and is accepted (theta = pi/2: m = n = 1, crossed cylinders) in
+    // every model; the f64 above it lies above pi/2 and is refused.
+    for phi in [half_pi, -half_pi, below] {
+        let a = elliptic_case(&format!("phi = {phi}"), &s, 1e3, phi).unwrap();
+        assert!(a.s.is_finite() && a.s > 0.0 && a.f.is_finite());
+        line_case(&format!("line phi = {phi}"), &s, 1e5, phi);
+    }
     assert_eq!(
         elliptic_case("theta = pi/2 + ulp", &s, 1e3, above).err(),
         Some(Error::Angle)
     );
+    assert_eq!(reference::line(&s, 1e5, above).err(), Some(Error::Angle));
     let shape = reference::normal::ellipse_shape(half_pi).unwrap();
     assert!((shape.m - 1.0).abs() < 1e-15 && (shape.n - 1.0).abs() < 1e-15);
-    // The f32 neighbours of pi/2: the one below is inside; f32's FRAC_PI_2 lies above
-    // pi/2 by 4.4e-8 and is refused.
-    let f32_below = f32::from_bits(core::f32::consts::FRAC_PI_2.to_bits() - 1);
-    elliptic_case("theta = f32 below pi/2", &s, 1e3, f32_below as f64).unwrap();
-    let r = reference::elliptic(&s, 1e3, f32_below as f64).unwrap();
-    let got = EllipticScene::new(&s)
+    // The f32 core reads f32: f32's FRAC_PI_2 (the rounding of f64's, above pi/2 by
+    // 4.4e-8) stands for pi/2 and answers as the reference at pi/2; its lower
+    // neighbour as the reference at that value; the f32 above is refused.
+    let f32_half_pi = core::f32::consts::FRAC_PI_2;
+    let f32_below = f32_half_pi.next_down();
+    let core = EllipticScene::new(&s).unwrap();
+    let line = LineScene::new(&s).unwrap();
+    for (phi, at) in [(f32_half_pi, half_pi), (f32_below, f32_below as f64)] {
+        let want = reference::elliptic(&s, 1e3, at).unwrap();
+        let got = core.estimate(1e3, phi).unwrap();
+        let what = format!("f32 phi = {phi}");
+        close(
+            &what,
+            from_f32(got),
+            Answer {
+                s: want.slip_ratio,
+                f: want.axial_force,
+                phi0: want.critical_angle,
+                regime: want.regime,
+            },
+            F32_BOUND,
+        );
+        let d = core.details(1e3, phi).unwrap();
+        assert!(
+            rel(d.m as f64, want.shape.m) < F32_BOUND,
+            "{what}: m {}",
+            d.m
+        );
+        let want = reference::line(&s, 1e5, at).unwrap();
+        let got = line.estimate(1e5, phi).unwrap();
+        assert!(
+            rel(got.slip_ratio as f64, want.slip_ratio) <= F32_BOUND,
+            "{what}"
+        );
+        assert!(
+            rel(got.axial_force as f64, want.axial_force) <= F32_BOUND,
+            "{what}"
+        );
+    }
+    let f32_above = f32_half_pi.next_up();
+    assert_eq!(core.estimate(1e3, f32_above), Err(Error::Angle));
+    assert_eq!(line.estimate(1e5, f32_above), Err(Error::Angle));
+    // Section 9's choosers and the inverses take it too.
+    let long = s.with_length(0.3).unwrap();
+    reference::estimate(&long, 1e3, half_pi).unwrap();
+    misalign::float::Auto::new(&long)
         .unwrap()
-        .estimate(1e3, f32_below)
+        .estimate(1e3, f32_half_pi)
         .unwrap();
-    assert!(rel(got.slip_ratio as f64, r.slip_ratio) <= F32_BOUND);
-    assert_eq!(
-        EllipticScene::new(&s)
-            .unwrap()
-            .estimate(1e3, core::f32::consts::FRAC_PI_2),
-        Err(Error::Angle)
-    );
+    let (load_lsb, p) = exact_lsb(1e3, 1 << 30, 0.0);
+    let (angle_lsb, a) = exact_lsb(half_pi, 1 << 30, 0.0);
+    misalign::fixed::FixedAuto::new(&long, load_lsb, angle_lsb)
+        .unwrap()
+        .estimate(p, a as i32)
+        .unwrap();
+    misalign::reference::inverse::friction_estimate(&long, 1e3, half_pi, 100.0).unwrap();
 }
 
 #[test]
@@ -232,7 +273,12 @@ fn slip_ratio_at_one_from_both_sides() {
         }
         let l = reference::line(&s, 1e5, 1e-3).unwrap();
         for k in [1.0 - 1e-9, 1.0, 1.0 + 1e-9] {
-            line_case(&format!("line phi0 x {k}"), &s, 1e5, l.critical_angle * k);
+            line_case(
+                &format!("line phi0 x {k}"),
+                &s,
+                1e5,
+                l.critical_angle.unwrap() * k,
+            );
         }
     }
 }
@@ -367,4 +413,47 @@ fn undefined_input_gets_a_typed_error_everywhere() {
     assert!(e.slip_ratio.is_finite() && e.axial_force.is_finite());
     let r = reference::elliptic(&s, tiny, tiny).unwrap();
     assert!(r.slip_ratio.is_finite() && r.axial_force.is_finite() && r.critical_angle.is_some());
+}
+
+/// phi0 beyond pi/2 is no critical angle (`None`, no margin) in every model, never a
+/// number: eq (4) with unequal radii gives phi0 = theta0 / c, which passes pi/2 while
+/// theta0 is still below it, and eq (28) passes it at extreme loads per length.
+#[test]
+fn a_critical_angle_beyond_a_right_angle_is_none_in_every_model() {
+    let half_pi = core::f64::consts::FRAC_PI_2;
+    // c = 0.198: phi0 reaches pi/2 at theta0 = 0.311. The load where it does, by
+    // bisection in log P on the reference (phi0 grows with P).
+    let s = steel(0.01, 1.0, 0.3, 0.3);
+    let (mut lo, mut hi) = (1e-3f64, 1e12f64);
+    for _ in 0..100 {
+        let mid = (lo * hi).sqrt();
+        match reference::critical_angle(&s, mid) {
+            Some(_) => lo = mid,
+            None => hi = mid,
+        }
+    }
+    let (phi0, theta0) = reference::critical_angle(&s, lo).unwrap();
+    assert!(
+        rel(phi0, half_pi) < 1e-9 && theta0 < 0.32,
+        "{phi0} {theta0}"
+    );
+    let core = EllipticScene::new(&s).unwrap();
+    for (load, none) in [(lo / 1.1, false), (hi * 1.1, true), (hi * 1e3, true)] {
+        let a = elliptic_case(&format!("P = {load:e}"), &s, load, 0.01).unwrap();
+        assert_eq!(a.phi0.is_none(), none, "P = {load:e}: {:?}", a.phi0);
+        assert!(a.phi0.is_none_or(|p| p <= half_pi));
+        let e = core.estimate(load as f32, 0.01).unwrap();
+        assert_eq!(e.margin.is_none(), none, "P = {load:e}");
+    }
+    // A cylinder on a plane, per unit length: eq (28) reaches pi/2 near 6e10 N/m.
+    let plane = steel(0.05, f64::INFINITY, 0.3, 0.3);
+    for (load, none) in [(1e10, false), (1e11, true), (1e14, true)] {
+        let a = line_case(&format!("line P = {load:e}"), &plane, load, 1e-3);
+        assert_eq!(a.phi0.is_none(), none, "P = {load:e}: {:?}", a.phi0);
+        let e = LineScene::new(&plane)
+            .unwrap()
+            .estimate(load as f32, 1e-3)
+            .unwrap();
+        assert_eq!(e.margin.is_none(), none, "P = {load:e}");
+    }
 }

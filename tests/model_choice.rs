@@ -1,6 +1,6 @@
 //! Section 9's model choice per sample, the same in the reference, the f32 core and the
 //! fixed-point core: which model answers, one meaning of P with a length,
-//! the flag and the jump at the switch, |phi| < pi/2, nu = 0.5, line-contact details,
+//! the flag and the jump at the switch, |phi| <= pi/2, nu = 0.5, line-contact details,
 //! rolling resistance and power.
 
 use misalign::fixed::{FixedAuto, FixedContactDetails, FixedLineScene, exact_lsb};
@@ -217,7 +217,7 @@ fn the_jump_at_the_switch_is_the_documented_one() {
             e.a / e.b,
             l.slip_ratio / e.slip_ratio,
             above.axial_force(&scene) / e.axial_force,
-            l.critical_angle / e.critical_angle.unwrap()
+            l.critical_angle.unwrap() / e.critical_angle.unwrap()
         );
         assert!(rel(l.slip_ratio / e.slip_ratio, jump) < 1e-6);
         assert!((jump - 1.5f64.sqrt()).abs() < 0.1);
@@ -225,10 +225,11 @@ fn the_jump_at_the_switch_is_the_documented_one() {
         // phi0 of the line model: eq (28) at P / length, not the ellipse's.
         assert!(
             rel(
-                l.critical_angle,
+                l.critical_angle.unwrap(),
                 reference::line(&scene, p_switch / length, 0.0)
                     .unwrap()
                     .critical_angle
+                    .unwrap()
             ) < 1e-9
         );
         for p in [p_switch * 0.999, p_switch * 1.001] {
@@ -243,16 +244,18 @@ fn the_jump_at_the_switch_is_the_documented_one() {
     }
 }
 
-/// The angle between two axes is below a right angle: |phi| >= pi/2 is refused in every
-/// model, also when unequal radii keep theta = c |phi| below pi/2.
+/// The angle between two axes is at most a right angle: |phi| above pi/2 (as the
+/// input's precision rounds it) is refused in every model, also when unequal radii keep
+/// theta = c |phi| below pi/2; f64's FRAC_PI_2 and f32's are accepted.
 #[test]
-fn a_right_angle_is_refused_in_every_model() {
+fn beyond_a_right_angle_is_refused_in_every_model() {
     let unequal = Scene::new(0.05, 0.5, 79.3e9, 0.3, 0.3).unwrap();
     let equal = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3).unwrap();
     let half_pi = core::f64::consts::FRAC_PI_2;
+    let above = half_pi.next_up();
+    let above32 = core::f32::consts::FRAC_PI_2.next_up();
     for scene in [unequal, equal] {
-        for phi in [half_pi, -half_pi, 2.0, 3.0] {
-            let phi32 = phi as f32; // f32's pi/2 lies above pi/2
+        for (phi, phi32) in [(above, above32), (-above, -above32), (2.0, 2.0), (3.0, 3.0)] {
             let answers = [
                 reference::elliptic(&scene, 1e3, phi).err(),
                 reference::line(&scene, 1e3, phi).err(),
@@ -271,17 +274,38 @@ fn a_right_angle_is_refused_in_every_model() {
             ];
             assert_eq!(answers, [Some(Error::Angle); 8], "phi = {phi}");
         }
-        let below = f64::from_bits(half_pi.to_bits() - 1);
-        assert!(reference::elliptic(&scene, 1e3, below).is_ok());
-        assert!(reference::line(&scene, 1e3, below).is_ok());
-        // Fixed point: an LSB of pi/2 / 1000 accepts 999 counts, not 1000.
+        for phi in [half_pi, half_pi.next_down()] {
+            assert!(reference::elliptic(&scene, 1e3, phi).is_ok());
+            assert!(reference::line(&scene, 1e3, phi).is_ok());
+            assert!(reference::estimate(&scene, 1e3, phi).is_ok());
+        }
+        let phi32 = core::f32::consts::FRAC_PI_2;
+        assert!(
+            EllipticScene::new(&scene)
+                .unwrap()
+                .estimate(1e3, phi32)
+                .is_ok()
+        );
+        assert!(LineScene::new(&scene).unwrap().estimate(1e3, phi32).is_ok());
+        assert!(Auto::new(&scene).unwrap().estimate(1e3, phi32).is_ok());
+        // Fixed point: the last count is the largest whose angle is at most pi/2 in f64.
         let lsb = half_pi / 1000.0;
         let fixed = misalign::fixed::FixedEllipticScene::new(&scene, 1.0, lsb).unwrap();
-        assert_eq!(fixed.input_range().angle_max, 999);
-        assert_eq!(fixed.estimate(1000, 1000).err(), Some(Error::Angle));
-        assert!(fixed.estimate(1000, 999).is_ok());
+        let last = fixed.input_range().angle_max;
+        assert!(last as f64 * lsb <= half_pi && (last + 1) as f64 * lsb > half_pi);
+        assert!(last >= 999, "{last}");
+        assert_eq!(
+            fixed.estimate(1000, last as i32 + 1).err(),
+            Some(Error::Angle)
+        );
+        assert!(fixed.estimate(1000, last as i32).is_ok());
         let line = FixedLineScene::new(&scene, 1.0, lsb).unwrap();
-        assert_eq!(line.estimate(1000, -1000).err(), Some(Error::Angle));
+        assert_eq!(line.input_range().angle_max, last);
+        assert_eq!(
+            line.estimate(1000, -(last as i32) - 1).err(),
+            Some(Error::Angle)
+        );
+        assert!(line.estimate(1000, -(last as i32)).is_ok());
     }
 }
 
@@ -386,4 +410,99 @@ fn round_ellipses_are_flagged() {
     let round = reference::elliptic(&scene, 1e3, 0.5).unwrap();
     assert!(round.a / round.b < reference::SLENDER_LIMIT && round.validity.round_ellipse);
     assert!(!round.validity.is_valid());
+}
+
+/// A length absurd against the radii (1e-12 m or 1e-30 m for 50 mm rollers, or one in
+/// the wrong unit) is refused when the scene is built, so that every model, prepared
+/// scene and batch refuses it alike. The f32 chooser had answered a margin of 406 rad
+/// at 2 kN and 2 mrad (phi0 far beyond pi/2), the fixed-point one a margin saturated
+/// at 214.748 rad, both with d/b 0.
+#[test]
+fn a_length_absurd_against_the_radii_is_refused_in_every_model() {
+    let (load, phi) = (2e3, 2e-3);
+    for length in [1e-12, 1e-30, 1e-7] {
+        match Scene::DEMO.with_length(length) {
+            Err(e) => assert_eq!(e, Error::LengthTooShort, "{length}"),
+            Ok(scene) => {
+                let f32_margin = Auto::new(&scene)
+                    .ok()
+                    .and_then(|a| a.estimate(load as f32, phi as f32).ok())
+                    .and_then(|e| e.estimate.margin);
+                let fixed_margin = FixedAuto::new(&scene, 1.0, 1e-7)
+                    .ok()
+                    .and_then(|a| {
+                        misalign::Estimator::estimate_si(&a, load as f32, phi as f32).ok()
+                    })
+                    .and_then(|e| e.margin);
+                panic!(
+                    "length {length} m accepted: margin {f32_margin:?} rad (f32), \
+                     {fixed_margin:?} rad (fixed)"
+                );
+            }
+        }
+    }
+    // The bound: 2 (1 - nu) R x 1e-5, the strip's half-width at p0 = 1e-5 G.
+    let shortest = Scene::DEMO.shortest_length();
+    let r = Scene::DEMO.effective_radius();
+    assert!(rel(shortest, 2.0 * 0.7 * r * misalign::SHORT_ROLLER_PRESSURE) < 1e-15);
+    assert!(Scene::DEMO.with_length(shortest).is_ok());
+    assert_eq!(
+        Scene::DEMO.with_length(shortest.next_down()),
+        Err(Error::LengthTooShort)
+    );
+    // The relation it rests on, b / R = 2 (1 - nu) p0 / G (eqs 22, 31), over loads.
+    for per_length in [1e-3, 1.0, 1e4, 1e8] {
+        let l = reference::line(&Scene::DEMO, per_length, 1e-3).unwrap();
+        let g = Scene::DEMO.shear_modulus();
+        assert!(rel(l.b / r, 2.0 * 0.7 * l.p0 / g) < 1e-12, "{per_length}");
+    }
+    // A length in mm for a scene in m is fine: the bound is far below any roller.
+    assert!(Scene::DEMO.with_length(1e-3).is_ok());
+    // The message says what is wrong and suggests the unit.
+    let message = Error::LengthTooShort.to_string();
+    assert!(
+        message.contains("1e-5") && message.contains(" m?"),
+        "{message}"
+    );
+    assert_eq!(format!("{:e}", misalign::SHORT_ROLLER_PRESSURE), "1e-5");
+    // The batch API builds each row's scene the same way: the row is refused.
+    let (r1, l) = ([0.05; 2], [0.3, 1e-12]);
+    let inputs = misalign::batch::Inputs {
+        r1: misalign::batch::Column::Each(&r1),
+        length: Some(misalign::batch::Column::Each(&l)),
+        ..misalign::batch::Inputs::one_scene(
+            &Scene::DEMO,
+            misalign::batch::Column::One(load),
+            misalign::batch::Column::One(phi),
+        )
+    };
+    for model in [
+        misalign::batch::Model::Reference,
+        misalign::batch::Model::F32,
+        misalign::batch::Model::Fixed {
+            load_lsb: 1.0,
+            angle_lsb: Some(1e-7),
+        },
+    ] {
+        let mut status = [0u8; 2];
+        let (mut s, mut f, mut phi0) = ([0.0; 2], [0.0; 2], [0.0; 2]);
+        let (mut regime, mut choice, mut flags) = ([0u8; 2], [0u8; 2], [0u8; 2]);
+        let mut out = misalign::batch::Outputs {
+            slip_ratio: &mut s,
+            axial_force: &mut f,
+            critical_angle: &mut phi0,
+            regime: &mut regime,
+            model: &mut choice,
+            flags: &mut flags,
+            status: &mut status,
+            details: None,
+        };
+        assert_eq!(misalign::batch::estimate(&inputs, &mut out, model), Ok(1));
+        assert_eq!(
+            misalign::batch::error_of(status[1]),
+            Some(Error::LengthTooShort),
+            "{model:?}"
+        );
+        assert_eq!(status[0], misalign::batch::OK, "{model:?}");
+    }
 }

@@ -189,7 +189,7 @@ fn zero_load_and_zero_angle_have_defined_answers() {
     let l = reference::line(&s, 0.0, 1e-3).unwrap();
     assert_eq!(
         (l.b, l.p0, l.axial_force, l.critical_angle),
-        (0.0, 0.0, 0.0, 0.0)
+        (0.0, 0.0, 0.0, Some(0.0))
     );
 }
 

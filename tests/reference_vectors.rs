@@ -51,13 +51,13 @@ fn elliptic_scenes_against_vectors_scene() {
             "phi0",
             i,
             e.critical_angle.unwrap_or(f64::NAN),
-            num(row, "phi0"),
+            common::phi0(row),
         );
         worst.add(
             "theta0",
             i,
             e.critical_theta.unwrap_or(f64::NAN),
-            num(row, "theta0"),
+            common::theta0(row),
         );
         assert_eq!(e.regime.as_str(), row["regime"], "row {i}");
     }
@@ -85,7 +85,12 @@ fn line_contact_against_vectors_line() {
         worst.add("s", i, l.slip_ratio, num(row, "s"));
         worst.add("d", i, l.d, num(row, "d"));
         worst.add("F", i, l.axial_force, num(row, "F"));
-        worst.add("phi0", i, l.critical_angle, num(row, "phi0"));
+        worst.add(
+            "phi0",
+            i,
+            l.critical_angle.unwrap_or(f64::NAN),
+            common::phi0(row),
+        );
         assert_eq!(
             l.regime.as_str(),
             row["regime"],

@@ -75,7 +75,7 @@ fuzz_target!(|i: Input| {
             l.slip_ratio,
             l.d,
             l.axial_force,
-            l.critical_angle,
+            l.critical_angle.unwrap_or(0.0),
             l.critical_load,
         ];
         assert!(fields.iter().all(|v| !v.is_nan()), "{l:?}");

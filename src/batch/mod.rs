@@ -258,7 +258,7 @@ pub mod flags {
 }
 
 /// Every error in the order of its status code (1, 2, ...).
-const ERRORS: [Error; 11] = [
+const ERRORS: [Error; 12] = [
     Error::Radius,
     Error::ShearModulus,
     Error::PoissonRatio,
@@ -270,6 +270,7 @@ const ERRORS: [Error; 11] = [
     Error::Unsupported,
     Error::Force,
     Error::OutOfRange,
+    Error::LengthTooShort,
 ];
 
 /// The status code of a refused row: 1 + the error's place in a fixed list; never [`OK`].

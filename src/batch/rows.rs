@@ -182,10 +182,10 @@ fn reference_row(
             Row {
                 slip_ratio: l.slip_ratio,
                 axial_force: force,
-                critical_angle: Some(l.critical_angle),
+                critical_angle: l.critical_angle,
                 regime: l.regime,
                 model: ContactModel::Line,
-                flags: flag_bits(&l.validity, false),
+                flags: flag_bits(&l.validity, l.critical_angle.is_none()),
             },
             [
                 f64::NAN,
@@ -310,8 +310,8 @@ fn fixed_row(f: &FixedCore, load: f64, phi: f64) -> Result<Row, Error> {
     if !(load.is_finite() && load >= 0.0) {
         return Err(Error::Load);
     }
-    // As the reference: the angle between two axes is below a right angle.
-    if phi.is_nan() || libm::fabs(phi) >= core::f64::consts::FRAC_PI_2 {
+    // As the reference: |phi| up to FRAC_PI_2 (the f64 below the true pi/2).
+    if phi.is_nan() || libm::fabs(phi) > core::f64::consts::FRAC_PI_2 {
         return Err(Error::Angle);
     }
     let counts = libm::round(load / f.load_lsb);

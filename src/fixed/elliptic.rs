@@ -35,6 +35,11 @@ pub struct FixedEllipticScene {
     log_hertz: i32,
     /// log2(3 x load LSB / (2 pi)): log2 p0 = this + log2(counts) - log2 a - log2 b (eq 7).
     log_pressure: i32,
+    /// The largest log2 g0 (Q8.24) with a critical angle: phi0 = theta0 / c at most
+    /// pi/2 (and g0 at most pi/2). Derived from `log_radius_factor` and the theta(g)
+    /// table when the scene is prepared or loaded (not in its bytes), so that the
+    /// per-sample path tests one bound.
+    log_g0_max: i32,
     /// `load_min >= 1`: `estimate` tests zero load only below it.
     range: InputRange,
     /// What one count stands for (the estimator contract).
@@ -66,7 +71,7 @@ impl FixedEllipticScene {
         let slip_gain = PI * scene.shear_modulus() * v * v / (3.0 * scene.friction() * c);
         let cbrt_lsb = libm::cbrt(load_lsb);
         // One count must give a theta on the tables: from 2^-40 up to pi/2 (eq 4), and
-        // a |phi| below pi/2.
+        // a |phi| up to pi/2.
         let angle_counts = angle_max(angle_lsb);
         if angle_counts == 0 {
             return Err(Error::OutOfRange);
@@ -97,10 +102,11 @@ impl FixedEllipticScene {
             log_risk: constant(DEFAULT_RISK_SLIP_RATIO as f64)?,
             log_hertz: constant(v * cbrt_lsb)?,
             log_pressure: constant(3.0 * load_lsb / (2.0 * PI))?,
+            log_g0_max: log_g0_max(constant(c)?),
             units: Units::new(load_lsb, angle_lsb)?,
             range: InputRange {
                 load_min,
-                // |phi| < pi/2; then theta = c |phi| < pi/2 too (c <= 1).
+                // |phi| <= pi/2; then theta = c |phi| <= pi/2 too (c <= 1).
                 angle_max: angle_counts,
             },
         };
@@ -191,7 +197,9 @@ impl FixedEllipticScene {
         // every sum over the declared range (`check_sums`); counts add < 32, tables < 42.
         // Critical angle: g(theta0) = g0 (eq 18 at d/b = 1), phi0 = theta0 / c.
         let z = self.log_critical.wrapping_add(lp3);
-        let (critical, margin) = if z > LOG2_HALF_PI {
+        // No critical angle above g0 = pi/2 (eq 18), nor where phi0 = theta0 / c would
+        // pass pi/2 (unequal radii): `log_g0_max` bounds both.
+        let (critical, margin) = if z > self.log_g0_max {
             (None, None)
         } else {
             let log_theta0 = lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z)?;
@@ -335,6 +343,35 @@ pub struct FixedDetails {
     pub p0: Log2,
 }
 
+/// The largest log2 g0 (Q8.24, at most log2(pi/2)) whose theta0 from the table gives
+/// phi0 = theta0 / c at most pi/2, for `log_c` = log2 c: a bisection on the table
+/// (theta(g) increases), integers only, so that a scene loaded from bytes derives it
+/// alike. Below the table's start: the start less one (no critical angle at all).
+fn log_g0_max(log_c: i32) -> i32 {
+    let within = |z: i32| {
+        lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z)
+            .is_ok_and(|t| t as i64 - log_c as i64 <= LOG2_HALF_PI as i64)
+    };
+    let (mut lo, mut hi) = (LOG_THETA_LOW.start, LOG2_HALF_PI);
+    if within(hi) {
+        return hi;
+    }
+    if !within(lo) {
+        return lo.saturating_sub(1);
+    }
+    // within(lo) and not within(hi), lo < hi, both within +-2^31 / 2 (table and
+    // log2(pi/2)): the differences cannot wrap; 32 halvings at most.
+    while hi.wrapping_sub(lo) > 1 {
+        let mid = lo.wrapping_add(hi.wrapping_sub(lo) / 2);
+        if within(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
 /// A log-log table in two pieces, coarse below the high piece's start.
 #[inline(always)]
 fn lookup(low: UniformTable<'static>, high: UniformTable<'static>, x: i32) -> Result<i32, Error> {
@@ -432,6 +469,7 @@ impl FixedEllipticScene {
             log_risk: c[5],
             log_hertz: c[6],
             log_pressure: c[7],
+            log_g0_max: log_g0_max(c[3]),
             range: InputRange {
                 load_min: r.u32()?,
                 angle_max: r.u32()?,

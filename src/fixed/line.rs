@@ -4,8 +4,8 @@ use super::elliptic::{zero_angle, zero_load};
 use super::logexp::{exp2_fixed, log2_u32};
 use super::uniform::ONE;
 use super::{
-    FixedEstimate, InputRange, Log2, Units, angle_max, constant, constant_below, log_risk,
-    margin_counts, output_range_thirds, read_constant,
+    FixedEstimate, InputRange, LOG2_HALF_PI, Log2, Units, angle_max, constant, constant_below,
+    log_risk, margin_counts, output_range_thirds, read_constant,
 };
 use crate::estimator::DEFAULT_RISK_SLIP_RATIO;
 use crate::prepared::{Kind, PreparedError, Reader, Writer, seal, value};
@@ -62,7 +62,7 @@ impl FixedLineScene {
         let root_lsb = libm::sqrt(load_lsb);
         let angle_counts = angle_max(angle_lsb);
         if angle_counts == 0 {
-            return Err(Error::OutOfRange); // no angle count but 0 below pi/2
+            return Err(Error::OutOfRange); // no angle count but 0 up to pi/2
         }
         // sqrt((1 - nu) R / (pi G l)), as a product of roots (no overflow).
         let sq = libm::sqrt;
@@ -81,7 +81,7 @@ impl FixedLineScene {
             log_pressure: constant(root_lsb / (PI * compliance * length))?,
             range: InputRange {
                 load_min: 1,
-                angle_max: angle_counts, // |phi| < pi/2
+                angle_max: angle_counts, // |phi| <= pi/2
             },
         };
         scene.check_sums()?;
@@ -148,8 +148,16 @@ impl FixedLineScene {
         let lp = log2_u32(load);
         let half_lp = lp >> 1;
         let log_phi0 = self.log_critical.wrapping_add(half_lp); // eq (28)
-        let critical = Some(Log2(log_phi0));
-        let margin = Some(margin_counts(log_phi0.wrapping_sub(self.log_angle_lsb), a));
+        // phi0 beyond pi/2 (an extreme load per length): no angle between two axes
+        // reaches gross slip.
+        let (critical, margin) = if log_phi0 > LOG2_HALF_PI {
+            (None, None)
+        } else {
+            (
+                Some(Log2(log_phi0)),
+                Some(margin_counts(log_phi0.wrapping_sub(self.log_angle_lsb), a)),
+            )
+        };
         if a == 0 {
             return Ok(zero_angle(critical, margin));
         }

@@ -119,7 +119,7 @@ pub struct InputRange {
     /// Smallest non-zero load in counts (0 is accepted too); below it the critical
     /// angle would fall under the tables (theta0 < 2^-40).
     pub load_min: u32,
-    /// Largest |angle| in counts: |phi| < pi/2 (so theta < pi/2, eq 4).
+    /// Largest |angle| in counts: |phi| <= pi/2 (so theta <= pi/2, eq 4).
     pub angle_max: u32,
 }
 
@@ -138,7 +138,8 @@ pub struct FixedEstimate {
     /// True when F is negative (it has the sign of phi).
     pub axial_force_negative: bool,
     /// log2 of the critical angle phi0 in rad at this load; `None` when no theta <= pi/2
-    /// reaches d/b = 1.
+    /// reaches d/b = 1 or phi0 would pass pi/2 (log2 above log2(pi/2) in Q8.24): no
+    /// angle between two axes reaches gross slip.
     pub critical_angle: Option<Log2>,
     /// `phi0 - |phi|` in angle counts, saturating at the i32 range.
     pub margin: Option<i32>,
@@ -368,10 +369,18 @@ pub fn exact_lsb(x: f64, max_counts: u32, min_lsb: f64) -> (f64, u32) {
     (x / counts, counts as u32)
 }
 
-/// Largest angle count with counts x `angle_lsb` < pi/2 (the angle between two axes
-/// is below a right angle), at most 2^31.
+/// Largest angle count with counts x `angle_lsb` <= pi/2 as f64 has it (the angle
+/// between two axes is at most a right angle; `FRAC_PI_2` lies below the true pi/2,
+/// and the reference accepts it), at most 2^31.
 fn angle_max(angle_lsb: f64) -> u32 {
-    let n = libm::ceil(core::f64::consts::FRAC_PI_2 / angle_lsb) - 1.0;
+    let half_pi = core::f64::consts::FRAC_PI_2;
+    let mut n = libm::floor(half_pi / angle_lsb);
+    // The quotient's rounding may put n one count off, either way.
+    if n * angle_lsb > half_pi {
+        n -= 1.0;
+    } else if (n + 1.0) * angle_lsb <= half_pi {
+        n += 1.0;
+    }
     libm::fmin(libm::fmax(n, 0.0), 2_147_483_648.0) as u32
 }
 

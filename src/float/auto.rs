@@ -143,7 +143,7 @@ impl Auto {
     #[inline(always)]
     pub(super) fn checked(load: f32, phi: f32) -> Result<(), Error> {
         check(load, phi)?;
-        if phi.abs() >= FRAC_PI_2 {
+        if phi.abs() > FRAC_PI_2 {
             return Err(Error::Angle);
         }
         Ok(())

@@ -39,6 +39,14 @@ const HOT_CUBE_SPAN: u32 = 0x3f00_0000 - 0x1700_0000; // up to 1/2
 const HOT_GAIN_MIN: f32 = 7.523_164e-37; // 2^-120
 const HOT_GAIN_MAX: f32 = 549_755_813_888.0; // 2^39
 
+/// The smallest c (eq 4) whose scene takes the hot path, rounded up to f32 (a test
+/// holds it to `theta(cbrt(1/2)) / (pi/2)` of the reference, plus 1e-4 for the
+/// tables' error): the hot path's largest theta0 (g0 below cbrt(1/2)) is 0.632 rad,
+/// so its phi0 = theta0 / c stays at most pi/2 from this c up. Scenes of smaller c
+/// (radii more than 22 times apart) take the general path, which says `None` where
+/// phi0 would pass pi/2; so the hot path needs no check of its own.
+const HOT_MIN_RADIUS_FACTOR: f32 = 0.402_505_9;
+
 /// `2^31 - bits(threshold)` for a positive finite threshold.
 fn risk_offset(threshold: f32) -> u32 {
     0x8000_0000u32.wrapping_sub(threshold.to_bits())
@@ -112,7 +120,8 @@ pub struct EllipticScene<'t> {
     risk_offset: u32,
     /// `B^3 = 1/A^3` for the hot path, where g0 = (B^3 P)^(1/3) (eq 18); 0 (no hot
     /// path) when B^3 lies outside [2^-120, 2^39], so that B^3 P in the hot path's range
-    /// [2^-81, 1/2) means a load in [2^-120, 2^119).
+    /// [2^-81, 1/2) means a load in [2^-120, 2^119), or when c is below
+    /// `HOT_MIN_RADIUS_FACTOR`.
     cubed_critical_gain: f32,
     tables: Tables<'t>,
 }
@@ -176,7 +185,11 @@ impl<'t> EllipticScene<'t> {
             hertz_gain: f[5],
             risk_slip_ratio: DEFAULT_RISK_SLIP_RATIO,
             risk_offset: risk_offset(DEFAULT_RISK_SLIP_RATIO),
-            cubed_critical_gain: hot_gain((1.0 / (slip_gain * slip_gain * slip_gain)) as f32),
+            cubed_critical_gain: if f[0] >= HOT_MIN_RADIUS_FACTOR {
+                hot_gain((1.0 / (slip_gain * slip_gain * slip_gain)) as f32)
+            } else {
+                0.0
+            },
             tables,
         })
     }
@@ -201,7 +214,7 @@ impl<'t> EllipticScene<'t> {
     ///
     /// # Errors
     /// [`Error::Load`] for a NaN, infinite or negative load; [`Error::Angle`] for a
-    /// non-finite angle or |phi| >= pi/2; [`Error::OutOfRange`] for a theta below
+    /// non-finite angle or |phi| above pi/2; [`Error::OutOfRange`] for a theta below
     /// narrowed tables, a load above 2^120 N whose mu P overflows f32, or a load so
     /// light that phi0 would underflow f32 (below its smallest normal value).
     #[inline(always)]
@@ -275,7 +288,9 @@ impl<'t> EllipticScene<'t> {
     #[inline(never)]
     fn general_parts(&self, load: f32, phi: f32) -> Result<Parts, Error> {
         let abs_phi = phi.abs();
-        if abs_phi.to_bits() >= FRAC_PI_2.to_bits() {
+        // f32's nearest pi/2 (above the true pi/2 by 4e-8) stands for pi/2: the
+        // rounding of f64's, accepted by the reference.
+        if abs_phi.to_bits() > FRAC_PI_2.to_bits() {
             return Err(Error::Angle);
         }
         let theta = self.radius_factor * abs_phi;
@@ -300,8 +315,19 @@ impl<'t> EllipticScene<'t> {
             slip_ratio,
             // mu P is finite: `extreme_load` refused the loads where it is not.
             signed_limit: (self.friction * load).copysign(phi),
-            critical_angle: self.theta_of_g(g0)?.map(|t| t * self.inv_radius_factor),
+            critical_angle: self.critical_angle_of(g0)?,
         })
+    }
+
+    /// phi0 = theta0 / c (eqs 4, 18) for g0 = g(theta0); `None` where no theta <= pi/2
+    /// reaches g0, or where phi0 would pass pi/2 (f32's pi/2, which stands for it):
+    /// no angle between two axes reaches gross slip.
+    #[inline]
+    pub(super) fn critical_angle_of(&self, g0: f32) -> Result<Option<f32>, Error> {
+        Ok(self
+            .theta_of_g(g0)?
+            .map(|t| t * self.inv_radius_factor)
+            .filter(|phi0| phi0.to_bits() <= FRAC_PI_2.to_bits()))
     }
 
     /// g0 = g(theta0) at load `load` (eq 18 at d/b = 1) for a load 0 or above:
@@ -390,7 +416,7 @@ impl<'t> EllipticScene<'t> {
         Err(Error::OutOfRange)
     }
 
-    /// 2a / length for a checked sample (load finite and >= 0, |phi| < pi/2), with
+    /// 2a / length for a checked sample (load finite and >= 0, |phi| <= pi/2), with
     /// `two_over_length` = 2 / length (1/m): section 9's measure, from a = m L (eqs 2,
     /// 5-6) with 1/m from its table. 0 at zero load, +inf at zero angle.
     #[inline]
@@ -415,7 +441,7 @@ impl<'t> EllipticScene<'t> {
     /// As [`EllipticScene::estimate`].
     pub fn details(&self, load: f32, phi: f32) -> Result<Details, Error> {
         check(load, phi)?;
-        if phi.abs() >= FRAC_PI_2 {
+        if phi.abs() > FRAC_PI_2 {
             return Err(Error::Angle);
         }
         let theta = self.radius_factor * phi.abs();
@@ -532,7 +558,8 @@ impl<'t> EllipticScene<'t> {
         let cubed_critical_gain = r.f32()?;
         // On the bits (positive f32 order as their bits): 2^-40 <= c <= 1, A within
         // `SLIP_GAIN_LIMIT`, mu at most 128 (the f32 of a mu below 128), B^3 0 or in
-        // the hot path's [2^-120, 2^39] (whether it is B's cube takes floating point:
+        // the hot path's [2^-120, 2^39] with c from `HOT_MIN_RADIUS_FACTOR` up
+        // (whether it is B's cube takes floating point:
         // like A against B, it is the writer's).
         let bits = |x: f32| x.to_bits();
         value(
@@ -542,7 +569,8 @@ impl<'t> EllipticScene<'t> {
                 && bits(c[4]) <= bits(FRICTION_LIMIT as f32)
                 && (bits(cubed_critical_gain) == 0
                     || (bits(HOT_GAIN_MIN) <= bits(cubed_critical_gain)
-                        && bits(cubed_critical_gain) <= bits(HOT_GAIN_MAX))),
+                        && bits(cubed_critical_gain) <= bits(HOT_GAIN_MAX)
+                        && bits(HOT_MIN_RADIUS_FACTOR) <= bits(c[0]))),
         )?;
         Ok(EllipticScene {
             radius_factor: c[0],
@@ -561,7 +589,22 @@ impl<'t> EllipticScene<'t> {
 
 #[cfg(test)]
 mod prepared_tests {
-    use super::SLIP_GAIN_LIMIT;
+    use super::{HOT_MIN_RADIUS_FACTOR, SLIP_GAIN_LIMIT};
+
+    /// The hot path's smallest c is the reference's theta0 at its largest g0
+    /// (cbrt(1/2)) over pi/2, with 1e-4 for the tables, rounded up to f32.
+    #[test]
+    fn hot_min_radius_factor_is_the_largest_hot_theta0_over_a_right_angle() {
+        let theta = crate::reference::normal::theta_for_g(libm::cbrt(0.5))
+            .unwrap()
+            .theta;
+        let bound = theta / core::f64::consts::FRAC_PI_2 * (1.0 + 1e-4);
+        let limit = HOT_MIN_RADIUS_FACTOR as f64;
+        assert!(
+            bound <= limit && limit <= bound * (1.0 + 1e-6),
+            "{bound} {limit}"
+        );
+    }
 
     /// The bound that `from_bytes` checks on the bits is the one `with_tables` applies
     /// in f64, rounded up to f32 (within 1e-5): no prepared scene is refused.

@@ -27,6 +27,14 @@
 //! `d ln g / d ln theta` by a difference of the g table, and S ~ 1/f'(s) is steep in s
 //! near gross slip).
 //!
+//! Saturation: an answer is `Exact` only where the inputs, read as f32, determine it.
+//! Where F / (mu P) as the core forms it lies within [`ROUNDING_BELOW_SATURATION`] of
+//! 1 (or [`ROUNDING_ABOVE_SATURATION`] above), F cannot be told from mu P and the
+//! phi-inverse answers `AtLeast` phi0, as the reference does at F = mu P; where
+//! F / (K P) lies within [`SATURATION_ULPS`] of the no-slip limit, the mu-inverse
+//! answers `AtLeast` the mu at the band's edge. Each band is the sum of the roundings
+//! of the quantity as the core forms it (their docs).
+//!
 //! Section 9: [`Auto`] chooses the model per sample. mu's inverse is the chosen
 //! model's (phi is known); phi's solves both models and keeps each answer only where
 //! the choice takes its model.
@@ -50,13 +58,31 @@ use crate::reference::ContactModel;
 use crate::reference::inverse::{Inconsistency, Inverse, angle_trivial, friction_trivial};
 use core::f32::consts::FRAC_PI_2;
 
-/// Relative distance below the no-slip limit of F(mu) within which F counts as the
-/// limit (the f32 forward map's rounding there): the answer is then only `AtLeast`.
-const SATURATION_ULPS: f32 = 8.0 * f32::EPSILON;
+/// Relative distance below the no-slip limit of F(mu) (`F / (K P)` at its largest,
+/// eq 16 with s -> 0) within which F counts as the limit: the answer is then only
+/// `AtLeast` mu, as the inputs at f32 do not tell it from the limit. The bound of q =
+/// F / (K P) as the core forms it, in units u = 2^-24 (half an f32 ulp): F, P rounded
+/// to f32 and F / P (3 u), q's division (1 u), g(theta) from its table (within 3 u)
+/// at theta = c |phi| (c, phi and the product: 3 u, times d ln g / d ln theta <= 1),
+/// g0 = cbrt(B^3 P) (the hot cube root's bound and the cube's 3 u / 3), g / g0 and mu
+/// times it (2 u): within 16 u = 8 eps (the test `saturation_bands_cover_the_rounding`
+/// sums it and holds the g table to its 3 u). Line contact's K (inv_sqrt's bound and
+/// four products) stays below it too.
+pub const SATURATION_ULPS: f32 = 8.0 * f32::EPSILON;
 
 /// An F up to this far (relative) above mu P counts as mu P (the rounding of mu P
 /// and of F from inputs rounded to f32); further above, F is inconsistent.
 pub const ROUNDING_ABOVE_SATURATION: f32 = 4.0 * f32::EPSILON;
+
+/// An F down to this far (relative) below mu P counts as mu P in the phi-inverses:
+/// the answer is `AtLeast` phi0 (gross slip), as the reference answers at F = mu P,
+/// since the inputs at f32 cannot tell F from mu P there. F / (mu P) as the core
+/// forms it is off the exact inputs' ratio by five roundings at most (F, P and mu
+/// read as f32, mu P, the quotient: 5 u = 2.5 eps, u = 2^-24); this is 4 eps, as
+/// [`ROUNDING_ABOVE_SATURATION`] on the other side. Below it, the answer is `Exact`
+/// with its sensitivity, which near saturation is large (1e3 and more): phi moves by
+/// the sensitivity times F's relative error.
+pub const ROUNDING_BELOW_SATURATION: f32 = 4.0 * f32::EPSILON;
 
 /// Relative step of the difference that gives `d ln g / d ln theta`.
 const LOG_STEP: f32 = 1.0 / 64.0;
@@ -191,12 +217,11 @@ impl EllipticScene<'_> {
         }
         // eq (16): g = s P^(1/3) / A = s g0, g0 formed as the forward estimate has it.
         let g_per_slip = self.critical_g(load);
-        let answer = if abs_force >= saturated {
-            // Gross slip: only |phi| >= phi0 (eq 18 at d/b = 1).
-            match self.theta_of_g(g_per_slip)? {
-                Some(theta0) => Inverse::AtLeast {
-                    value: theta0 * self.inv_radius_factor,
-                },
+        let answer = if abs_force >= saturated * (1.0 - ROUNDING_BELOW_SATURATION) {
+            // Gross slip: only |phi| >= phi0 (eq 18 at d/b = 1); none within a right
+            // angle: F stays below mu P.
+            match self.critical_angle_of(g_per_slip)? {
+                Some(phi0) => Inverse::AtLeast { value: phi0 },
                 None => Inverse::Inconsistent(Inconsistency::AboveModel),
             }
         } else {
@@ -212,7 +237,10 @@ impl EllipticScene<'_> {
                     force,
                 ));
             }
-            match self.theta_of_g(g_per_slip * s)? {
+            match self
+                .theta_of_g(g_per_slip * s)?
+                .filter(|theta| (theta * self.inv_radius_factor).to_bits() <= FRAC_PI_2.to_bits())
+            {
                 Some(theta) => Inverse::Exact {
                     value: theta * self.inv_radius_factor,
                     // S = f / (s f' E), E = d ln g / d ln theta (eq 16).
@@ -281,7 +309,7 @@ impl LineScene {
         }
         // Refused as the forward estimate refuses it: outside the load range, phi0 or
         // mu P leaves f32 (phi0 = inf times s = 0 would give a NaN).
-        if !self.load_in_range(load) {
+        if !self.accepts(load) {
             return Err(Error::OutOfRange);
         }
         let saturated = self.friction * (load * 1.0);
@@ -290,8 +318,11 @@ impl LineScene {
             return Ok(Inverse::Inconsistent(Inconsistency::AboveModel));
         }
         let phi0 = self.critical_gain * (load * inv_sqrt(load)); // eq (28)
-        let answer = if abs_force >= saturated {
-            Inverse::AtLeast { value: phi0 }
+        let answer = if abs_force >= saturated * (1.0 - ROUNDING_BELOW_SATURATION) {
+            match super::line::within_right_angle(phi0) {
+                Some(phi0) => Inverse::AtLeast { value: phi0 },
+                None => Inverse::Inconsistent(Inconsistency::AboveModel),
+            }
         } else {
             let r = abs_force / saturated;
             let s = r / (1.0 + sqrt(1.0 - r));
@@ -405,3 +436,38 @@ macro_rules! friction_inverse {
     )*};
 }
 friction_inverse!(EllipticScene<'_>, LineScene, Auto);
+
+#[cfg(test)]
+mod tests {
+    use super::{ROUNDING_ABOVE_SATURATION, ROUNDING_BELOW_SATURATION, SATURATION_ULPS};
+    use crate::float::kernels::cbrt::CBRT_HOT_MAX_REL_ERROR;
+    use crate::float::kernels::sqrt::INV_SQRT_MAX_REL_ERROR;
+    use crate::float::tables::G_OF_THETA;
+
+    /// The bands hold the roundings their docs list, in u = 2^-24; the g table's part
+    /// is measured here against the reference over its whole range.
+    #[test]
+    fn saturation_bands_cover_the_rounding() {
+        let u = 2f64.powi(-24);
+        let mut g_error = 0.0f64;
+        for i in 0..20_000 {
+            // theta from 2^-32 up to pi/2, log-spaced, as the f32 the table reads.
+            let x = (i as f64 / 20_000.0) * (32.0 + core::f64::consts::FRAC_PI_2.log2());
+            let theta = 2f64.powf(-32.0 + x) as f32;
+            let want = crate::reference::normal::ellipse_shape(theta as f64)
+                .unwrap()
+                .g();
+            let got = G_OF_THETA.eval(theta).unwrap() as f64;
+            g_error = g_error.max((got / want - 1.0).abs());
+        }
+        assert!(g_error <= 3.0 * u, "g table {}", g_error / u);
+        let cbrt = CBRT_HOT_MAX_REL_ERROR as f64 / u;
+        let elliptic = 3.0 + 1.0 + 3.0 + 3.0 + cbrt + 1.0 + 2.0;
+        let line = 3.0 + 1.0 + INV_SQRT_MAX_REL_ERROR as f64 / u + 4.0;
+        let band = SATURATION_ULPS as f64 / u;
+        assert!(elliptic <= band && line <= band, "{elliptic} {line} {band}");
+        // F / (mu P): F, P, mu read as f32, mu P, the quotient.
+        assert!(5.0 <= ROUNDING_BELOW_SATURATION as f64 / u);
+        assert_eq!(ROUNDING_BELOW_SATURATION, ROUNDING_ABOVE_SATURATION);
+    }
+}

@@ -33,7 +33,9 @@ pub struct LineScene {
     /// The lightest load (as f32 bits) above 0 whose results fit f32: d/b finite,
     /// phi0 a normal number.
     load_min_bits: u32,
-    /// `heaviest - lightest` (f32 bits): F = mu P and phi0 finite up to the heaviest.
+    /// `heaviest - lightest` (f32 bits) of the hot path: F = mu P finite and phi0
+    /// below pi/2 up to its heaviest load. Heavier loads take the cold path, which
+    /// answers no critical angle where phi0 passes pi/2: the hot path needs no check.
     load_span_bits: u32,
 }
 
@@ -42,7 +44,8 @@ impl LineScene {
     ///
     /// # Errors
     /// [`Error::OutOfRange`] if a constant does not fit in f32, or no load has all its
-    /// results in f32 (see [`LineScene::load_range`]).
+    /// results in f32 (see [`LineScene::load_range`]) with phi0 below pi/2 (an absurd
+    /// scene: phi0 beyond a right angle at the lightest load).
     pub fn new(scene: &Scene) -> Result<Self, Error> {
         let mu = scene.friction();
         let stiffness = core::f64::consts::PI
@@ -74,7 +77,9 @@ impl LineScene {
         let (slip, critical, mu) = (f[0] as f64, f[1] as f64, f[2] as f64);
         // With a factor 2 for inv_sqrt's and the products' rounding: d/b =
         // slip |phi| / sqrt(P) <= slip (pi/2) / sqrt(P) finite (eq 23); phi0 =
-        // critical sqrt(P) normal and finite (eq 28); F <= mu P finite (eqs 27, 29).
+        // critical sqrt(P) normal (eq 28); F <= mu P finite (eqs 27, 29). The hot path
+        // stops 2^-20 short of phi0 = pi/2 (inv_sqrt's and the products' rounding are
+        // far smaller), so that its phi0 never passes pi/2.
         let (max, min_normal) = (f32::MAX as f64, f32::MIN_POSITIVE as f64);
         let lightest = f64::max(
             f64::max(
@@ -83,7 +88,8 @@ impl LineScene {
             ),
             square(2.0 * min_normal / critical),
         );
-        let heaviest = f64::min(f64::min(max, max / mu), square(max / (2.0 * critical)));
+        let right_angle = square(core::f64::consts::FRAC_PI_2 / critical) * (1.0 - 1.0 / 1048576.0);
+        let heaviest = f64::min(f64::min(max, max / mu), right_angle);
         let (lightest, heaviest) = (f32_above(lightest), f32_below(heaviest));
         if lightest > heaviest {
             return Err(Error::OutOfRange);
@@ -120,7 +126,7 @@ impl LineScene {
     ///
     /// # Errors
     /// [`Error::Load`] for a NaN, infinite or negative load; [`Error::Angle`] for a
-    /// non-finite angle or |phi| >= pi/2; [`Error::OutOfRange`] for a load outside
+    /// non-finite angle or |phi| above pi/2; [`Error::OutOfRange`] for a load outside
     /// [`LineScene::load_range`] (other than 0), where a result would not fit f32.
     #[inline]
     pub fn estimate(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
@@ -130,8 +136,9 @@ impl LineScene {
             return self.outside_load(load, phi);
         }
         let abs_phi = phi.abs();
-        // On the bits: above pi/2, and also inf and NaN, whose patterns lie above.
-        if abs_phi.to_bits() >= FRAC_PI_2.to_bits() {
+        // On the bits: above f32's pi/2 (which stands for pi/2), and also inf and NaN,
+        // whose patterns lie above.
+        if abs_phi.to_bits() > FRAC_PI_2.to_bits() {
             return Err(Error::Angle);
         }
         let y = inv_sqrt(load); // P^(-1/2), subnormal loads included
@@ -155,37 +162,65 @@ impl LineScene {
         load.to_bits().wrapping_sub(self.load_min_bits) <= self.load_span_bits
     }
 
-    /// Loads outside [`LineScene::load_range`]: bad input, zero load (d/b = inf at
-    /// phi != 0, F = 0, phi0 = 0), or a load whose results would not fit f32.
+    /// Loads outside the hot path's range: bad input, zero load (d/b = inf at
+    /// phi != 0, F = 0, phi0 = 0), a load whose results would not fit f32, or a load
+    /// heavy enough for phi0 to near pi/2 (answered as the hot path does, with no
+    /// critical angle where phi0 passes pi/2).
     #[cold]
     #[inline(never)]
     fn outside_load(&self, load: f32, phi: f32) -> Result<Estimate, Error> {
         check(load, phi)?;
         let abs_phi = phi.abs();
-        if abs_phi >= FRAC_PI_2 {
+        if abs_phi > FRAC_PI_2 {
             return Err(Error::Angle);
         }
-        if load != 0.0 {
+        if load == 0.0 {
+            let s = if abs_phi == 0.0 { 0.0 } else { f32::INFINITY };
+            return Ok(Estimate::new(
+                s,
+                0.0,
+                Some(0.0),
+                abs_phi,
+                self.risk_slip_ratio,
+            ));
+        }
+        if !self.accepts(load) {
             return Err(Error::OutOfRange);
         }
-        let s = if abs_phi == 0.0 { 0.0 } else { f32::INFINITY };
+        let y = inv_sqrt(load);
+        let s = self.slip_gain * abs_phi * y; // eq (23)
+        let ratio = if s < 1.0 { s * (2.0 - s) } else { 1.0 }; // eqs (27), (29)
+        let force = (self.friction * (load * ratio)).copysign(phi);
+        let critical = self.critical_gain * (load * y); // eq (28)
         Ok(Estimate::new(
             s,
-            0.0,
-            Some(0.0),
+            force,
+            within_right_angle(critical),
             abs_phi,
             self.risk_slip_ratio,
         ))
     }
 
+    /// Whether `load` (finite, above 0) is one [`LineScene::estimate`] accepts: from
+    /// the lightest on, mu P finite.
+    pub(super) fn accepts(&self, load: f32) -> bool {
+        load.to_bits() >= self.load_min_bits && (self.friction * load).is_finite()
+    }
+
     /// The loads (N/m, or N with a length) [`LineScene::estimate`] accepts besides 0:
-    /// those at which d/b, F and phi0 are finite and phi0 is a normal f32. For a
-    /// realistic scene, every positive f32 load, subnormal ones included.
+    /// those at which d/b and F are finite and phi0 is a normal f32 (or none, beyond
+    /// pi/2). For a realistic scene, every positive f32 load, subnormal ones included.
     pub fn load_range(&self) -> (f32, f32) {
-        (
-            f32::from_bits(self.load_min_bits),
-            f32::from_bits(self.load_min_bits.wrapping_add(self.load_span_bits)),
-        )
+        // The heaviest load with mu P finite: near f32::MAX / mu, then to the ulp.
+        let mut heaviest = (f32::MAX / self.friction).min(f32::MAX);
+        for _ in 0..4 {
+            if !(self.friction * heaviest).is_finite() {
+                heaviest = heaviest.next_down();
+            } else if heaviest < f32::MAX && (self.friction * heaviest.next_up()).is_finite() {
+                heaviest = heaviest.next_up();
+            }
+        }
+        (f32::from_bits(self.load_min_bits), heaviest)
     }
 
     /// The contact strip on request: half-width b (m, eq 22) and peak pressure p0
@@ -195,7 +230,7 @@ impl LineScene {
     /// As [`LineScene::estimate`].
     pub fn details(&self, load: f32, phi: f32) -> Result<LineDetails, Error> {
         check(load, phi)?;
-        if phi.abs() >= FRAC_PI_2 {
+        if phi.abs() > FRAC_PI_2 {
             return Err(Error::Angle);
         }
         let root = if load == 0.0 {
@@ -218,6 +253,14 @@ pub struct LineDetails {
     pub b: f32,
     /// Peak pressure p0 = 2 P / (pi b) (Pa), P per unit length.
     pub p0: f32,
+}
+
+/// phi0 if it is an angle between two axes (at most f32's pi/2, which stands for pi/2),
+/// else `None`: eq (28) passes pi/2 only at extreme loads per length, where no angle
+/// reaches gross slip. One compare on the bits.
+#[inline(always)]
+pub(super) fn within_right_angle(phi0: f32) -> Option<f32> {
+    (phi0.to_bits() <= FRAC_PI_2.to_bits()).then_some(phi0)
 }
 
 fn square(x: f64) -> f64 {

@@ -551,7 +551,7 @@ fn angle_line_below(
     if at {
         // Gross slip needs |phi| >= phi0; the forward solution takes |phi| < pi/2 only
         // (phi0 overflows to inf where mu or P / R is extreme).
-        return if phi0 < FRAC_PI_2 {
+        return if phi0 <= FRAC_PI_2 {
             Inverse::AtLeast { value: phi0 }
         } else {
             Inverse::Inconsistent(Inconsistency::AboveModel)
@@ -649,10 +649,10 @@ pub fn angle_estimate(scene: &Scene, load: f64, force: f64) -> Result<Inverse<f6
     let picks = |phi: f64, model: ContactModel| {
         super::estimate(scene, load, phi).is_ok_and(|e| e.model() == model)
     };
-    // The largest phi the forward solution takes: below pi/2 (|phi| >= pi/2 is refused)
-    // and, for eq (4), at most theta = pi/2. The ellipse is shortest there, so the
+    // The largest phi the forward solution takes: FRAC_PI_2 (the f64 below pi/2) and,
+    // for eq (4), at most theta = pi/2. The ellipse is shortest there, so the
     // elliptic model is chosen somewhere iff it is there.
-    let below_right_angle = FRAC_PI_2 * (1.0 - f64::EPSILON);
+    let below_right_angle = FRAC_PI_2;
     let phi_max = match scene.theta_relation() {
         ThetaRelation::SmallAngle => libm::fmin(
             FRAC_PI_2 / scene.radius_factor() * (1.0 - 4.0 * f64::EPSILON),

@@ -155,7 +155,8 @@ pub struct Elliptic {
     /// Axial force F (N) with the sign of phi, eq (21).
     pub axial_force: f64,
     /// Critical angle phi0 (rad) at this load, where d/b = 1 (eqs 18, 30); `None`
-    /// when no theta <= pi/2 reaches d/b = 1.
+    /// when no theta <= pi/2 reaches d/b = 1, or when phi0 = theta0 / c (eq 4) would
+    /// lie beyond pi/2 (unequal radii): no angle between two axes reaches gross slip.
     pub critical_angle: Option<f64>,
     /// Auxiliary angle at the critical angle, theta0 (rad).
     pub critical_theta: Option<f64>,
@@ -193,8 +194,9 @@ pub struct Line {
     pub regime: Regime,
     /// Axial force per unit length F (N/m) with the sign of phi, eqs (27), (29).
     pub axial_force: f64,
-    /// Critical angle phi0 (rad), eq (28).
-    pub critical_angle: f64,
+    /// Critical angle phi0 (rad), eq (28); `None` where eq (28) gives more than pi/2
+    /// (an extreme load per length): no angle between two axes reaches gross slip.
+    pub critical_angle: Option<f64>,
     /// Critical load per unit length (N/m) at this phi.
     pub critical_load: f64,
     /// Where the theory is stretched.
@@ -258,7 +260,7 @@ impl Solution {
     pub fn critical_angle(&self) -> Option<f64> {
         match self {
             Solution::Elliptic(e) => e.critical_angle,
-            Solution::Line(l) => Some(l.critical_angle),
+            Solution::Line(l) => l.critical_angle,
         }
     }
     /// Validity flags.
@@ -283,8 +285,10 @@ fn check_sample(load: f64, phi: f64) -> Result<(), Error> {
     if !(load.is_finite() && load >= 0.0) {
         return Err(Error::Load);
     }
-    // The angle between two axes is below a right angle (NaN fails the compare).
-    if phi.is_nan() || libm::fabs(phi) >= FRAC_PI_2 {
+    // The angle between two axes is at most a right angle (theta = pi/2 at c = 1: m = n
+    // = 1, crossed cylinders). Every f64 up to FRAC_PI_2, which lies below the true
+    // pi/2, is accepted (NaN fails the compare).
+    if phi.is_nan() || libm::fabs(phi) > FRAC_PI_2 {
         return Err(Error::Angle);
     }
     Ok(())
@@ -340,14 +344,15 @@ fn phi_of_theta(scene: &Scene, theta: f64) -> f64 {
 
 /// Critical angle at `load`: the phi >= 0 with d/b = 1 (eq 15 = 1, i.e. eq 30
 /// `phi0 = 2 mu p0 / G` with p0 at phi0). Returns `(phi0, theta0)`, or `None` when
-/// d/b stays below 1 up to theta = pi/2 (or, for the exact relation, phi = pi/2).
+/// d/b stays below 1 up to theta = pi/2 or up to phi = pi/2 (theta0 / c beyond pi/2
+/// for unequal radii under eq 4): no angle between two axes reaches gross slip.
 pub fn critical_angle(scene: &Scene, load: f64) -> Option<(f64, f64)> {
     angle_at_slip_ratio(scene, load, 1.0)
 }
 
 /// The phi >= 0 (and its theta) at which eq (16) gives the slip ratio `slip_ratio`
 /// (> 0) at `load`; [`critical_angle`] is the case d/b = 1, the inverses of
-/// [`inverse`] use the others. `None` when no theta <= pi/2 reaches it.
+/// [`inverse`] use the others. `None` when no theta <= pi/2 and phi <= pi/2 reaches it.
 fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64, f64)> {
     if load == 0.0 {
         return Some((0.0, 0.0));
@@ -373,7 +378,7 @@ fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64
     if c * target < normal::small_theta_g_limit() {
         // theta0 < 1e-100: the asymptotics, where sin phi = phi exactly (both relations).
         let theta0 = normal::small_theta_for_g(c * target);
-        return Some((theta0 / c, theta0));
+        return within_right_angle(theta0 / c, theta0);
     }
     let theta_max = match scene.theta_relation() {
         ThetaRelation::SmallAngle => FRAC_PI_2,
@@ -398,7 +403,13 @@ fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64
     let (_, theta0) =
         normal::kprime_for_mn_phi(target, phi, libm::fmin(seed, kprime_max), kprime_max)?;
     let theta0 = libm::fmin(theta0, theta_max);
-    Some((phi_of_theta(scene, theta0), theta0))
+    within_right_angle(phi_of_theta(scene, theta0), theta0)
+}
+
+/// `(phi, theta)` if phi is an angle between two axes (at most pi/2; FRAC_PI_2 lies
+/// below it), else `None`: under eq (4) with unequal radii theta / c can exceed it.
+fn within_right_angle(phi: f64, theta: f64) -> Option<(f64, f64)> {
+    (phi <= FRAC_PI_2).then_some((phi, theta))
 }
 
 /// The elliptic solution (sections 5-7) for load `load` (N) and misalignment `phi`
@@ -406,7 +417,7 @@ fn angle_at_slip_ratio(scene: &Scene, load: f64, slip_ratio: f64) -> Option<(f64
 /// zero load gives a = b = p0 = F = 0, d/b = inf (gross slip), phi0 = 0.
 ///
 /// # Errors
-/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| >= pi/2,
+/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| above pi/2,
 /// [`Error::PlaneHasNoEllipse`] for a plane.
 pub fn elliptic(scene: &Scene, load: f64, phi: f64) -> Result<Elliptic, Error> {
     check_sample(load, phi)?;
@@ -511,7 +522,7 @@ impl Elliptic {
 /// Zero angle: d/b = 0, F = 0. Zero load: b = p0 = F = phi0 = 0, d/b = inf.
 ///
 /// # Errors
-/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| >= pi/2.
+/// [`Error::Load`], [`Error::Angle`] for undefined input or |phi| above pi/2.
 pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
     check_sample(load, phi)?;
     let (g_mod, nu, mu) = (
@@ -528,7 +539,8 @@ pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
         line::slip_ratio(load, nu, g_mod, radius, mu, phi)
     };
     let p0star = line::critical_nondimensional_load(phi, mu);
-    let critical_angle = line::critical_angle(load, nu, g_mod, radius, mu);
+    let critical_angle =
+        Some(line::critical_angle(load, nu, g_mod, radius, mu)).filter(|&p| p <= FRAC_PI_2);
     Ok(Line {
         phi,
         load,
@@ -544,7 +556,8 @@ pub fn line(scene: &Scene, load: f64, phi: f64) -> Result<Line, Error> {
         critical_angle,
         critical_load: chain::chain(&[p0star, 1.0 - nu, g_mod, radius], &[]),
         validity: Validity {
-            large_angle: libm::fabs(phi) > ANGLE_LIMIT || critical_angle > ANGLE_LIMIT,
+            large_angle: libm::fabs(phi) > ANGLE_LIMIT
+                || critical_angle.is_none_or(|p| p > ANGLE_LIMIT),
             high_pressure: p0 / g_mod > PRESSURE_LIMIT,
             longer_than_rollers: false,
             near_model_switch: false,

@@ -42,9 +42,40 @@ pub fn num(row: &Row, key: &str) -> f64 {
         .unwrap_or_else(|_| panic!("column {key}: {:?}", row[key]))
 }
 
-/// Relative error of `got` against `want`; exact zeros and equal infinities give 0.
+/// The data's phi0 (rad), NaN where it passes pi/2: eq (4) with unequal radii gives
+/// phi0 = theta0 / c beyond a right angle while theta0 is below it, where every model
+/// answers no critical angle (NaN in the CSV tools' and the batch's numbers).
+pub fn phi0(row: &Row) -> f64 {
+    let p = num(row, "phi0");
+    if p > core::f64::consts::FRAC_PI_2 {
+        f64::NAN
+    } else {
+        p
+    }
+}
+
+/// The data's theta0, NaN where its phi0 passes pi/2 (no critical angle: [`phi0`]).
+pub fn theta0(row: &Row) -> f64 {
+    if phi0(row).is_nan() {
+        f64::NAN
+    } else {
+        num(row, "theta0")
+    }
+}
+
+/// A number of the CSV tools' output: an empty field (no value) is NaN.
+pub fn num_or_nan(row: &Row, key: &str) -> f64 {
+    if row[key].is_empty() {
+        f64::NAN
+    } else {
+        num(row, key)
+    }
+}
+
+/// Relative error of `got` against `want`; exact zeros, equal infinities and two NaN
+/// (both "none", see [`phi0`]) give 0.
 pub fn rel_err(got: f64, want: f64) -> f64 {
-    if got == want {
+    if got == want || (got.is_nan() && want.is_nan()) {
         0.0
     } else {
         ((got - want) / want).abs()

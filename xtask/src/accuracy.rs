@@ -9,7 +9,7 @@
 //! them exactly (up to 1 234 567 891 counts, so that log2 of the counts is not exact),
 //! so that what is measured is the core's arithmetic, not a sensor's quantisation.
 
-use crate::bench::{Record, f32s, fixed3, num, read, rel, scene, signed};
+use crate::bench::{Record, data, f32s, fixed3, num, read, rel, scene, signed};
 use crate::records::{self, AccuracyRow};
 use misalign::fixed::{FixedEllipticScene, FixedLineScene, exact_lsb};
 use misalign::float::{EllipticScene, LineScene};
@@ -49,7 +49,7 @@ impl Worst {
 
     /// Keeps the worst error of `quantity` (NaN counts as infinite).
     fn add(&mut self, quantity: &'static str, got: f64, row: &Record) {
-        let e = rel(got, num(row, quantity));
+        let e = rel(got, data(row, quantity));
         let e = if e.is_nan() { f64::INFINITY } else { e };
         match self.errors.iter_mut().find(|(q, _)| *q == quantity) {
             Some(slot) => slot.1 = slot.1.max(e),
@@ -129,7 +129,14 @@ pub fn measure() -> Result<Vec<AccuracyRow>, String> {
         let s = scene(row);
         let (p, phi) = (num(row, "P"), num(row, "phi"));
         let r = reference::line(&s, p, phi).map_err(err)?;
-        reference_line.add3((r.slip_ratio, r.axial_force, r.critical_angle), row);
+        reference_line.add3(
+            (
+                r.slip_ratio,
+                r.axial_force,
+                r.critical_angle.unwrap_or(f64::NAN),
+            ),
+            row,
+        );
         reference_line.add("b", r.b, row);
         reference_line.add("p0", r.p0, row);
         let core = LineScene::new(&s).map_err(err)?;

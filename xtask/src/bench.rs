@@ -31,7 +31,7 @@ use std::process::ExitCode;
 
 /// Relative error of `got` against `want`; equal values (zeros, infinities) give 0.
 pub fn rel(got: f64, want: f64) -> f64 {
-    if got == want {
+    if got == want || (got.is_nan() && want.is_nan()) {
         0.0
     } else {
         ((got - want) / want).abs()
@@ -78,7 +78,18 @@ pub fn scene(row: &Record) -> Scene {
 fn worst3(got: (f64, f64, f64), row: &Record) -> f64 {
     rel(got.0, num(row, "s"))
         .max(rel(got.1, num(row, "F")))
-        .max(rel(got.2, num(row, "phi0")))
+        .max(rel(got.2, data(row, "phi0")))
+}
+
+/// A reference row's value of `quantity`; phi0 beyond pi/2 (theta0 / c of eq 4 with
+/// unequal radii) is NaN, as every model answers no critical angle there.
+pub fn data(row: &Record, quantity: &str) -> f64 {
+    let x = num(row, quantity);
+    if quantity == "phi0" && x > std::f64::consts::FRAC_PI_2 {
+        f64::NAN
+    } else {
+        x
+    }
 }
 
 /// Angle counts with the sign of phi.
@@ -208,9 +219,13 @@ fn monitor_errors(e: &mut Errors) -> Result<(), String> {
     let worst = |reading: &Reading| -> f64 {
         let (p, phi) = (f64::from(reading.load), f64::from(reading.phi));
         let want = match choice {
-            ModelChoice::Line => {
-                reference::line(&s, p, phi).map(|r| (r.slip_ratio, r.axial_force, r.critical_angle))
-            }
+            ModelChoice::Line => reference::line(&s, p, phi).map(|r| {
+                (
+                    r.slip_ratio,
+                    r.axial_force,
+                    r.critical_angle.unwrap_or(f64::NAN),
+                )
+            }),
             _ => reference::elliptic(&s, p, phi).map(|r| {
                 let c = r.critical_angle.unwrap_or(f64::NAN);
                 (r.slip_ratio, r.axial_force, c)
@@ -297,7 +312,11 @@ fn line_errors(e: &mut Errors, row: &Record) -> Result<(), String> {
     let s = scene(row);
     let (p, phi) = (num(row, "P"), num(row, "phi"));
     let r = reference::line(&s, p, phi).map_err(|e| e.to_string())?;
-    let r3 = (r.slip_ratio, r.axial_force, r.critical_angle);
+    let r3 = (
+        r.slip_ratio,
+        r.axial_force,
+        r.critical_angle.unwrap_or(f64::NAN),
+    );
     put(
         e,
         Model::Reference,

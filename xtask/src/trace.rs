@@ -82,7 +82,7 @@ pub fn source() -> String {
         .map(|&(p, phi)| {
             let l = reference::line(&scene, p as f64, phi as f64)
                 .unwrap_or_else(|err| panic!("reference::line({p}, {phi}): {err:?}"));
-            (l.slip_ratio, l.axial_force, Some(l.critical_angle), phi)
+            (l.slip_ratio, l.axial_force, l.critical_angle, phi)
         })
         .collect();
     let mut text = String::from(HEADER);

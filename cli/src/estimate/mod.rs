@@ -335,7 +335,7 @@ fn reference_row(x: &Sample) -> Result<Answer, String> {
                 p0: Some(Num::F64(l.p0)),
                 s: Some(Num::F64(l.slip_ratio)),
                 force: f,
-                phi0: Some(Num::F64(l.critical_angle)),
+                phi0: l.critical_angle.map(Num::F64),
                 regime: l.regime.as_str(),
                 pstar: Some(Num::F64(l.pstar)),
                 p0star: Some(Num::F64(l.p0star)),
@@ -347,7 +347,7 @@ fn reference_row(x: &Sample) -> Result<Answer, String> {
             Ok(Answer {
                 row,
                 validity: l.validity,
-                no_critical_angle: false,
+                no_critical_angle: l.critical_angle.is_none(),
             })
         }
     }
