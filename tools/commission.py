@@ -15,7 +15,8 @@ them back, commits, checks that the node runs them, and prints the node's status
   `fixed::FixedAuto`) by `cargo run --release --example prepare`; or `--prepared B`:
   bytes that `examples/prepare.rs --out` wrote.
 - `--config C.csv`: `name,value` lines, a `config_*` register of the map (the prefix may
-  be left out) or `new_code`; `--set NAME=VALUE` adds or overrides one.
+  be left out, here and in `--set`) or `new_code`; `--set NAME=VALUE` adds or
+  overrides one.
   `cargo xtask modbus --default-config C.csv` writes the defaults.
 - `--thresholds T.csv`: the planner's table (`P,phi0,phi_warning,...`). It holds no
   register (its angles follow from the scene and the configuration's thresholds): it is
@@ -165,6 +166,11 @@ def commission(node, code, settings, scene):
 STATES = {0: "stopped", 1: "normal", 2: "microslip", 3: "gross slip", 4: "sensor fault"}
 
 
+def register(name):
+    """A configuration register's name: `config_` added to a field's name."""
+    return name if name == "new_code" or name.startswith("config_") else "config_" + name
+
+
 def read_config(path):
     """`name,value` lines (a header `name,value`, blank lines and `#` comments allowed)."""
     out = []
@@ -176,10 +182,7 @@ def read_config(path):
                 continue
             if len(row) != 2:
                 raise Failed(f"{path}:{n}: name,value")
-            name, value = row[0].strip(), row[1].strip()
-            if name != "new_code" and not name.startswith("config_"):
-                name = "config_" + name
-            out.append((name, value))
+            out.append((register(row[0].strip()), row[1].strip()))
     return out
 
 
@@ -302,7 +305,7 @@ def main():
             name, eq, value = s.partition("=")
             if not eq:
                 p.error(f"--set {s}: NAME=VALUE")
-            settings.append((name, value))
+            settings.append((register(name.strip()), value.strip()))
         if args.scene:
             scene = prepare(read_scene(args.scene), args.core)
         else:
