@@ -22,8 +22,11 @@ them back, commits, checks that the node runs them, and prints the node's status
   register (its angles follow from the scene and the configuration's thresholds): it is
   checked against the configuration the node will run, its loads within the stop load
   and the highest accepted load, and its alarm angles summed up on the way.
-- `--events OUT.csv`: the events the node holds, their registers raw
-  (`event,w0,...`), read without acknowledging them.
+- `--events OUT.csv`: the events the node holds, in the monitor example's `--events`
+  format (decoded as `misalign::modbus::event_from_registers` does), from its
+  `event_from` or `--events-from SEQ`; read through the window, `event_from` put back,
+  nothing acknowledged.
+- Without `--code`, nothing is written: the node's status and events only.
 
 Register names and types come from the register map (`--registers`, default
 docs/modbus/registers.csv); 32-bit values high word first. Exit status 0 when the node
@@ -34,6 +37,7 @@ Needs pymodbus (3.16).
 
 import argparse
 import csv
+import math
 import os
 import subprocess
 import tempfile
@@ -101,6 +105,12 @@ class Node:
         """The exception code, or None."""
         answer = self.c.write_registers(int(self.row(name)["address"]), words, device_id=self.unit)
         return answer.exception_code if answer.isError() else None
+
+    def write_plain(self, name, words):
+        """A holding register that needs no unlock (`event_from`)."""
+        answer = self.c.write_registers(int(self.row(name)["address"]), words, device_id=self.unit)
+        if answer.isError():
+            raise Failed(f"write {name}: {answer}")
 
     def write_words(self, address, words):
         for i in range(0, len(words), 120):
@@ -237,8 +247,103 @@ def check_thresholds(node, path, settings):
     return f"thresholds planned for {min(loads):.4g} to {max(loads):.4g} N{at}"
 
 
-def status(node, events_out):
-    """The node's status as lines; its held events (raw registers) into `events_out`."""
+RISK = ["stopped", "normal", "microslip", "gross_slip", "sensor_fault"]
+KINDS = {1: "state", 2: "approaching", 3: "friction_changed", 4: "friction_cleared"}
+CHANNELS = ["Load", "Angle", "Speed", "AxialForce"]
+FAULTS = {1: "NonFinite", 2: "OutOfRange", 3: "Stuck", 6: "Driver"}
+NONE = 0x7FC00000  # the map's sentinel of an absent value
+
+
+def rust(x):
+    """A number as Rust's Display prints it: the shortest digits that read back to
+    the same value, without an exponent."""
+    if x != x:
+        return "NaN"
+    if x in (float("inf"), float("-inf")):
+        return "inf" if x > 0 else "-inf"
+    from decimal import Decimal
+    text = format(Decimal(repr(x)).normalize(), "f")
+    return "-0" if text == "0" and math.copysign(1, x) < 0 else text
+
+
+def rust_f32(bits):
+    """An f32 (its bit pattern) as Rust's Display prints it."""
+    x = struct.unpack(">f", struct.pack(">I", bits))[0]
+    for digits in range(1, 10):
+        short = float(f"{x:.{digits}g}")
+        if x != x or struct.pack(">f", short) == struct.pack(">I", bits):
+            return rust(short) if x == x else "NaN"
+    return rust(x)
+
+
+def fault(code):
+    """A fault code as the monitor's Debug name (`misalign::modbus::fault_from_code`)."""
+    kind, low = code >> 8, code & 0xFF
+    if code == 0:
+        return ""
+    if kind in FAULTS and low < len(CHANNELS):
+        return f"{FAULTS[kind]}({CHANNELS[low]})"
+    return {0x400: "Gap", 0x500: "TimeBackwards", 0x700: "Estimator"}.get(code, f"code {code:#06x}")
+
+
+def event_row(w):
+    """One event slot's registers as a row of the monitor example's --events file."""
+    u32_at = lambda i: w[i] << 16 | w[i + 1]  # noqa: E731
+    opt = lambda i: "" if u32_at(i) == NONE else rust_f32(u32_at(i))  # noqa: E731
+    kind = KINDS.get(w[7])
+    if kind is None:
+        raise Failed(f"event {u32_at(0)}: kind {w[7]}")
+    state, frm, why, ttc = "", "", "", ""
+    if w[7] == 1:
+        state, frm, why = RISK[w[9]], RISK[w[8]], fault(w[10])
+    elif w[7] == 2:
+        ttc = rust_f32(u32_at(11))
+    else:
+        state = "mu=" + rust_f32(u32_at(11))
+    reading = ["", "", "", "", "", ""] if w[7] >= 3 else [
+        rust_f32(u32_at(13)), rust_f32(u32_at(15)), rust_f32(u32_at(17)), rust_f32(u32_at(19)),
+        opt(21), opt(23)]
+    t = rust((u32_at(4) * 1000 + w[6]) / 1e3)
+    return [t, str(u32_at(0)), state, frm, kind, why, *reading, ttc, str(u32_at(2))]
+
+
+EVENTS_HEADER = "t,seq,state,from,kind,fault,P,phi,s,F,phi0,margin,time_to_critical,time_ms"
+
+
+def held_events(node, start):
+    """Every event the node holds from sequence number `start` (None: from its own
+    `event_from`), read through the window; `event_from` is put back as it was (reading
+    acknowledges nothing)."""
+    event_from = node.read("event_from")
+    first_at = int(node.row("event_first", "input")["address"])
+    slot0 = int(node.row("event_0_seq", "input")["address"])
+    stride = int(node.row("event_1_seq", "input")["address"]) - slot0
+    slots = sum(1 for (t, n) in node.rows if t == "input" and n.startswith("event_") and n.endswith("_seq"))
+    if start is not None:
+        node.write_plain("event_from", [start >> 16, start & 0xFFFF])
+    held = []
+    try:
+        while True:
+            answer = node.c.read_input_registers(first_at, count=slot0 + slots * stride - first_at,
+                                                 device_id=node.unit)
+            if answer.isError():
+                raise Failed(f"the event window: {answer}")
+            w = answer.registers
+            count = w[int(node.row("event_count", "input")["address"]) - first_at]
+            for k in range(count):
+                at = slot0 - first_at + k * stride
+                held.append(w[at:at + stride])
+            if count < slots:
+                return held
+            nxt = (u32(w[0:2]) + count) & 0xFFFFFFFF
+            node.write_plain("event_from", [nxt >> 16, nxt & 0xFFFF])
+    finally:
+        node.write_plain("event_from", event_from)
+
+
+def status(node, events_out, events_from):
+    """The node's status as lines; the events it holds into `events_out` (the monitor
+    example's --events format)."""
     s = node.read("status", "input")[0]
     lines = [
         f"state {STATES.get(s & 0xFF, s & 0xFF)}, config_source {node.read('config_source')[0]}, "
@@ -247,22 +352,14 @@ def status(node, events_out):
         f"events_dropped {u32(node.read('events_dropped', 'input'))}, "
         f"event_seq_next {u32(node.read('event_seq_next', 'input'))}",
     ]
-    slot0 = int(node.row("event_0_seq", "input")["address"])
-    stride = int(node.row("event_1_seq", "input")["address"]) - slot0
-    count = node.read("event_count", "input")[0]
-    held = []
-    for k in range(count):
-        answer = node.c.read_input_registers(slot0 + k * stride, count=stride, device_id=node.unit)
-        if answer.isError():
-            raise Failed(f"event slot {k}: {answer}")
-        held.append(answer.registers)
-    lines.append(f"{count} events held from {u32(node.read('event_first', 'input'))}")
+    held = held_events(node, events_from)
+    first = f" from {u32(held[0][0:2])}" if held else ""
+    lines.append(f"{len(held)} events held{first}")
     if events_out:
         with open(events_out, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["event"] + [f"w{k}" for k in range(stride)])
-            for k, e in enumerate(held):
-                w.writerow([k] + list(e))
+            f.write(EVENTS_HEADER + "\n")
+            for e in held:
+                f.write(",".join(event_row(e)) + "\n")
     return lines
 
 
@@ -273,7 +370,7 @@ def main():
     p.add_argument("--baud", type=int, default=19200)
     p.add_argument("--unit", type=int, default=1)
     p.add_argument("--registers", default="docs/modbus/registers.csv")
-    p.add_argument("--code", type=int, required=True, help="the site's code")
+    p.add_argument("--code", type=int, help="the site's code (without it: the status only)")
     p.add_argument("--scene", help="the monitor example's scene file (R1,R2,G,nu,mu[,length])")
     p.add_argument("--core", choices=["f32", "fixed"], default="f32",
                    help="the node's core, for --scene (default f32)")
@@ -282,7 +379,10 @@ def main():
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="a configuration register (config_*, new_code) and its value")
     p.add_argument("--thresholds", help="the monitor example's --thresholds table, checked")
-    p.add_argument("--events", metavar="OUT.csv", help="the events the node holds, raw")
+    p.add_argument("--events", metavar="OUT.csv",
+                   help="the events the node holds, as the monitor example's --events")
+    p.add_argument("--events-from", type=int, metavar="SEQ",
+                   help="read the events from this sequence number (default: event_from)")
     args = p.parse_args()
     if args.scene and args.prepared:
         p.error("--scene or --prepared, not both")
@@ -319,15 +419,19 @@ def main():
     try:
         node = Node(client, args.registers, args.unit)
         planned = check_thresholds(node, args.thresholds, settings) if args.thresholds else None
-        source = commission(node, args.code, settings, scene)
-        lines = status(node, args.events)
+        if args.code is not None:
+            source = commission(node, args.code, settings, scene)
+        elif settings or scene:
+            raise Failed("writing needs the site's code (--code)")
+        lines = status(node, args.events, args.events_from)
     except Failed as e:
         print(f"commission: {e}", file=sys.stderr)
         return 1
     finally:
         client.close()
-    print(f"commissioned: {len(settings)} registers{' and the scene' if scene else ''} committed, "
-          f"config_source {source}")
+    if args.code is not None:
+        print(f"commissioned: {len(settings)} registers{' and the scene' if scene else ''} "
+              f"committed, config_source {source}")
     if planned:
         print(planned)
     for line in lines:

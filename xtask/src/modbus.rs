@@ -552,11 +552,42 @@ fn trace(
         .arg(&raw)
         .status()
         .map_err(|e| format!("master.py: {e}"))?;
-    drop(booted);
     if !status.success() {
         return Err(format!("the master failed: {status}"));
     }
+    // The events as the commissioning tool reads and decodes them (no code: status
+    // only), from the first: those the node still holds, the host's last ones.
+    let decoded = dir.join("trace-events-tool.csv");
+    let status = Command::new(&python)
+        .current_dir(crate::root())
+        .arg("tools/commission.py")
+        .arg("--tcp")
+        .arg(format!("127.0.0.1:{}", booted.port))
+        .arg("--registers")
+        .arg(&registers)
+        .args(["--events-from", "0", "--events"])
+        .arg(&decoded)
+        .status()
+        .map_err(|e| format!("commission.py: {e}"))?;
+    drop(booted);
+    if !status.success() {
+        return Err(format!(
+            "reading the events with commission.py failed: {status}"
+        ));
+    }
     let compared = host::compare_events(core, &samples, &raw)?;
+    let tool =
+        std::fs::read_to_string(&decoded).map_err(|e| format!("{}: {e}", decoded.display()))?;
+    let tool: Vec<&str> = tool.lines().collect();
+    let host: Vec<&str> = compared.csv.lines().collect();
+    let held = compared.events.min(misalign::modbus::EVENT_WINDOW);
+    if tool.len() != held + 1 || tool[0] != host[0] || tool[1..] != host[host.len() - held..] {
+        return Err(format!(
+            "tools/commission.py --events wrote {} rather than the last {held} of the host's \
+             events",
+            decoded.display()
+        ));
+    }
     std::fs::write(events, &compared.csv).map_err(|e| format!("{events}: {e}"))?;
     println!(
         "{} samples fed over Modbus to the {} node, {} events read back: the host replay's, \
