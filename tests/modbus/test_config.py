@@ -126,30 +126,64 @@ def commission(client, *args):
     client.close()
     time.sleep(0.1)
     done = subprocess.run(
-        [sys.executable, "tools/commission.py", "--port", os.environ["MODBUS_PORT"],
+        [sys.executable, "tools/commission.py", "--tcp", f"127.0.0.1:{os.environ['MODBUS_PORT']}",
          "--registers", os.environ["MODBUS_REGISTERS"], *args],
-        capture_output=True, text=True, timeout=60)
+        capture_output=True, text=True, timeout=900)
     time.sleep(0.1)
     assert client.connect()
-    return done.returncode, done.stderr
+    return done.returncode, done.stderr + done.stdout
 
 
 def test_the_commissioning_tool_writes_a_scene_the_node_was_not_built_with(client):
     scene = open(os.environ["MODBUS_SCENE"], "rb").read()
     crc = int.from_bytes(scene[-4:], "little")
     assert get(client, "scene_active_crc") != crc
-    status, err = commission(client, "--code", str((code() + 1) & 0xFFFF), "--scene", os.environ["MODBUS_SCENE"])
+    status, err = commission(client, "--code", str((code() + 1) & 0xFFFF), "--prepared", os.environ["MODBUS_SCENE"])
     assert status == 1 and "wrong code" in err, err
     status, err = commission(client, "--code", str(code()), "--set", "config_warning=2.5")
     assert status == 1 and "commit refused" in err and "0x11" in err, err
     assert get(client, "staged") == 0 and get(client, "unlock") == 0  # reverted and locked
-    status, err = commission(client, "--code", str(code()), "--scene", os.environ["MODBUS_SCENE"],
+    status, err = commission(client, "--code", str(code()), "--prepared", os.environ["MODBUS_SCENE"],
                              "--set", "config_off_delay=45000", "--set", "config_alarm=1.1")
     assert status == 0, err
     assert get(client, "scene_active_crc") == crc
     assert get(client, "active_off_delay") == 45000
     assert get(client, "active_alarm") == f32(1.1)
     assert get(client, "config_source") == 1
+
+
+PLANNED = "P,phi0,phi_warning,phi_warning_clear,phi_alarm,phi_alarm_clear\n"
+
+
+def test_the_commissioning_tool_takes_what_an_engineer_planned(client, tmp_path):
+    """A scene file (prepared by the tool), a configuration file and the planner's
+    table in; the node runs them; a table planned for other loads is refused."""
+    scene = tmp_path / "scene.csv"
+    scene.write_text("R1,R2,G,nu,mu,length\n0.06,0.04,79.3e9,0.3,0.25,0.02\n")
+    config = tmp_path / "config.csv"
+    config.write_text("name,value\n# on-delay and warning\nconfig_on_delay,6000\nwarning,0.75\n")
+    table = tmp_path / "thresholds.csv"
+    table.write_text(PLANNED + "500,0.0006,0.0004,0.00038,0.0005,0.00048\n2000,0.0007,,,0.0006,\n")
+    wide = tmp_path / "wide.csv"
+    wide.write_text(PLANNED + "500,0.0006,0.0004,0.00038,0.0005,0.00048\n90000,0.0007,,,,\n")
+    crc = get(client, "scene_active_crc")
+    core = os.environ["MODBUS_CORE"]
+    status, err = commission(client, "--code", str(code()), "--scene", str(scene), "--core", core,
+                             "--config", str(config), "--thresholds", str(wide))
+    assert status == 1 and "planned with another configuration" in err, err
+    assert get(client, "staged") == 0 and get(client, "active_on_delay") != 6000
+    events = tmp_path / "events.csv"
+    status, out = commission(client, "--code", str(code()), "--scene", str(scene), "--core", core,
+                             "--config", str(config), "--thresholds", str(table),
+                             "--events", str(events))
+    assert status == 0, out
+    assert "thresholds planned for 500 to 2000 N" in out and "events held" in out, out
+    assert get(client, "active_on_delay") == 6000
+    assert get(client, "active_warning") == f32(0.75)
+    assert get(client, "scene_active_crc") not in (0, crc)
+    held = events.read_text().splitlines()
+    assert held[0] == "t,seq,state,from,kind,fault,P,phi,s,F,phi0,margin,time_to_critical,time_ms"
+    assert len(held) - 1 == int(out.split(" events held")[0].split()[-1]) > 0, out
 
 
 # Last: the lock-out lasts minutes of the node's time.

@@ -15,6 +15,11 @@
 //! - `--trace T.csv --scene S.csv --events OUT.csv [--model f32|fixed] [--target
 //!   TRIPLE]`: feeds a trace to the node over Modbus, reads its events back, writes
 //!   them as `examples/monitor --events` does and compares them with the host replay.
+//!   Before the trace, the node is commissioned over the bus (tools/commission.py:
+//!   unlock, the scene prepared for its core and the default configuration, commit,
+//!   read back), so any scene goes; the host replays through the same prepared scene.
+//! - `--default-config C.csv`: writes the default configuration as
+//!   tools/commission.py's `--config` file.
 //! - `--registers`: writes `docs/modbus/registers.csv` from the library.
 //! - `--measure`: what the server costs on the Cortex-M0 and the Cortex-M4F (flash,
 //!   RAM, instructions per request; harness images `modbus_node` against
@@ -117,6 +122,10 @@ pub struct Args {
     /// Write docs/modbus/registers.csv from the library's register map.
     #[arg(long, conflicts_with_all = ["boards", "measure"])]
     registers: bool,
+    /// Write the default configuration (`Config::default()`) as tools/commission.py's
+    /// --config file (`name,value`).
+    #[arg(long, value_name = "C.csv", conflicts_with_all = ["boards", "measure", "trace", "serve"])]
+    default_config: Option<String>,
     /// Measure flash, RAM and instructions per request; write docs/modbus-cost.csv and
     /// its table.
     #[arg(long, conflicts_with = "boards")]
@@ -127,6 +136,8 @@ pub struct Args {
 pub fn run(args: &Args) -> ExitCode {
     let result = if args.registers {
         registers()
+    } else if let Some(out) = &args.default_config {
+        default_config(out)
     } else if args.measure {
         measure()
     } else if let Some(port) = &args.serve {
@@ -149,6 +160,16 @@ pub fn run(args: &Args) -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `--default-config C.csv`: the default configuration, for tools/commission.py.
+fn default_config(out: &str) -> Result<(), String> {
+    let registers = crate::root().join("target/modbus/registers.csv");
+    std::fs::create_dir_all(registers.parent().unwrap()).map_err(|e| e.to_string())?;
+    std::fs::write(&registers, registers_text()?).map_err(|e| e.to_string())?;
+    host::write_default_config(&crate::node::core(true)?, &registers, Path::new(out))?;
+    println!("wrote {out}");
+    Ok(())
 }
 
 /// `--registers`: the register map as the library exports it.
@@ -421,7 +442,7 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         return Err(format!("pytest {}: {status}", tests.join(" ")));
     }
     if node.external {
-        let compared = host::compare_events(fpu, &host::scenario(), &file)?;
+        let compared = host::compare_events(crate::node::core(fpu)?, &host::scenario(), &file)?;
         println!(
             "  the {} events read over Modbus are the host replay's, bit for bit",
             compared.events
@@ -459,13 +480,6 @@ fn trace(
     let open = |p: &str| std::fs::File::open(p).map_err(|e| format!("{p}: {e}"));
     let scene = misalign_cli::monitor_input::read_scene(open(scene)?)
         .map_err(|e| format!("{scene}: {e}"))?;
-    if scene != host::node_scene()? {
-        return Err(
-            "the scene differs from the node's build-time scene (the built-in scenario's), and \
-             the node cannot yet be commissioned over the bus: refused"
-                .into(),
-        );
-    }
     let samples = misalign_cli::monitor_input::read_trace(open(trace)?)
         .map_err(|e| format!("{trace}: {e}"))?;
     let cpu = match (model, target) {
@@ -491,9 +505,36 @@ fn trace(
     let (python, dir, registers) = prepare()?;
     let samples_csv = dir.join("trace-samples.csv");
     host::write_samples(&samples_csv, &samples)?;
+    // The scene's estimator for the trace's operating range, as the monitor example
+    // builds it (`scenario::estimator_for` up to the largest finite load, at least the
+    // scenario's): its prepared bytes go to the node, and the host replays through it.
+    let load_max = samples
+        .iter()
+        .map(|s| f64::from(s.load))
+        .filter(|l| l.is_finite())
+        .fold(misalign::monitor::scenario::LOAD_MAX, f64::max);
+    let core = host::core_for(fpu, &scene, load_max)?;
+    let scene_bin = dir.join("trace-scene.bin");
+    host::write_prepared(&core, &scene_bin)?;
+    let config_csv = dir.join("trace-config.csv");
+    host::write_default_config(&core, &registers, &config_csv)?;
     let elf = build(&Node::on(cpu, true))?;
     let port = free_port()?;
     let booted = boot(cpu.machine, &elf, port, Duration::from_secs(300), false)?;
+    // Commissioned over the bus as on site: unlock, the prepared scene and the
+    // default configuration, commit, read back (tools/commission.py).
+    let code = misalign::modbus::DEFAULT_UNLOCK_CODE.to_string();
+    let (scene_bin, config_csv) = (scene_bin.as_os_str(), config_csv.as_os_str());
+    let args = [
+        "--code".as_ref(),
+        code.as_ref(),
+        "--prepared".as_ref(),
+        scene_bin,
+        "--config".as_ref(),
+        config_csv,
+    ];
+    commission_py(&python, booted.port, &registers, &args)
+        .map_err(|e| format!("commissioning the node failed: {e}"))?;
     let raw = dir.join("trace-events-raw.csv");
     let status = Command::new(&python)
         .arg(crate::root().join("tests/modbus/master.py"))
@@ -506,11 +547,39 @@ fn trace(
         .arg(&raw)
         .status()
         .map_err(|e| format!("master.py: {e}"))?;
-    drop(booted);
     if !status.success() {
         return Err(format!("the master failed: {status}"));
     }
-    let compared = host::compare_events(fpu, &samples, &raw)?;
+    // The events as the commissioning tool reads and decodes them (no code: status
+    // only), from the first: those the node still holds, the host's last ones.
+    let decoded = dir.join("trace-events-tool.csv");
+    let args = [
+        "--events-from".as_ref(),
+        "0".as_ref(),
+        "--events".as_ref(),
+        decoded.as_os_str(),
+    ];
+    let read = commission_py(&python, booted.port, &registers, &args);
+    drop(booted);
+    read.map_err(|e| format!("reading the events with commission.py failed: {e}"))?;
+    let compared = host::compare_events(core, &samples, &raw)?;
+    let tool =
+        std::fs::read_to_string(&decoded).map_err(|e| format!("{}: {e}", decoded.display()))?;
+    let tool: Vec<&str> = tool.lines().collect();
+    let host: Vec<&str> = compared.csv.lines().collect();
+    // Each row the host's of its sequence number (numbered from 0), and at least as
+    // many rows as the window holds.
+    let same = |row: &&str| {
+        let seq = row.split(',').nth(1).and_then(|q| q.parse::<usize>().ok());
+        seq.and_then(|q| host.get(q + 1)) == Some(row)
+    };
+    let held = compared.events.min(misalign::modbus::EVENT_WINDOW);
+    if tool.first() != host.first() || tool.len() < held + 1 || !tool[1..].iter().all(same) {
+        return Err(format!(
+            "tools/commission.py --events wrote {}: not {held} or more of the host's events",
+            decoded.display()
+        ));
+    }
     std::fs::write(events, &compared.csv).map_err(|e| format!("{events}: {e}"))?;
     println!(
         "{} samples fed over Modbus to the {} node, {} events read back: the host replay's, \
@@ -520,6 +589,31 @@ fn trace(
         compared.events
     );
     Ok(())
+}
+
+/// Runs tools/commission.py against the node on 127.0.0.1:`port` with `args` (its
+/// status lines on stdout).
+fn commission_py(
+    python: &Path,
+    port: u16,
+    registers: &Path,
+    args: &[&std::ffi::OsStr],
+) -> Result<(), String> {
+    let status = Command::new(python)
+        .current_dir(crate::root())
+        .arg("tools/commission.py")
+        .arg("--tcp")
+        .arg(format!("127.0.0.1:{port}"))
+        .arg("--registers")
+        .arg(registers)
+        .args(args)
+        .status()
+        .map_err(|e| format!("commission.py: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(status.to_string())
+    }
 }
 
 /// The host's side: what the node must answer, from the same samples through the same
@@ -536,10 +630,95 @@ mod host {
     use std::fmt::Write as _;
     use std::path::Path;
 
-    /// The node's build-time scene: the built-in scenario's.
-    pub fn node_scene() -> Result<misalign::Scene, String> {
-        let [r1, r2, g, nu, mu] = scenario::SCENE;
-        misalign::Scene::new(r1, r2, g, nu, mu).map_err(|e| e.to_string())
+    /// The node's estimator (`fpu`: the f32 core's `Auto`, else `FixedAuto`) for
+    /// `scene` up to `load_max` (N), as the monitor example builds it.
+    pub fn core_for(fpu: bool, scene: &misalign::Scene, load_max: f64) -> Result<Core, String> {
+        let err = |e: misalign::Error| e.to_string();
+        Ok(if fpu {
+            Core::F32(scenario::estimator_for(scene, load_max).map_err(err)?)
+        } else {
+            Core::Fixed(scenario::estimator_for(scene, load_max).map_err(err)?)
+        })
+    }
+
+    /// `core`'s prepared scene, as `examples/prepare.rs --out` writes it.
+    pub fn write_prepared(core: &Core, out: &Path) -> Result<(), String> {
+        fn bytes<C: PreparedScene>(core: &C) -> Vec<u8> {
+            let mut out = [0; misalign::modbus::SCENE_BYTES_MAX];
+            core.to_prepared(&mut out);
+            out[..C::BYTES].to_vec()
+        }
+        let bytes = match core {
+            Core::F32(c) => bytes(c),
+            Core::Fixed(c) => bytes(c),
+        };
+        std::fs::write(out, bytes).map_err(|e| format!("{}: {e}", out.display()))
+    }
+
+    /// The default configuration (`Config::default()`) as tools/commission.py's
+    /// `--config` file (`name,value`, one `config_*` register a line), read through
+    /// the library's server from its staged view, which reads as the active one
+    /// before a first write. `registers`: the map's CSV, for the names and types.
+    pub fn write_default_config(core: &Core, registers: &Path, out: &Path) -> Result<(), String> {
+        let map = std::fs::read_to_string(registers)
+            .map_err(|e| format!("{}: {e}", registers.display()))?;
+        let mut rows = Vec::new();
+        for line in map.lines().skip(1) {
+            let cells: Vec<&str> = line.splitn(8, ',').collect();
+            // The staged registers (config_source is the running one's origin).
+            if let [table, address, name, ty, _, _, access, _] = cells[..]
+                && table == "holding"
+                && name.starts_with("config_")
+                && access == "rw"
+            {
+                let at = address.parse::<u16>().map_err(|e| format!("{name}: {e}"))?;
+                rows.push((at, name, ty));
+            }
+        }
+        let start = rows
+            .iter()
+            .map(|r| r.0)
+            .min()
+            .ok_or("the map has no config_*")?;
+        let words = match core {
+            Core::F32(c) => config_view(*c, start)?,
+            Core::Fixed(c) => config_view(*c, start)?,
+        };
+        let mut text = String::from("name,value\n");
+        for (at, name, ty) in rows {
+            let i = usize::from(at - start);
+            let word = |k: usize| words.get(i + k).copied().ok_or("config_* past the view");
+            let u32_at =
+                || -> Result<u32, &str> { Ok(u32::from(word(0)?) << 16 | u32::from(word(1)?)) };
+            let value = match ty {
+                "u16" => word(0)?.to_string(),
+                "u32" => u32_at()?.to_string(),
+                "i32" => (u32_at()? as i32).to_string(),
+                // Rust's shortest form that reads back to the same f32.
+                "f32" => f32::from_bits(u32_at()?).to_string(),
+                _ => return Err(format!("{name}: type {ty}")),
+            };
+            writeln!(text, "{name},{value}").unwrap();
+        }
+        std::fs::write(out, text).map_err(|e| format!("{}: {e}", out.display()))
+    }
+
+    /// The staged configuration view of a fresh server (the defaults), from `start`.
+    fn config_view<E: Estimator + PreparedScene>(core: E, start: u16) -> Result<Vec<u16>, String> {
+        let monitor = Monitor::new(core, Config::default()).map_err(|e| e.to_string())?;
+        let mut server =
+            Server::new(monitor, ServerConfig::default()).map_err(|e| e.to_string())?;
+        let [a, b] = start.to_be_bytes();
+        let [c, d] = (misalign::modbus::CONFIG_WORDS as u16).to_be_bytes();
+        let answer = request(&mut server, &[3, a, b, c, d]);
+        if answer.get(1) != Some(&3) {
+            return Err(format!("the host's server answered {answer:02x?}"));
+        }
+        let data = &answer[3..answer.len() - 2];
+        Ok(data
+            .chunks(2)
+            .map(|w| u16::from_be_bytes([w[0], w[1]]))
+            .collect())
     }
 
     /// The tables in the order the test reads them, with the function that reads each.
@@ -675,8 +854,8 @@ mod host {
     /// Compares the events the master read from the node (`raw`: master.py's output)
     /// with the host's replay of `samples` through the node's estimator; every field
     /// bit for bit, or an error naming the first differences.
-    pub fn compare_events(fpu: bool, samples: &[Sample], raw: &Path) -> Result<Compared, String> {
-        let host = match node::core(fpu)? {
+    pub fn compare_events(core: Core, samples: &[Sample], raw: &Path) -> Result<Compared, String> {
+        let host = match core {
             Core::F32(core) => replay(core, samples)?,
             Core::Fixed(core) => replay(core, samples)?,
         };
