@@ -7,8 +7,11 @@
 //!   `tests/modbus/` against it: the node on its own samples (the built-in scenario;
 //!   every register equal, word for word, to this host's replay of the same samples
 //!   through `misalign::modbus::Server`), then the node on a master's samples (every
-//!   event read back across the event window's wrap). pymodbus and pytest, pinned, in
-//!   a virtual environment under `target/modbus-venv`.
+//!   event read back across the event window's wrap); and on the Cortex-M4F the node
+//!   with flash (feature `modbus-flash`) across a reset through QEMU's monitor
+//!   (`tests/modbus/test_reset.py`: the committed configuration and the unacknowledged
+//!   events back). pymodbus and pytest, pinned, in a virtual environment under
+//!   `target/modbus-venv`.
 //!   With `--boards`, the node on its own samples also on the Cortex-M7 and M3 (MPS2,
 //!   CMSDK UART0) and the STM32F405 (`netduinoplus2`, USART1).
 //! - `--serve PORT [--target TRIPLE]`: boots the node and serves until killed.
