@@ -51,6 +51,11 @@
 
 #[cfg(target_os = "none")]
 mod node;
+#[cfg(all(target_os = "none", feature = "modbus-node", feature = "modbus-flash"))]
+mod persist;
+#[cfg(all(target_os = "none", feature = "modbus-node", feature = "modbus-flash"))]
+#[path = "../common/ram_flash.rs"]
+mod ram_flash;
 #[cfg(target_os = "none")]
 mod selftest;
 #[cfg(all(target_os = "none", feature = "sim-sensors"))]

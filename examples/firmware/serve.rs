@@ -41,12 +41,28 @@ pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut(
     uart: &mut U,
     mut clock: LineClock<T>,
 ) -> Option<core::convert::Infallible> {
-    let monitor = match Monitor::new(core, Config::default()) {
+    #[allow(unused_mut)]
+    let mut monitor = match Monitor::new(core, Config::default()) {
         Ok(m) => m,
         Err(e) => {
             defmt::error!("node: configuration refused: {}", e);
             return None;
         }
+    };
+    // With flash (`modbus-flash`): the monitor goes on from its last checkpoint.
+    #[cfg(feature = "modbus-flash")]
+    let mut persist = {
+        let Some(mut persist) = crate::persist::Persist::open() else {
+            defmt::error!("node: the flash cannot be opened");
+            return None;
+        };
+        let restored = persist.restore_state(&mut monitor);
+        defmt::println!(
+            "storage: state restored {=bool}, {=u64} samples monitored",
+            restored,
+            monitor.statistics().samples()
+        );
+        persist
     };
     let config = ServerConfig {
         external_samples: EXTERNAL_SAMPLES,
@@ -65,9 +81,16 @@ pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut(
     };
     // Commissioning takes scenes of the node's core type over the bus.
     server.accept_scenes();
+    #[cfg(feature = "modbus-flash")]
+    defmt::println!("storage: configuration from {}", persist.start(&mut server));
     if !EXTERNAL_SAMPLES {
-        for sample in Scenario::new() {
+        // The scenario's samples not yet monitored (after a restored checkpoint, those
+        // after it).
+        let done = server.monitor().statistics().samples() as usize;
+        for sample in Scenario::new().skip(done) {
             server.process(sample);
+            #[cfg(feature = "modbus-flash")]
+            persist.service(&mut server);
         }
     }
     defmt::println!(
@@ -94,6 +117,8 @@ pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut(
             // and resynchronisation deal with; the master retries.
             defmt::warn!("modbus: a UART error");
         }
+        #[cfg(feature = "modbus-flash")]
+        persist.service(&mut server);
         let now = (clock.ticks)();
         let step = now.wrapping_sub(ticked);
         if step >= per_ms {

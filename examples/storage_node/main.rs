@@ -61,14 +61,15 @@ use misalign_logger as _;
 misalign_harness::log_panics_and_faults!();
 
 #[cfg(target_os = "none")]
+#[path = "../common/ram_flash.rs"]
+mod ram_flash;
+
+#[cfg(target_os = "none")]
 mod node {
     use core::mem::MaybeUninit;
     use core::ptr::addr_of_mut;
 
-    use embedded_storage::nor_flash::{
-        ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash, check_erase,
-        check_read, check_write,
-    };
+    use super::ram_flash::{RamFlash, SECTOR};
     use misalign::Estimator;
     #[cfg(not(target_abi = "eabihf"))]
     use misalign::fixed::FixedEllipticScene;
@@ -82,7 +83,6 @@ mod node {
     use misalign_harness::prepared;
     use misalign_harness::support::{exit, stack};
 
-    const SECTOR: usize = 1024;
     const SIZE: usize = 4 * SECTOR;
     /// What the control block holds first, so that cold RAM is told apart.
     const MAGIC: u32 = 0x4D53_4C43;
@@ -144,77 +144,6 @@ mod node {
         acked: u32,
     }
 
-    /// NOR flash over the `.uninit` RAM: erase to 0xFF, writes only clear bits. With a
-    /// cut armed, it resets the core at the `cut`-th point: a byte written or a word
-    /// erased (the bytes and words before it done, that one and the rest not).
-    struct RamFlash {
-        bytes: &'static mut [u8],
-        points: u32,
-        cut: Option<u32>,
-    }
-
-    impl RamFlash {
-        fn tick(&mut self) {
-            if self.cut == Some(self.points) {
-                // The power fails: no stack use noted (the deepest is the completed
-                // checkpoint's, noted at the phase's end).
-                cortex_m::peripheral::SCB::sys_reset();
-            }
-            self.points += 1;
-        }
-    }
-
-    #[derive(Debug, PartialEq)]
-    struct Refused(NorFlashErrorKind);
-
-    impl NorFlashError for Refused {
-        fn kind(&self) -> NorFlashErrorKind {
-            self.0
-        }
-    }
-
-    impl ErrorType for RamFlash {
-        type Error = Refused;
-    }
-
-    impl ReadNorFlash for RamFlash {
-        const READ_SIZE: usize = 1;
-
-        fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), Refused> {
-            check_read(self, offset, bytes.len()).map_err(Refused)?;
-            let at = offset as usize;
-            bytes.copy_from_slice(&self.bytes[at..at + bytes.len()]);
-            Ok(())
-        }
-
-        fn capacity(&self) -> usize {
-            self.bytes.len()
-        }
-    }
-
-    impl NorFlash for RamFlash {
-        const WRITE_SIZE: usize = 4;
-        const ERASE_SIZE: usize = SECTOR;
-
-        fn erase(&mut self, from: u32, to: u32) -> Result<(), Refused> {
-            check_erase(self, from, to).map_err(Refused)?;
-            for word in (from as usize..to as usize).step_by(Self::WRITE_SIZE) {
-                self.tick();
-                self.bytes[word..word + Self::WRITE_SIZE].fill(0xFF);
-            }
-            Ok(())
-        }
-
-        fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Refused> {
-            check_write(self, offset, bytes.len()).map_err(Refused)?;
-            for (i, &b) in bytes.iter().enumerate() {
-                self.tick();
-                self.bytes[offset as usize + i] &= b;
-            }
-            Ok(())
-        }
-    }
-
     /// Notes this boot's deepest stack use.
     fn note_stack(control: &mut Control) {
         let used = stack::used(control.sp as usize) as u32;
@@ -232,12 +161,11 @@ mod node {
         bytes: &'static mut [u8; SIZE],
         cut: Option<u32>,
     ) -> Store<BlockingFlash<RamFlash>, BUF> {
-        let flash = RamFlash {
-            bytes,
-            points: 0,
-            cut,
-        };
-        match Store::new(BlockingFlash(flash), 0..SIZE as u32, INTERVAL_S) {
+        match Store::new(
+            BlockingFlash(RamFlash::new(bytes, cut)),
+            0..SIZE as u32,
+            INTERVAL_S,
+        ) {
             Ok(store) => store,
             Err(_) => exit(20),
         }
@@ -508,11 +436,7 @@ mod node {
             control.boots += 1;
         }
         let mut store = open(flash, (step == 2).then_some(cut));
-        let events_flash = RamFlash {
-            bytes: events_flash,
-            points: 0,
-            cut: None,
-        };
+        let events_flash = RamFlash::new(events_flash, None);
         let Ok(mut events) = Events::new(BlockingFlash(events_flash), 0..EVENTS_SIZE as u32) else {
             exit(40 + code)
         };

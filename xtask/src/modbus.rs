@@ -7,8 +7,11 @@
 //!   `tests/modbus/` against it: the node on its own samples (the built-in scenario;
 //!   every register equal, word for word, to this host's replay of the same samples
 //!   through `misalign::modbus::Server`), then the node on a master's samples (every
-//!   event read back across the event window's wrap). pymodbus and pytest, pinned, in
-//!   a virtual environment under `target/modbus-venv`.
+//!   event read back across the event window's wrap); and on the Cortex-M4F the node
+//!   with flash (feature `modbus-flash`) across a reset through QEMU's monitor
+//!   (`tests/modbus/test_reset.py`: the committed configuration and the unacknowledged
+//!   events back). pymodbus and pytest, pinned, in a virtual environment under
+//!   `target/modbus-venv`.
 //!   With `--boards`, the node on its own samples also on the Cortex-M7 and M3 (MPS2,
 //!   CMSDK UART0) and the STM32F405 (`netduinoplus2`, USART1).
 //! - `--serve PORT [--target TRIPLE]`: boots the node and serves until killed.
@@ -47,6 +50,9 @@ struct Node {
     machine: &'static str,
     memory_x: Option<&'static str>,
     external: bool,
+    /// Built with flash (`modbus-flash`: examples/firmware/persist.rs) and
+    /// tested across a reset (`tests/modbus/test_reset.py`).
+    stored: bool,
 }
 
 impl Node {
@@ -57,6 +63,7 @@ impl Node {
             machine: cpu.machine,
             memory_x: None,
             external,
+            stored: false,
         }
     }
 }
@@ -200,6 +207,12 @@ fn build(node: &Node) -> Result<PathBuf, String> {
         node.cpu.target,
     ])
     .args(["--features", "modbus-node", "--example", "firmware"])
+    .args(
+        node.stored
+            .then_some(["--features", "modbus-flash"])
+            .into_iter()
+            .flatten(),
+    )
     .arg("--message-format=json-render-diagnostics");
     if node.external {
         cmd.env("MISALIGN_MODBUS_EXTERNAL", "1");
@@ -213,9 +226,10 @@ fn build(node: &Node) -> Result<PathBuf, String> {
     let built = cross::build(&mut cmd)?;
     let elf = cross::artifact(&built, "firmware")?;
     let kept = elf.with_file_name(format!(
-        "firmware-modbus-{}-{}",
+        "firmware-modbus-{}-{}{}",
         node.machine,
-        if node.external { "external" } else { "own" }
+        if node.external { "external" } else { "own" },
+        if node.stored { "-stored" } else { "" }
     ));
     std::fs::copy(&elf, &kept).map_err(|e| format!("{}: {e}", kept.display()))?;
     Ok(kept)
@@ -244,19 +258,24 @@ impl Drop for Booted {
     }
 }
 
-/// Boots `elf` on `machine` with serial0 on 127.0.0.1:`port`; returns once the node
-/// logs that it serves. Its log goes to stderr, prefixed: every line with `all`, else
+/// Boots `elf` on `machine` with serial0 on 127.0.0.1:`port` (and QEMU's monitor on
+/// 127.0.0.1:`monitor`, if given); returns once the node logs that it serves. Its log goes to stderr, prefixed: every line with `all`, else
 /// its Modbus lines, warnings and errors (the self-test's lines are `cargo xtask
 /// firmware`'s business).
 fn boot(
     machine: &str,
     elf: &Path,
     port: u16,
+    monitor: Option<u16>,
     timeout: Duration,
     all: bool,
 ) -> Result<Booted, String> {
     use std::os::unix::process::CommandExt;
-    let mut child = Command::new(crate::root().join("tools/qemu-run"))
+    let mut cmd = Command::new(crate::root().join("tools/qemu-run"));
+    if let Some(monitor) = monitor {
+        cmd.env("MISALIGN_QEMU_MONITOR_PORT", monitor.to_string());
+    }
+    let mut child = cmd
         .arg(machine)
         .arg(elf)
         .env("MISALIGN_QEMU_MACHINE", machine)
@@ -272,7 +291,7 @@ fn boot(
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
         for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-            let notable = ["modbus", "ERROR", "WARN", "panick", "qemu"];
+            let notable = ["modbus", "storage", "ERROR", "WARN", "panick", "qemu"];
             if all || notable.iter().any(|n| line.contains(n)) {
                 eprintln!("  node| {line}");
             }
@@ -359,6 +378,12 @@ fn tests(boards: bool) -> Result<(), String> {
         .iter()
         .flat_map(|id| [false, true].map(|external| Node::on(cpu(id), external)))
         .collect();
+    // With flash, across a reset: on the Cortex-M4F (the M0's 16 KiB of RAM do not
+    // hold the node's stack beside the 6 KiB of flash regions: docs/firmware.md).
+    nodes.push(Node {
+        stored: true,
+        ..Node::on(cpu("cortex-m4f"), true)
+    });
     if boards {
         nodes.extend(OTHER_BOARDS.map(|(id, machine, memory_x)| Node {
             machine,
@@ -367,10 +392,10 @@ fn tests(boards: bool) -> Result<(), String> {
         }));
     }
     for node in &nodes {
-        let source = if node.external {
-            "the master"
-        } else {
-            "the node"
+        let source = match (node.external, node.stored) {
+            (true, true) => "the master, with flash, across a reset",
+            (true, false) => "the master",
+            _ => "the node",
         };
         let what = format!(
             "{} ({}), samples from {source}",
@@ -394,7 +419,14 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
     let id = node.cpu.id;
     // The node on its own samples: every register as the host's replay reads it. On a
     // master's samples: every event the master reads back, compared below.
-    let (tests, file) = if node.external {
+    let (tests, file) = if node.stored {
+        host::write_samples(&dir.join("samples.csv"), &host::scenario())?;
+        host::write_other_scene(fpu, &dir.join(format!("scene-{id}.bin")))?;
+        (
+            &["tests/modbus/test_reset.py"][..],
+            dir.join(format!("reset-{id}.csv")),
+        )
+    } else if node.external {
         host::write_samples(&dir.join("samples.csv"), &host::scenario())?;
         (
             &["tests/modbus/test_external.py"][..],
@@ -411,12 +443,24 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         )
     };
     let port = free_port()?;
-    let booted = boot(node.machine, &elf, port, Duration::from_secs(300), false)?;
+    let monitor = node.stored.then(free_port).transpose()?;
+    let booted = boot(
+        node.machine,
+        &elf,
+        port,
+        monitor,
+        Duration::from_secs(300),
+        false,
+    )?;
     let status = Command::new(python)
         .current_dir(crate::root())
         .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
         .args(tests)
         .env("MODBUS_PORT", booted.port.to_string())
+        .env(
+            "MODBUS_QEMU_MONITOR",
+            monitor.map(|m| m.to_string()).unwrap_or_default(),
+        )
         .env("MODBUS_REGISTERS", registers)
         .env("MODBUS_CORE", if fpu { "f32" } else { "fixed" })
         .env("MODBUS_EXPECTED", &file)
@@ -441,7 +485,7 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
     if !status.success() {
         return Err(format!("pytest {}: {status}", tests.join(" ")));
     }
-    if node.external {
+    if node.external && !node.stored {
         let compared = host::compare_events(crate::node::core(fpu)?, &host::scenario(), &file)?;
         println!(
             "  the {} events read over Modbus are the host replay's, bit for bit",
@@ -459,7 +503,14 @@ fn serve(port: &str, target: Option<&str>) -> Result<(), String> {
     crate::tools::preflight()?;
     let cpu = cpu_for_target(target.unwrap_or("thumbv7em-none-eabihf"))?;
     let elf = build(&Node::on(cpu, false))?;
-    let mut booted = boot(cpu.machine, &elf, port, Duration::from_secs(600), true)?;
+    let mut booted = boot(
+        cpu.machine,
+        &elf,
+        port,
+        None,
+        Duration::from_secs(600),
+        true,
+    )?;
     println!("serving on 127.0.0.1:{port}");
     // The node's log goes on to stderr; QEMU runs until it is killed (with us).
     let status = booted.child.wait().map_err(|e| e.to_string())?;
@@ -520,7 +571,14 @@ fn trace(
     host::write_default_config(&core, &registers, &config_csv)?;
     let elf = build(&Node::on(cpu, true))?;
     let port = free_port()?;
-    let booted = boot(cpu.machine, &elf, port, Duration::from_secs(300), false)?;
+    let booted = boot(
+        cpu.machine,
+        &elf,
+        port,
+        None,
+        Duration::from_secs(300),
+        false,
+    )?;
     // Commissioned over the bus as on site: unlock, the prepared scene and the
     // default configuration, commit, read back (tools/commission.py).
     let code = misalign::modbus::DEFAULT_UNLOCK_CODE.to_string();

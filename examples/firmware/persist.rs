@@ -1,0 +1,216 @@
+//! The Modbus node's flash (feature `modbus-flash`): what a
+//! node keeps through a reset or a power cut, through `misalign::storage` as a
+//! firmware uses it (a blocking flash driver, `block_on`, no executor). In QEMU the
+//! "flash" is RAM in cortex-m-rt's `.uninit` section (`examples/common/ram_flash.rs`,
+//! shared with the storage node), kept across a system reset.
+//!
+//! Two regions: a [`Store`] of 4 KiB holding the monitor's state (checkpointed at each
+//! event and once a minute of monitored time) and the configuration committed over the
+//! bus (`ConfigImage`, written once per commit); an [`EventQueue`] of 2 KiB holding
+//! every event until a master acknowledges it (`event_ack`, made durable as it is
+//! written). At boot: the state restored (numbering after the newest event stored),
+//! the committed configuration restored (`config_source` says which ran), the event
+//! window fed from the queue, from its oldest unacknowledged event on.
+
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
+
+use crate::ram_flash::{RamFlash, SECTOR};
+use misalign::Estimator;
+use misalign::modbus::{BootSource, IMAGE_LEN, Server, StorageStatus, Stored};
+use misalign::monitor::{Event, Monitor, MonitorState};
+use misalign::storage::{BlockingFlash, ConfigImage, EventQueue, RestoreOutcome, Store, block_on};
+
+/// The store's region (the state's and the configuration's records).
+const STORE_SIZE: usize = 4 * SECTOR;
+/// The event queue's region.
+const EVENTS_SIZE: usize = 2 * SECTOR;
+/// The periodic checkpoint's interval (s of monitored time).
+const INTERVAL_S: u32 = 60;
+
+type Flash = BlockingFlash<RamFlash>;
+const STATE_BUF: usize = Store::<Flash, 0>::buffer_len::<MonitorState>();
+const IMAGE_BUF: usize = Store::<Flash, 0>::buffer_len::<ConfigImage<IMAGE_LEN>>();
+/// The store's buffer: the larger of its two records'.
+const BUF: usize = if STATE_BUF > IMAGE_BUF {
+    STATE_BUF
+} else {
+    IMAGE_BUF
+};
+const EVENT_BUF: usize = EventQueue::<Flash, Event, 0>::buffer_len();
+
+#[unsafe(link_section = ".uninit.misalign_node_store")]
+static mut STORE: MaybeUninit<[u8; STORE_SIZE]> = MaybeUninit::uninit();
+#[unsafe(link_section = ".uninit.misalign_node_events")]
+static mut EVENTS: MaybeUninit<[u8; EVENTS_SIZE]> = MaybeUninit::uninit();
+
+/// The node's storage, and what it last told the server.
+pub struct Persist {
+    store: Store<Flash, BUF>,
+    events: EventQueue<Flash, Event, EVENT_BUF>,
+    /// The acknowledgement made durable last.
+    acked: Option<u32>,
+    /// The next event number at the last checkpoint, and its monitored time (s).
+    checkpointed_seq: u32,
+    checkpointed_s: Option<u64>,
+    status: StorageStatus,
+}
+
+impl Persist {
+    /// The two regions, opened once at boot; the event queue read through. `None` on
+    /// a flash error.
+    pub fn open() -> Option<Self> {
+        // SAFETY: the only references to the two statics, taken once per boot (`node`
+        // calls this once, before its loop); u8 holds any bit pattern, and the RAM is
+        // initialised memory on the target (what the previous boot left, or the
+        // power-on contents).
+        let (store, events) = unsafe {
+            (
+                &mut *addr_of_mut!(STORE).cast::<[u8; STORE_SIZE]>(),
+                &mut *addr_of_mut!(EVENTS).cast::<[u8; EVENTS_SIZE]>(),
+            )
+        };
+        let store = Store::new(
+            BlockingFlash(RamFlash::new(store, None)),
+            0..STORE_SIZE as u32,
+            INTERVAL_S,
+        )
+        .ok()?;
+        let mut events = EventQueue::new(
+            BlockingFlash(RamFlash::new(events, None)),
+            0..EVENTS_SIZE as u32,
+        )
+        .ok()?;
+        let found = block_on(events.open()).ok()?;
+        defmt::println!(
+            "storage: {=u32} events kept, acknowledged through {=?}, region erased {=bool}",
+            found.unacknowledged,
+            found.acknowledged,
+            found.erased
+        );
+        Some(Persist {
+            store,
+            events,
+            acked: found.acknowledged,
+            checkpointed_seq: 0,
+            checkpointed_s: None,
+            status: StorageStatus::default(),
+        })
+    }
+
+    /// The monitor's last checkpoint into `m` (a fresh monitor), numbering its events
+    /// after the newest stored. False if there was none (or it was damaged: the region
+    /// is then erased and the monitor starts afresh).
+    pub fn restore_state<E: Estimator>(&mut self, m: &mut Monitor<E>) -> bool {
+        let mut state = MonitorState::default();
+        let restored = match block_on(self.store.restore_into(&mut state)) {
+            Ok(
+                RestoreOutcome::Restored { sequence } | RestoreOutcome::Migrated { sequence, .. },
+            ) => Some(sequence),
+            _ => None,
+        };
+        let newest = self.events.state().newest;
+        if let Some(n) = newest {
+            state.continue_events_after(n);
+        }
+        if let Some(sequence) = restored {
+            m.resume(&state);
+            self.status.checkpoints = sequence;
+            self.status.last_checkpoint_ms = Some(m.elapsed_ms());
+            self.checkpointed_s = Some(m.elapsed_ms() / 1000);
+        } else if let Some(n) = newest {
+            // No state, but events kept: number on after them.
+            let mut fresh = m.snapshot();
+            fresh.continue_events_after(n);
+            m.resume(&fresh);
+        }
+        self.checkpointed_seq = m.next_event_seq();
+        restored.is_some()
+    }
+
+    /// At boot, after [`restore_state`](Self::restore_state) and before the first
+    /// sample: the committed configuration restored into the server (its
+    /// `config_source`), the server told to store its events, its window fed from the
+    /// queue.
+    pub fn start<E: Estimator>(&mut self, server: &mut Server<E>) -> BootSource {
+        let mut image = ConfigImage::<IMAGE_LEN>::new();
+        let stored = match block_on(self.store.restore_into(&mut image)) {
+            Ok(RestoreOutcome::Restored { .. } | RestoreOutcome::Migrated { .. }) => {
+                Stored::Image(&image.0)
+            }
+            Ok(RestoreOutcome::Blank) => Stored::Nothing,
+            _ => Stored::Damaged,
+        };
+        let source = server.restore(stored);
+        server.store_events(self.events.state().first);
+        self.service(server);
+        source
+    }
+
+    /// After each sample and each request: new events onto the flash and into the
+    /// window, the master's acknowledgement made durable, the window fed from the
+    /// flash while it is behind, a committed configuration persisted, the state
+    /// checkpointed at each event and at the interval, the storage registers told.
+    pub fn service<E: Estimator>(&mut self, server: &mut Server<E>) {
+        while let Some(e) = server.pop_event() {
+            if block_on(self.events.push(e.seq, &e)).is_err() {
+                defmt::warn!("storage: event {=u32} not stored", e.seq);
+            }
+            server.offer_event(e);
+        }
+        let ack = server.acknowledged_through();
+        if let Some(k) = ack.filter(|_| ack != self.acked) {
+            if block_on(self.events.acknowledge(k)).is_err() {
+                defmt::warn!("storage: acknowledgement {=u32} not stored", k);
+            }
+            self.acked = ack;
+        }
+        while let Some(wanted) = server.wanted_event() {
+            let mut found = None;
+            if block_on(self.events.read(wanted, |_, e| {
+                found = Some(e);
+                false
+            }))
+            .is_err()
+            {
+                break;
+            }
+            match found {
+                Some(e) if server.offer_stored_event(e) => {}
+                Some(_) => break,
+                None => server.end_backlog(),
+            }
+        }
+        let mut image = ConfigImage::<IMAGE_LEN>::new();
+        if server.take_committed(&mut image.0) && block_on(self.store.checkpoint(&image)).is_err() {
+            defmt::warn!("storage: the committed configuration not stored");
+        }
+        self.checkpoint(server.monitor());
+        let q = self.events.state();
+        self.status.events_acknowledged = q.acknowledged;
+        self.status.events_stored = q.unacknowledged;
+        self.status.events_overwritten = self.events.dropped();
+        server.set_storage_status(self.status);
+    }
+
+    /// The monitor's state checkpointed when it raised an event since the last
+    /// checkpoint, or when [`INTERVAL_S`] of monitored time have passed.
+    fn checkpoint<E: Estimator>(&mut self, m: &Monitor<E>) {
+        let now_s = m.elapsed_ms() / 1000;
+        let due = self
+            .checkpointed_s
+            .is_none_or(|last| now_s.saturating_sub(last) >= u64::from(INTERVAL_S));
+        if m.next_event_seq() == self.checkpointed_seq && !due {
+            return;
+        }
+        self.checkpointed_seq = m.next_event_seq();
+        self.checkpointed_s = Some(now_s);
+        match block_on(self.store.checkpoint(&m.snapshot())) {
+            Ok(sequence) => {
+                self.status.checkpoints = sequence;
+                self.status.last_checkpoint_ms = Some(m.elapsed_ms());
+            }
+            Err(_) => defmt::warn!("storage: checkpoint failed"),
+        }
+    }
+}
