@@ -76,15 +76,15 @@ impl Words {
         let at = self.at;
         // At most byte 251 (see above): always in the buffer.
         if n == 2 {
-            if let Some(bytes) = response.get_mut(at..at + 4) {
+            if let Some(bytes) = response.get_mut(at..at.wrapping_add(4)) {
                 bytes.copy_from_slice(&v.to_be_bytes());
             }
-            self.at = at + 4;
+            self.at = at.wrapping_add(4);
         } else {
-            if let Some(bytes) = response.get_mut(at..at + 2) {
+            if let Some(bytes) = response.get_mut(at..at.wrapping_add(2)) {
                 bytes.copy_from_slice(&(v as u16).to_be_bytes());
             }
-            self.at = at + 2;
+            self.at = at.wrapping_add(2);
         }
     }
 }
