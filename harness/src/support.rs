@@ -207,15 +207,38 @@ pub mod counter {
             let r = f();
             let end = SYST::get_current();
             let ticks = start.wrapping_sub(end) & RELOAD;
-            let n = (ticks as u64 * self.instructions as u64 + self.ticks as u64 / 2)
-                / (self.ticks as u64).max(1);
+            let n = div(
+                ticks as u64 * self.instructions as u64 + self.ticks as u64 / 2,
+                self.ticks,
+            );
+            // Computed here, before the caller's next reading of the timer: arithmetic
+            // may otherwise move past it, into the next measurement (the volatile
+            // readings order only each other).
+            let n = core::hint::black_box(n);
             (r, (n as u32).saturating_sub(self.overhead))
         }
 
         /// SysTick ticks per 1000 instructions (1600 on the mps2 boards under QEMU).
         pub fn ticks_per_1000(&self) -> u32 {
-            (self.ticks as u64 * 1000 / (self.instructions as u64).max(1)) as u32
+            div(self.ticks as u64 * 1000, self.instructions) as u32
         }
+    }
+
+    /// `n / d` rounded down (`n` for `d == 0`), by shifts and subtractions: a 64-bit
+    /// division would link the 64-bit division routine (about 1 KiB on a Cortex-M0)
+    /// into every image that counts, and into its measured size.
+    fn div(n: u64, d: u32) -> u64 {
+        let d = u64::from(d.max(1));
+        let mut q = 0u64;
+        let mut rest = 0u64;
+        for bit in (0..64).rev() {
+            rest = rest << 1 | (n >> bit & 1);
+            if rest >= d {
+                rest -= d;
+                q |= 1 << bit;
+            }
+        }
+        q
     }
 
     #[inline(always)]

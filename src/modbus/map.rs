@@ -96,6 +96,22 @@ impl Access {
 /// What an entry holds: the server computes it when it is read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Field {
+    // Holding registers, first: the fields a read of holding registers computes
+    // inline (`value_holding`) are then the first tags, which a Cortex-M0 dispatches
+    // on without subtracting an offset.
+    EventFrom,
+    AcknowledgeAlarms,
+    LatchingAlarms,
+    ExternalMode,
+    UnitId,
+    MapVersion,
+    EventAck,
+    /// A commissioning register (`unlock`, `command`, the scene block, ...).
+    Commission(Reg),
+    /// A staged configuration register.
+    Staged(ConfigField),
+    /// An external sample's field (the basic or the full record).
+    Sample(SampleField),
     // Coils.
     Acknowledge,
     Latching(AlarmSet),
@@ -142,29 +158,14 @@ pub(crate) enum Field {
     EventsMissed,
     /// An event slot's field.
     Event(EventField),
-    // Holding registers.
-    EventFrom,
-    AcknowledgeAlarms,
-    LatchingAlarms,
-    ExternalMode,
-    UnitId,
-    MapVersion,
     // Store-and-forward and checkpoints.
-    EventAck,
     EventAcked,
     EventsStored,
     EventsOverwritten,
     Checkpoints,
     CheckpointAge,
-    /// A commissioning register (`unlock`, `command`, the scene block, ...).
-    Commission(Reg),
-    /// A staged configuration register.
-    Staged(ConfigField),
     /// An active configuration register.
     Active(ConfigField),
-
-    /// An external sample's field (the basic or the full record).
-    Sample(SampleField),
 }
 
 /// The fields of an event slot.

@@ -65,25 +65,26 @@ enum Reply {
 /// (into the CRC's place, written after), and a read that starts at the low word of a
 /// 32-bit value writes that value from byte 1 (the head's place, written after).
 struct Words {
-    at: u8,
+    /// A word's width, not a byte's: no narrowing in a read's loop.
+    at: usize,
 }
 
 impl Words {
     /// Writes the `n`-word value `v` (high word first).
     #[inline(always)]
     fn put(&mut self, response: &mut [u8; ADU_MAX], v: u32, n: u16) {
-        let at = usize::from(self.at);
+        let at = self.at;
         // At most byte 251 (see above): always in the buffer.
         if n == 2 {
-            if let Some(bytes) = response.get_mut(at..at + 4) {
+            if let Some(bytes) = response.get_mut(at..at.wrapping_add(4)) {
                 bytes.copy_from_slice(&v.to_be_bytes());
             }
-            self.at = self.at.wrapping_add(4);
+            self.at = at.wrapping_add(4);
         } else {
-            if let Some(bytes) = response.get_mut(at..at + 2) {
+            if let Some(bytes) = response.get_mut(at..at.wrapping_add(2)) {
                 bytes.copy_from_slice(&(v as u16).to_be_bytes());
             }
-            self.at = self.at.wrapping_add(2);
+            self.at = at.wrapping_add(2);
         }
     }
 }
@@ -205,9 +206,9 @@ impl<E: Estimator> Core<E> {
         let end = 3 + bytes;
         // Each table's values from a function of its own (small enough to inline).
         if function == 3 {
-            self.fill::<true>(map, start, end, Self::value_holding);
+            self.fill::<true>(map, start, usize::from(end), Self::value_holding);
         } else {
-            self.fill::<false>(map, start, end, Self::value);
+            self.fill::<false>(map, start, usize::from(end), Self::value);
         }
         // After the values: the first may have begun in the head's place.
         self.response[..3].copy_from_slice(&[self.unit, function, bytes]);
@@ -230,7 +231,7 @@ impl<E: Estimator> Core<E> {
         &mut self,
         map: &Served,
         start: u16,
-        end: u8,
+        end: usize,
         value: impl Fn(&Self, Field, u16) -> u32,
     ) {
         // Where the blocks' part starts: the first block's first record when the
@@ -239,7 +240,7 @@ impl<E: Estimator> Core<E> {
         let mut out = Words { at: 3 };
         if let Some((mut i, word)) = map.single(start) {
             // A read from a value's low word: the value from the byte before.
-            out.at = 3 - 2 * (word as u8 & 1);
+            out.at = 3 - 2 * usize::from(word & 1);
             while out.at < end {
                 let Some(e) = map.entries.get(i) else {
                     from = Some((0, 0, 0));
@@ -252,7 +253,7 @@ impl<E: Estimator> Core<E> {
         } else if let Some(l) = map.locate(start)
             && let Some(b) = l.block
         {
-            out.at = 3 - 2 * (l.word as u8 & 1);
+            out.at = 3 - 2 * usize::from(l.word & 1);
             from = Some((b, l.record, l.index));
         }
         let Some((mut b, mut record, mut i)) = from else {

@@ -14,6 +14,21 @@ fn opt(x: Option<f32>) -> u32 {
     x.map_or(NONE, f32::to_bits)
 }
 
+/// Whole seconds in `ms` (saturated at `u32::MAX`) and the milliseconds left over, by
+/// long division in 16-bit digits: u32 divisions only, so that no 64-bit division is
+/// linked into a Cortex-M0 node.
+fn split_seconds(ms: u64) -> (u32, u32) {
+    let mut seconds = 0u64;
+    let mut rest = 0u32;
+    for shift in [48, 32, 16, 0] {
+        // rest < 1000, so the digit fits in 26 bits.
+        let digit = rest << 16 | (ms >> shift) as u32 & 0xFFFF;
+        seconds = seconds << 16 | u64::from(digit / 1000);
+        rest = digit % 1000;
+    }
+    (u32::try_from(seconds).unwrap_or(u32::MAX), rest)
+}
+
 /// The NAMUR NE 107 category in `status` (bits 8-11).
 mod ne107 {
     pub const GOOD: u32 = 0;
@@ -115,8 +130,8 @@ fn event_value(e: &Event, field: EventField) -> u32 {
     match field {
         EventField::Seq => e.seq,
         EventField::TimeMs => e.time_ms,
-        EventField::ElapsedS => u32::try_from(e.elapsed_ms / 1000).unwrap_or(u32::MAX),
-        EventField::ElapsedMs => (e.elapsed_ms % 1000) as u32,
+        EventField::ElapsedS => split_seconds(e.elapsed_ms).0,
+        EventField::ElapsedMs => split_seconds(e.elapsed_ms).1,
         EventField::Kind => event_kind_code(&e.kind),
         EventField::From => from,
         EventField::To => to,
@@ -344,17 +359,21 @@ impl<E: Estimator> Core<E> {
                 .get(usize::from(i))
                 .copied()
                 .unwrap_or(0),
-            Field::TimeInState(i) => per_state(i).map_or(0, |state| {
-                u32::try_from(s.time_in_state_ms(state) / 1000).unwrap_or(u32::MAX)
-            }),
-            // The compensated sum (f64) rounded to f32.
-            Field::Energy(i) => {
-                per_state(i).map_or(0, |state| (s.energy_j(state) as f32).to_bits())
+            Field::TimeInState(i) => {
+                per_state(i).map_or(0, |state| split_seconds(s.time_in_state_ms(state)).0)
             }
+            // The compensated sum rounded to f32, added in f32: the same bits as the
+            // f64 total (`energy_j`) rounded to f32, for the compensation is below half
+            // an ulp of the sum, so that one rounding of the exact sum gives both, and no
+            // f64 arithmetic is linked into a node without an FPU for f64.
+            Field::Energy(i) => s
+                .energy
+                .get(usize::from(i))
+                .map_or(0, |e| (e.sum + e.compensation).to_bits()),
             Field::MaxSlipRatio => s.max_slip_ratio().to_bits(),
             Field::MaxAxialForce => s.max_axial_force().to_bits(),
             Field::MinMargin => opt(s.min_margin()),
-            Field::Elapsed => u32::try_from(m.elapsed_ms() / 1000).unwrap_or(u32::MAX),
+            Field::Elapsed => split_seconds(m.elapsed_ms()).0,
             Field::LastSampleTime => self.last_time_ms,
             Field::ExternalAccepted => self.counters.external_accepted,
             Field::ExternalRefused => self.counters.external_refused,
@@ -379,7 +398,9 @@ impl<E: Estimator> Core<E> {
             Field::EventsOverwritten => self.storage.events_overwritten,
             Field::Checkpoints => self.storage.checkpoints,
             Field::CheckpointAge => self.storage.last_checkpoint_ms.map_or(u32::MAX, |t| {
-                u32::try_from(m.elapsed_ms().saturating_sub(t) / 1000).unwrap_or(u32::MAX - 1)
+                split_seconds(m.elapsed_ms().saturating_sub(t))
+                    .0
+                    .min(u32::MAX - 1)
             }),
             Field::Commission(reg) => self.commissioning.value(reg, &self.monitor),
             Field::Staged(f) => self.commissioning.staged(f, self.monitor.config()),
@@ -390,5 +411,39 @@ impl<E: Estimator> Core<E> {
     /// A bus counter, modulo 2^16 (its register is 16 bits).
     fn bus(&self, f: impl Fn(&super::Counters) -> u32) -> u32 {
         f(&self.counters) & 0xFFFF
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::split_seconds;
+
+    /// The long division gives what u64 division gives, saturated where the seconds
+    /// pass u32.
+    #[test]
+    fn split_seconds_is_division_by_1000() {
+        let edges = [
+            0,
+            1,
+            999,
+            1000,
+            1001,
+            65_535_999,
+            u64::from(u32::MAX),
+            u64::from(u32::MAX) * 1000 + 999,
+            u64::from(u32::MAX) * 1000 + 1000,
+            u64::MAX,
+        ];
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let random = (0..10_000).map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x >> (x % 64)
+        });
+        for ms in edges.into_iter().chain(random) {
+            let seconds = u32::try_from(ms / 1000).unwrap_or(u32::MAX);
+            assert_eq!(split_seconds(ms), (seconds, (ms % 1000) as u32), "{ms}");
+        }
     }
 }
