@@ -216,10 +216,16 @@ mod tests {
             defmt::assert!(elliptic.details(1e3, phi).err() == Some(Error::Angle));
             defmt::assert!(line.estimate(1e3, phi) == Err(Error::Angle));
         }
-        // f32's pi/2 lies above pi/2 and is refused; the f32 below it is accepted.
-        defmt::assert!(elliptic.estimate(1e3, core::f32::consts::FRAC_PI_2) == Err(Error::Angle));
-        let below = f32::from_bits(core::f32::consts::FRAC_PI_2.to_bits() - 1);
+        // f32's pi/2 (the rounding of pi/2, above it by 4.4e-8) stands for pi/2 and is
+        // accepted, as is the f32 below it; the f32 above it is refused.
+        let half_pi = core::f32::consts::FRAC_PI_2;
+        defmt::assert!(elliptic.estimate(1e3, half_pi).is_ok());
+        defmt::assert!(line.estimate(1e3, half_pi).is_ok());
+        let below = f32::from_bits(half_pi.to_bits() - 1);
         defmt::assert!(elliptic.estimate(1e3, below).is_ok());
+        let above = f32::from_bits(half_pi.to_bits() + 1);
+        defmt::assert!(elliptic.estimate(1e3, above) == Err(Error::Angle));
+        defmt::assert!(line.estimate(1e3, above) == Err(Error::Angle));
     }
 
     #[test]
