@@ -375,3 +375,29 @@ fn threads_give_the_same_numbers() {
         assert_eq!(bits(&a.details[5]), bits(&b.details[5]));
     }
 }
+
+/// Every model of a batch takes f64 inputs and draws the right angle where the
+/// reference does: f64's FRAC_PI_2 (below the true pi/2) is answered, the f64 above it
+/// refused, also by the f32 core, whose rounding would carry it onto f32's FRAC_PI_2.
+#[test]
+fn every_model_of_a_batch_draws_the_right_angle_at_f64s() {
+    let scene = Scene::DEMO;
+    let half_pi = core::f64::consts::FRAC_PI_2;
+    let phi = [half_pi, half_pi.next_up(), -half_pi, -half_pi.next_up()];
+    let load = [1e3; 4];
+    let inputs = Inputs::one_scene(&scene, Column::Each(&load), Column::Each(&phi));
+    let angle = batch::status_of(Error::Angle);
+    let fixed = Model::Fixed {
+        load_lsb: 1e-2,
+        angle_lsb: Some(1e-6),
+    };
+    for model in [Model::Reference, Model::F32, fixed] {
+        let mut out = Owned::new(phi.len());
+        assert_eq!(
+            batch::estimate(&inputs, &mut out.outputs(false), model),
+            Ok(2),
+            "{model:?}"
+        );
+        assert_eq!(out.status, [0, angle, 0, angle], "{model:?}");
+    }
+}

@@ -419,3 +419,28 @@ fn a_header_alone_gives_the_header_alone() {
     let (code, out, _) = run(&["--solve", "mu"], b"R1,R2,G,nu,P,phi,F\n");
     assert_eq!((code, out.as_str()), (0, "mu,bound,sensitivity,error\n"));
 }
+
+/// Every model reads phi as the f64 the file gives: f64's FRAC_PI_2 (below the true
+/// pi/2) is answered, the f64 above it refused with the same message, also by the f32
+/// core, whose rounding would carry it onto f32's FRAC_PI_2.
+#[test]
+fn every_model_draws_the_right_angle_at_the_files_f64() {
+    let half_pi = core::f64::consts::FRAC_PI_2;
+    let input = format!(
+        "R1,R2,G,nu,mu,P,phi\n\
+         0.05,0.05,79.3e9,0.3,0.3,1000,{half_pi:?}\n\
+         0.05,0.05,79.3e9,0.3,0.3,1000,{:?}\n",
+        half_pi.next_up()
+    );
+    for model in ["reference", "f32", "fixed"] {
+        let (code, out, _) = run(&["--model", model], input.as_bytes());
+        assert_eq!(code, 0, "{model}");
+        let rows = parse(&out);
+        assert_eq!(rows[0]["error"], "", "{model}: {:?}", rows[0]);
+        assert!(
+            rows[1]["error"].contains("|phi| <= pi/2"),
+            "{model}: {:?}",
+            rows[1]
+        );
+    }
+}

@@ -377,3 +377,23 @@ mod properties {
         }
     }
 }
+
+/// The mu-inverse reads phi as the f64 the file gives, in both models: the f64 above
+/// f64's FRAC_PI_2 is refused, also by the f32 core, whose rounding would carry it onto
+/// f32's FRAC_PI_2; f64's FRAC_PI_2 itself is inside the domain.
+#[test]
+fn the_mu_inverse_draws_the_right_angle_at_the_files_f64() {
+    let half_pi = core::f64::consts::FRAC_PI_2;
+    let input = format!(
+        "R1,R2,G,nu,P,phi,F\n\
+         0.05,0.05,8e10,0.3,1000,{half_pi:?},100\n\
+         0.05,0.05,8e10,0.3,1000,{:?},100\n",
+        half_pi.next_up()
+    );
+    for model in ["reference", "f32"] {
+        let (code, _, out, err) = run(&["--model", model, "--solve", "mu"], &input);
+        assert_eq!((code, err.as_str()), (0, ""), "{model}");
+        assert!(!out[0][3].contains("pi/2"), "{model}: {:?}", out[0]);
+        assert!(out[1][3].contains("|phi| <= pi/2"), "{model}: {:?}", out[1]);
+    }
+}

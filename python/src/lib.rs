@@ -245,7 +245,11 @@ fn solve_row(
     if f32_core {
         let core = Auto::with_choice(scene, choice).map_err(text)?;
         let (p, f) = (narrow("P", load)?, narrow("F", force)?);
-        let answer = if unknown_mu {
+        let answer = if unknown_mu && phi.abs() > core::f64::consts::FRAC_PI_2 {
+            // Refused before f32's rounding carries it onto f32's FRAC_PI_2, as in the
+            // reference.
+            Err(Error::Angle)
+        } else if unknown_mu {
             core.friction_from_axial_force(p, narrow("phi", phi)?, f)
         } else {
             core.angle_from_axial_force(p, f)

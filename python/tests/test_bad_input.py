@@ -163,3 +163,21 @@ def test_extreme_values_never_give_a_silent_nan():
             b = misalign.solve_phi(*cols[:5], cols[5], cols[7], model=model, contact=contact)
             for r, k in [(a, "mu"), (b, "phi")]:
                 assert not (np.isnan(r[k]) & (r["error"] == "")).any(), (model, contact, k)
+
+
+def test_every_model_draws_the_right_angle_at_the_f64_given():
+    # f64's pi/2 lies below the true pi/2 and is answered; the f64 above it is refused,
+    # also by the f32 core, whose rounding would carry it onto f32's pi/2.
+    half_pi = np.pi / 2
+    phi = np.array([half_pi, np.nextafter(half_pi, 4.0)])
+    for model in ["reference", "f32", "fixed"]:
+        # The default angle count (the finest the tables allow) ends below a right
+        # angle; counts of 1 urad reach it.
+        lsb = {"angle_lsb": 1e-6} if model == "fixed" else {}
+        r = misalign.estimate(*SCENE, 1e3, phi, model=model, **lsb)
+        assert r["error"][0] == "", (model, r["error"])
+        assert "misalignment" in r["error"][1], (model, r["error"])
+    for model in ["reference", "f32"]:
+        m = misalign.solve_mu(*SCENE[:4], 1e3, phi, 100.0, model=model)
+        assert "pi/2" not in m["error"][0], (model, m["error"])
+        assert "misalignment" in m["error"][1], (model, m["error"])

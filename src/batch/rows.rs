@@ -237,6 +237,11 @@ fn narrow(x: f64, error: Error) -> Result<f32, Error> {
 
 #[inline(always)]
 fn float_row(core: &Auto, load: f64, phi: f64) -> Result<Row, Error> {
+    // As the reference: |phi| up to f64's FRAC_PI_2; above it, refused before f32's
+    // rounding would carry it down onto f32's FRAC_PI_2, which the core accepts.
+    if libm::fabs(phi) > core::f64::consts::FRAC_PI_2 {
+        return Err(Error::Angle);
+    }
     let e = core.estimate(narrow(load, Error::Load)?, narrow(phi, Error::Angle)?)?;
     let est = e.estimate;
     let critical = est.critical_angle.map(f64::from);

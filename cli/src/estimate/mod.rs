@@ -382,6 +382,11 @@ fn f32_error(e: Error) -> String {
 /// The f32 core's answer for one row.
 fn f32_row(x: &Sample) -> Result<Answer, String> {
     let (scene, load, phi, choice) = (&x.scene, x.load, x.phi, x.choice);
+    // As the reference: |phi| up to f64's FRAC_PI_2; above it, refused before f32's
+    // rounding would carry it down onto f32's FRAC_PI_2, which the core accepts.
+    if phi.abs() > core::f64::consts::FRAC_PI_2 {
+        return Err(f32_error(Error::Angle));
+    }
     let (p, a) = (to_f32("P", "N", load)?, to_f32("phi", "rad", phi)?);
     let auto = Auto::with_choice(scene, choice).map_err(f32_error)?;
     let e = auto.estimate(p, a).map_err(f32_error)?;

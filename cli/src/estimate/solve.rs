@@ -137,6 +137,11 @@ pub fn answer(
             let (p, f) = (narrow("P", "N", load)?, narrow("F", "N", force)?);
             let core = Auto::with_choice(scene, contact.choice()).map_err(f32_error)?;
             let answer = match unknown {
+                // |phi| above f64's FRAC_PI_2 refused before f32's rounding carries
+                // it onto f32's FRAC_PI_2, as in the reference.
+                Unknown::Mu if phi.abs() > core::f64::consts::FRAC_PI_2 => {
+                    Err(misalign::Error::Angle)
+                }
                 Unknown::Mu => core.friction_from_axial_force(p, narrow("phi", "rad", phi)?, f),
                 Unknown::Phi => core.angle_from_axial_force(p, f),
             };
