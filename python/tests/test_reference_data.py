@@ -22,6 +22,16 @@ def rel(got, want):
     return np.where(same, 0.0, np.nan_to_num(e, nan=np.inf))
 
 
+def want(df, c):
+    """The data's column c; phi0 and theta0 NaN where phi0 passes pi/2: eq (4) with
+    unequal radii gives phi0 = theta0 / c beyond a right angle, where every model
+    answers no critical angle (as tests/common's phi0 and theta0)."""
+    v = df[c].to_numpy(dtype=float).copy()
+    if c in ("phi0", "theta0"):
+        v[df["phi0"].to_numpy(dtype=float) > np.pi / 2] = np.nan
+    return v
+
+
 def inputs(df):
     return [df[c].to_numpy() for c in ["R1", "R2", "G", "nu", "mu", "P", "phi"]]
 
@@ -30,9 +40,9 @@ def test_scene_rows_every_column():
     df = pd.read_csv(DATA / "vectors_scene.csv")
     r = misalign.estimate(*inputs(df), details=True)
     for c in ["s", "F", "phi0"]:
-        assert rel(r[c], df[c]).max() <= MAIN, c
+        assert rel(r[c], want(df, c)).max() <= MAIN, c
     for c in ["theta", "kprime", "m", "n", "a", "b", "p0", "d", "Pstar", "P0star", "theta0"]:
-        assert rel(r[c], df[c]).max() <= REST, c
+        assert rel(r[c], want(df, c)).max() <= REST, c
     assert (r["regime"] == df["regime"].to_numpy()).all()
     assert (r["model"] == "elliptic").all()
     assert (r["error"] == "").all()
@@ -59,7 +69,7 @@ def test_f32_core_to_its_bound(threads):
     df = pd.read_csv(DATA / "vectors_scene.csv")
     r = misalign.estimate(*inputs(df), model="f32", threads=threads)
     for c in ["s", "F", "phi0"]:
-        assert rel(r[c], df[c]).max() <= F32, c
+        assert rel(r[c], want(df, c)).max() <= F32, c
     near_one = np.abs(df["s"].to_numpy() - 1) <= 1e-6
     assert (r["regime"][~near_one] == df["regime"].to_numpy()[~near_one]).all()
 
