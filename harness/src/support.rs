@@ -226,7 +226,9 @@ pub mod counter {
 
     /// `n / d` rounded down (`n` for `d == 0`), by shifts and subtractions: a 64-bit
     /// division would link the 64-bit division routine (about 1 KiB on a Cortex-M0)
-    /// into every image that counts, and into its measured size.
+    /// into every image that counts, and into its measured size. Never inlined: called
+    /// after the window's end, it would otherwise be unrolled into every call site.
+    #[inline(never)]
     fn div(n: u64, d: u32) -> u64 {
         let d = u64::from(d.max(1));
         let mut q = 0u64;
