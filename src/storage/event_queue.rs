@@ -225,21 +225,8 @@ impl<F: NorFlash, T: Checkpoint, const BUF: usize> EventQueue<F, T, BUF> {
     async fn region_is_blank(&mut self) -> Result<bool, StorageError<F::Error>> {
         let range = self.queue.flash_range();
         let chunk = BUF - BUF % F::READ_SIZE.max(1);
-        let mut at = range.start;
-        while at < range.end && chunk > 0 {
-            let n = chunk.min((range.end - at) as usize);
-            let buf = self.buf.0.get_mut(..n).ok_or(StorageError::Internal)?;
-            self.queue
-                .flash()
-                .read(at, buf)
-                .await
-                .map_err(StorageError::Flash)?;
-            if buf.iter().any(|&b| b != 0xFF) {
-                return Ok(false);
-            }
-            at += n as u32;
-        }
-        Ok(chunk > 0)
+        let buf = self.buf.0.get_mut(..chunk).ok_or(StorageError::Internal)?;
+        super::store::read_blank(self.queue.flash(), range, buf).await
     }
 
     /// What the log holds now (as [`EventQueue::open`] found it, kept up to date).

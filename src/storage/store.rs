@@ -503,21 +503,8 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
                 needed: F::READ_SIZE,
             });
         }
-        let mut at = self.range.start;
-        while at < self.range.end {
-            let n = chunk.min((self.range.end - at) as usize);
-            let buf = self.buf.0.get_mut(..n).ok_or(StorageError::Internal)?;
-            self.map
-                .flash()
-                .read(at, buf)
-                .await
-                .map_err(StorageError::Flash)?;
-            if buf.iter().any(|&b| b != 0xFF) {
-                return Ok(false);
-            }
-            at += n as u32;
-        }
-        Ok(true)
+        let buf = self.buf.0.get_mut(..chunk).ok_or(StorageError::Internal)?;
+        read_blank(self.map.flash(), self.range.clone(), buf).await
     }
 
     /// Erases the whole region: every kind, every checkpoint. The remedy when
@@ -589,4 +576,27 @@ impl<F: NorFlash, const BUF: usize> Store<F, BUF> {
         self.last_s = Some(now_s);
         self.checkpoint(value).await.map(Some)
     }
+}
+
+/// True if every byte of `range` reads 0xFF, read in chunks of `buf` (a multiple of
+/// the flash's read size); false for an empty `buf`.
+pub(super) async fn read_blank<F: NorFlash>(
+    flash: &mut F,
+    range: Range<u32>,
+    buf: &mut [u8],
+) -> Result<bool, StorageError<F::Error>> {
+    if buf.is_empty() {
+        return Ok(false);
+    }
+    let mut at = range.start;
+    while at < range.end {
+        let n = buf.len().min((range.end - at) as usize);
+        let part = buf.get_mut(..n).ok_or(StorageError::Internal)?;
+        flash.read(at, part).await.map_err(StorageError::Flash)?;
+        if part.iter().any(|&b| b != 0xFF) {
+            return Ok(false);
+        }
+        at += n as u32;
+    }
+    Ok(true)
 }
