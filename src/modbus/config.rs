@@ -329,19 +329,8 @@ pub(crate) fn config_from_words(words: &[u16; CONFIG_WORDS]) -> Result<Config, C
     let u = |f: ConfigField| f.get(words);
     let x = |f: ConfigField| f32::from_bits(u(f));
     let (warning, alarm, deadband) = (x(C::Warning), x(C::Alarm), x(C::Deadband));
-    let thresholds = match u(C::ThresholdsOn) {
-        0 => Thresholds::SlipRatio {
-            warning,
-            alarm,
-            deadband,
-        },
-        1 => Thresholds::Margin {
-            warning,
-            alarm,
-            deadband,
-        },
-        _ => return Err(ConfigError::Threshold),
-    };
+    let thresholds = Thresholds::from_kind(u(C::ThresholdsOn), warning, alarm, deadband)
+        .ok_or(ConfigError::Threshold)?;
     let spikes = match u(C::SpikeWindow) {
         0 => None,
         w => Some(SpikeFilter {

@@ -716,19 +716,8 @@ impl Checkpoint for Config {
     fn decode(r: &mut Reader<'_>) -> Result<Self, CodecError> {
         let tag = r.u8()?;
         let [warning, alarm, deadband] = r.array_of(|r| r.f32())?;
-        let thresholds = match tag {
-            0 => Thresholds::SlipRatio {
-                warning,
-                alarm,
-                deadband,
-            },
-            1 => Thresholds::Margin {
-                warning,
-                alarm,
-                deadband,
-            },
-            _ => return Err(INVALID),
-        };
+        let thresholds =
+            Thresholds::from_kind(u32::from(tag), warning, alarm, deadband).ok_or(INVALID)?;
         let [on_delay_ms, off_delay_ms, fault_delay_ms, inhibit_ms] = r.array_of(|r| r.u32())?;
         let [
             stop_load,

@@ -43,6 +43,32 @@ pub enum Thresholds {
     },
 }
 
+impl Thresholds {
+    /// From its kind as records and registers store it (0 on the slip ratio, 1 on the
+    /// margin) and its three values; `None` for another kind.
+    #[cfg(any(feature = "sequential-storage", feature = "modbus"))]
+    pub(crate) const fn from_kind(
+        kind: u32,
+        warning: f32,
+        alarm: f32,
+        deadband: f32,
+    ) -> Option<Self> {
+        match kind {
+            0 => Some(Thresholds::SlipRatio {
+                warning,
+                alarm,
+                deadband,
+            }),
+            1 => Some(Thresholds::Margin {
+                warning,
+                alarm,
+                deadband,
+            }),
+            _ => None,
+        }
+    }
+}
+
 /// Spike rejection: a Hampel test over the last `window` values of load and angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
