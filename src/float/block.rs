@@ -32,10 +32,12 @@ pub(crate) struct Block {
     /// Whether the hot path answered the sample; where not, the other fields are
     /// meaningless and [`Auto::estimate`] answers it.
     pub hot: [bool; BLOCK],
-    /// theta (rad), then g(theta), then theta0: the passes' scratch.
+    /// theta (rad), then g(theta) (eqs 4, 5-6).
     scratch: [f32; BLOCK],
     /// g0 = (B^3 P)^(1/3) (eq 18 at d/b = 1).
     g0: [f32; BLOCK],
+    /// theta0 = theta(g0) (rad).
+    theta0: [f32; BLOCK],
 }
 
 impl Block {
@@ -52,6 +54,7 @@ impl Block {
             hot: [false; BLOCK],
             scratch: [0.0; BLOCK],
             g0: [0.0; BLOCK],
+            theta0: [0.0; BLOCK],
         }
     }
 }
@@ -82,36 +85,34 @@ impl EllipticScene<'_> {
                 None => *hot = false,
             }
         }
-        // d/b = g / g0 (eq 16), then theta0 = theta(g0) from the inverse table.
-        for ((hot, x), (s, &g0)) in b
-            .hot
-            .iter_mut()
-            .zip(&mut b.scratch)
-            .zip(b.slip_ratio.iter_mut().zip(&b.g0))
-        {
-            *s = *x / g0;
+        // theta0 = theta(g0) from the inverse table.
+        for (hot, (t, &g0)) in b.hot.iter_mut().zip(b.theta0.iter_mut().zip(&b.g0)) {
             match self.tables.theta_of_g.eval(g0) {
-                Some(t) => *x = t,
+                Some(x) => *t = x,
                 None => *hot = false,
             }
         }
-        // F (eq 21), the regime and phi0 = theta0 / c, as the per-sample path ends.
-        for (((f, c), r), ((&s, &theta0), (&load, &phi))) in b
-            .axial_force
+        // d/b = g / g0 (eq 16), F (eq 21), the regime and phi0 = theta0 / c, as the
+        // per-sample path ends.
+        for ((((s, f), c), r), (((&g, &g0), &theta0), (&load, &phi))) in b
+            .slip_ratio
             .iter_mut()
+            .zip(&mut b.axial_force)
             .zip(&mut b.critical_angle)
             .zip(&mut b.regime)
             .zip(
-                b.slip_ratio
+                b.scratch
                     .iter()
-                    .zip(&b.scratch)
+                    .zip(&b.g0)
+                    .zip(&b.theta0)
                     .zip(b.load.iter().zip(&b.phi)),
             )
         {
             let abs_phi = phi.abs();
+            *s = g / g0;
             let e = self.finish(
                 Parts {
-                    slip_ratio: s,
+                    slip_ratio: *s,
                     // phi / |phi| is phi's sign on the hot path (phi is not 0 there).
                     signed_limit: self.friction * load * (phi / abs_phi),
                     critical_angle: Some(theta0 * self.inv_radius_factor),
