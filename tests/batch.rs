@@ -266,6 +266,109 @@ fn cores_in_a_batch_answer_as_row_by_row() {
     assert!(lines > 0, "the sweep reaches line contact");
 }
 
+/// One scene for all rows (the cores' block loops) answers every column as a scene
+/// given per row (the row-by-row loop), bit for bit: on the hot path, off it (zero,
+/// the asymptotics, line contact, phi0 beyond pi/2) and on refused rows, in full and
+/// partial blocks, with and without a length, P and phi per row or one value.
+#[test]
+fn one_scene_answers_every_column_as_a_scene_per_row() {
+    let (mut load, mut phi) = sweep();
+    let edges = [
+        (0.0, 2e-4),
+        (1e3, 0.0),
+        (1e3, -0.0),
+        (-0.0, 2e-4),
+        (f64::NAN, 2e-4),
+        (1e3, f64::NAN),
+        (-1.0, 2e-4),
+        (f64::INFINITY, 2e-4),
+        (1e3, 1.0),
+        (1e3, 1.0f64.next_up()),
+        (1e3, -1.5),
+        (1e3, core::f64::consts::FRAC_PI_2),
+        (1e3, core::f64::consts::FRAC_PI_2.next_up()),
+        (1e3, 1e-40),
+        (1e3, 1e-50),
+        (1e-50, 2e-4),
+        (1e-30, 2e-4),
+        (1e39, 2e-4),
+        (1e36, 2e-4),
+        (1e3, 1e-12),
+        (f64::MIN_POSITIVE, 1e-3),
+    ];
+    for (p, a) in edges {
+        load.insert(37, p);
+        phi.insert(37, a);
+    }
+    load.truncate(1000); // a partial block at the end
+    phi.truncate(1000);
+    let n = load.len();
+    let fixed = Model::Fixed {
+        load_lsb: 1e-2,
+        angle_lsb: None,
+    };
+    for (scene, choice) in [
+        (Scene::DEMO, ModelChoice::Section9),
+        (Scene::DEMO.with_length(0.2).unwrap(), ModelChoice::Section9),
+        (Scene::DEMO.with_length(0.2).unwrap(), ModelChoice::Line),
+        (Scene::DEMO.with_length(0.2).unwrap(), ModelChoice::Elliptic),
+        (
+            Scene::new(0.05, 1.0, 79.3e9, 0.3, 0.3).unwrap(),
+            ModelChoice::Section9,
+        ),
+    ] {
+        let cols = [
+            vec![scene.r1(); n],
+            vec![scene.r2(); n],
+            vec![scene.shear_modulus(); n],
+            vec![scene.poisson_ratio(); n],
+            vec![scene.friction(); n],
+            load.clone(),
+            phi.clone(),
+        ];
+        let lengths = scene.length().map(|l| vec![l; n]);
+        let per_row = Inputs {
+            length: lengths.as_deref().map(Column::Each),
+            ..inputs(&cols, choice)
+        };
+        let one = Inputs {
+            choice,
+            ..Inputs::one_scene(&scene, Column::Each(&load), Column::Each(&phi))
+        };
+        let scalars = Inputs {
+            load: Column::One(load[40]),
+            phi: Column::One(phi[40]),
+            ..one
+        };
+        for model in [Model::F32, fixed] {
+            let mut want = Owned::new(n);
+            let mut got = Owned::new(n);
+            let bad = batch::estimate(&per_row, &mut want.outputs(true), model).unwrap();
+            assert_eq!(
+                batch::estimate(&one, &mut got.outputs(true), model),
+                Ok(bad)
+            );
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            for (a, b) in [
+                (&want.s, &got.s),
+                (&want.f, &got.f),
+                (&want.phi0, &got.phi0),
+            ] {
+                assert_eq!(bits(a), bits(b), "{model:?} {choice:?}");
+            }
+            assert_eq!(want.regime, got.regime, "{model:?} {choice:?}");
+            assert_eq!(want.model, got.model, "{model:?} {choice:?}");
+            assert_eq!(want.flags, got.flags, "{model:?} {choice:?}");
+            assert_eq!(want.status, got.status, "{model:?} {choice:?}");
+            assert!(got.details.iter().flatten().all(|x| x.is_nan()));
+            let mut same = Owned::new(n);
+            batch::estimate(&scalars, &mut same.outputs(false), model).unwrap();
+            assert!(same.s.iter().all(|x| x.to_bits() == want.s[40].to_bits()));
+            assert!(same.flags.iter().all(|x| *x == want.flags[40]));
+        }
+    }
+}
+
 #[test]
 fn bad_rows_get_their_error_and_the_others_their_values() {
     let load = [1e3, f64::NAN, -1.0, 1e3, f64::INFINITY, 1e3, 1e3];

@@ -52,11 +52,15 @@ FLAGS = (
 _MODELS = ("reference", "f32", "fixed")
 _CONTACTS = ("auto", "elliptic", "line")
 _DETAILS = ("theta", "kprime", "m", "n", "a", "b", "p0", "d", "Pstar", "P0star", "theta0", "R")
-_ERRORS = np.array(_misalign.error_messages() + ["unknown error"], dtype=object)
+_MESSAGES = _misalign.error_messages()
+#: The message of every status code (a u8): the row's error, "" for a fine row.
+_ERRORS = np.array(_MESSAGES + ["unknown error"] * (256 - len(_MESSAGES)), dtype=object)
 _FLAG_TEXT = np.array(
     [";".join(name for bit, name in enumerate(FLAGS) if code >> bit & 1) for code in range(256)],
     dtype=object,
 )
+_REGIMES = np.array(["partial", "gross"] + [""] * 254, dtype=object)
+_CONTACT_MODELS = np.array(["elliptic", "line"] + [""] * 254, dtype=object)
 #: The built-in scenario's operating range: the replay's model choice takes at least it.
 _SCENARIO_LOAD_MAX = 5e3
 
@@ -101,7 +105,8 @@ def _option(name: str, value: str, allowed: Sequence[str]) -> str:
 class Result(Mapping):
     """The answer of :func:`estimate` and the inverses: a mapping of numpy arrays of
     the inputs' broadcast shape. Text columns (``regime``, ``model``, ``error``,
-    ``flags``) are built on first access. ``to_frame()`` gives a pandas DataFrame."""
+    ``flags``) are numpy object arrays of a few shared str objects, built from the
+    rows' codes on first access. ``to_frame()`` gives a pandas DataFrame."""
 
     def __init__(self, shape: Tuple[int, ...], numbers: dict, text: dict):
         self._shape = shape
@@ -189,13 +194,11 @@ def estimate(
     numbers = {"s": out["s"], "F": out["F"], "phi0": out["phi0"]}
     if details:
         numbers.update({k: out[k] for k in _DETAILS})
-    regime, model_code = out["regime_code"], out["model_code"]
-    status = np.minimum(out["status"], len(_ERRORS) - 1)
     text = {
-        "regime": (np.array(["partial", "gross"] + [""] * 254, dtype=object), regime),
-        "model": (np.array(["elliptic", "line"] + [""] * 254, dtype=object), model_code),
+        "regime": (_REGIMES, out["regime_code"]),
+        "model": (_CONTACT_MODELS, out["model_code"]),
         "flags": (_FLAG_TEXT, out["flags"]),
-        "error": (_ERRORS, status),
+        "error": (_ERRORS, out["status"]),
     }
     return Result(shape, numbers, text)
 

@@ -44,6 +44,18 @@ fn column<'a>(x: &'a [f64], n: usize, name: &str) -> PyResult<Column<'a>> {
     }
 }
 
+/// A numpy array of `n` elements as `numpy.empty` makes it: numpy's allocator (which
+/// asks the kernel for huge pages on large arrays: fewer page faults while the rows
+/// are written than a fresh Vec's), and no zeroing of memory that the batch then writes
+/// over in full (every output column gets every row).
+fn empty<'py, T: numpy::Element>(py: Python<'py>, n: usize) -> PyResult<Bound<'py, PyArray1<T>>> {
+    let array = py
+        .import("numpy")?
+        .getattr("empty")?
+        .call1((n, numpy::dtype::<T>(py)))?;
+    Ok(array.cast_into::<PyArray1<T>>()?)
+}
+
 const NAMES: [&str; 8] = ["R1", "R2", "G", "nu", "mu", "length", "P", "phi"];
 
 /// The messages of the status codes: index = status (0 = fine: "").
@@ -110,14 +122,12 @@ fn estimate<'py>(
         phi: cols[7],
         choice,
     };
-    // numpy's own arrays (its allocator asks the kernel for huge pages on large ones:
-    // fewer page faults while the rows are written than a fresh Vec's).
-    let floats: Vec<Bound<'py, PyArray1<f64>>> = (0..if details { 15 } else { 3 })
-        .map(|_| PyArray1::<f64>::zeros(py, n, false))
-        .collect();
-    let codes: Vec<Bound<'py, PyArray1<u8>>> = (0..4)
-        .map(|_| PyArray1::<u8>::zeros(py, n, false))
-        .collect();
+    let floats = (0..if details { 15 } else { 3 })
+        .map(|_| empty::<f64>(py, n))
+        .collect::<PyResult<Vec<_>>>()?;
+    let codes = (0..4)
+        .map(|_| empty::<u8>(py, n))
+        .collect::<PyResult<Vec<_>>>()?;
     let mut float_guards: Vec<_> = floats.iter().map(|a| a.readwrite()).collect();
     let mut code_guards: Vec<_> = codes.iter().map(|a| a.readwrite()).collect();
     let mut float_slices = float_guards

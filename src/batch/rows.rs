@@ -1,9 +1,10 @@
 //! The row loops of each model: a scene prepared once per run of rows with the same
 //! constants, then one estimate per row written into the output slices.
 
-use super::{Inputs, NONE, OK, Outputs, flags, status_of};
+use super::{Column, Inputs, NONE, OK, Outputs, flags, status_of};
 use crate::fixed::{FixedAuto, FixedEllipticScene};
-use crate::float::Auto;
+use crate::float::block::{BLOCK, Block};
+use crate::float::{Auto, AutoEstimate};
 use crate::reference::{self, ANGLE_LIMIT, ContactModel, ModelChoice, Regime, Validity};
 use crate::{Error, Scene};
 
@@ -34,10 +35,13 @@ fn model_code(m: ContactModel) -> u8 {
     }
 }
 
-/// Writes row `i`; returns 1 for a refused row, 0 otherwise.
+/// One row's cells: d/b, F, phi0, regime, model, flags, status.
+type Cells = (f64, f64, f64, u8, u8, u8, u8);
+
+/// A row's cells, and 1 for a refused row (0 otherwise).
 #[inline(always)]
-fn put(out: &mut Outputs<'_>, i: usize, row: Result<Row, Error>, details: &[f64; 12]) -> usize {
-    let (bad, values) = match row {
+fn cells(row: Result<Row, Error>) -> (usize, Cells) {
+    match row {
         Ok(r) => (
             0,
             (
@@ -54,7 +58,47 @@ fn put(out: &mut Outputs<'_>, i: usize, row: Result<Row, Error>, details: &[f64;
             1,
             (f64::NAN, f64::NAN, f64::NAN, NONE, NONE, 0, status_of(e)),
         ),
-    };
+    }
+}
+
+/// The main output columns of a core's loop.
+type Columns<'o> = (
+    &'o mut [f64],
+    &'o mut [f64],
+    &'o mut [f64],
+    &'o mut [u8],
+    &'o mut [u8],
+    &'o mut [u8],
+    &'o mut [u8],
+);
+
+/// The main output columns cut to the batch's length `n` (which `rows` checked), so
+/// that a loop over them needs no other bound; `None` where one is shorter.
+fn columns<'o>(out: &'o mut Outputs<'_>, n: usize) -> Option<Columns<'o>> {
+    Some((
+        out.slip_ratio.get_mut(..n)?,
+        out.axial_force.get_mut(..n)?,
+        out.critical_angle.get_mut(..n)?,
+        out.regime.get_mut(..n)?,
+        out.model.get_mut(..n)?,
+        out.flags.get_mut(..n)?,
+        out.status.get_mut(..n)?,
+    ))
+}
+
+/// The reference's further numbers, which the cores do not compute: NaN.
+fn no_details(out: &mut Outputs<'_>) {
+    if let Some(d) = &mut out.details {
+        for slice in d.slices() {
+            slice.fill(f64::NAN);
+        }
+    }
+}
+
+/// Writes row `i`; returns 1 for a refused row, 0 otherwise.
+#[inline(always)]
+fn put(out: &mut Outputs<'_>, i: usize, row: Result<Row, Error>, details: &[f64; 12]) -> usize {
+    let (bad, values) = cells(row);
     // The lengths were checked by `rows`: `get_mut` never misses.
     fn set<T>(slice: &mut [T], i: usize, x: T) {
         if let Some(v) = slice.get_mut(i) {
@@ -243,40 +287,222 @@ fn float_row(core: &Auto, load: f64, phi: f64) -> Result<Row, Error> {
         return Err(Error::Angle);
     }
     let e = core.estimate(narrow(load, Error::Load)?, narrow(phi, Error::Angle)?)?;
+    Ok(float_answer(e, phi))
+}
+
+/// [`float_row`] out of line: the rows off the ellipse's hot path.
+#[cold]
+#[inline(never)]
+fn float_row_cold(core: &Auto, load: f64, phi: f64) -> Result<Row, Error> {
+    float_row(core, load, phi)
+}
+
+/// The f32 core's answer as a row (`phi` the row's f64 angle, for the flags).
+#[inline(always)]
+fn float_answer(e: AutoEstimate, phi: f64) -> Row {
     let est = e.estimate;
     let critical = est.critical_angle.map(f64::from);
-    Ok(Row {
+    Row {
         slip_ratio: f64::from(est.slip_ratio),
         axial_force: f64::from(est.axial_force),
         critical_angle: critical,
         regime: est.regime,
         model: e.model,
         flags: core_flags(phi, critical, e.near_model_switch),
-    })
+    }
 }
 
 pub(super) fn float(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) -> usize {
-    let prepare = |s: &Scene| Auto::with_choice(s, inputs.choice);
-    let mut bad = 0;
+    by_scene(inputs, out, n, |s| Auto::with_choice(s, inputs.choice))
+}
+
+/// A prepared scene of a core, over rows.
+trait Core {
+    /// One row (f64 inputs as the batch has them).
+    fn row(&self, load: f64, phi: f64) -> Result<Row, Error>;
+    /// Rows `..n` of the columns into `out`; the number refused.
+    fn rows(&self, out: &mut Outputs<'_>, n: usize, load: impl At, phi: impl At) -> usize;
+}
+
+impl Core for Auto {
+    #[inline(always)]
+    fn row(&self, load: f64, phi: f64) -> Result<Row, Error> {
+        float_row(self, load, phi)
+    }
+    fn rows(&self, out: &mut Outputs<'_>, n: usize, load: impl At, phi: impl At) -> usize {
+        float_rows(self, out, n, load, phi)
+    }
+}
+
+/// A core's rows: the scene prepared once for the batch when every scene column is
+/// one value (the loop then specialised on whether P and phi are), else once per run
+/// of rows with the same constants.
+fn by_scene<C: Core>(
+    inputs: &Inputs<'_>,
+    out: &mut Outputs<'_>,
+    n: usize,
+    prepare: impl Fn(&Scene) -> Result<C, Error>,
+) -> usize {
     if inputs.one_scene_for_all() {
-        let core = inputs.scene(0).and_then(|s| prepare(&s));
-        for i in 0..n {
-            let row = match &core {
-                Ok(c) => float_row(c, inputs.load.at(i), inputs.phi.at(i)),
-                Err(e) => Err(*e),
-            };
-            bad += put(out, i, row, &NO_DETAILS);
-        }
-    } else {
-        let mut cache = Cache::new();
-        for i in 0..n {
-            let row = match cache.get(inputs, i, prepare) {
-                Ok(c) => float_row(c, inputs.load.at(i), inputs.phi.at(i)),
-                Err(e) => Err(*e),
-            };
-            bad += put(out, i, row, &NO_DETAILS);
+        let core = match inputs.scene(0).and_then(|s| prepare(&s)) {
+            Ok(core) => core,
+            Err(e) => return refuse_all(out, n, e),
+        };
+        return match (inputs.load, inputs.phi) {
+            (Column::Each(p), Column::Each(a)) => core.rows(out, n, p, a),
+            (Column::Each(p), Column::One(a)) => core.rows(out, n, p, Repeat(a)),
+            (Column::One(p), Column::Each(a)) => core.rows(out, n, Repeat(p), a),
+            (Column::One(p), Column::One(a)) => core.rows(out, n, Repeat(p), Repeat(a)),
+        };
+    }
+    let mut cache = Cache::new();
+    let mut bad = 0;
+    for i in 0..n {
+        let row = match cache.get(inputs, i, &prepare) {
+            Ok(c) => c.row(inputs.load.at(i), inputs.phi.at(i)),
+            Err(e) => Err(*e),
+        };
+        bad += put(out, i, row, &NO_DETAILS);
+    }
+    bad
+}
+
+/// Every row refused with the one scene's error.
+fn refuse_all(out: &mut Outputs<'_>, n: usize, error: Error) -> usize {
+    for i in 0..n {
+        put(out, i, Err(error), &NO_DETAILS);
+    }
+    n
+}
+
+/// An input column of a core's loop: one value per row, or one for every row.
+trait At: Copy {
+    /// Row `i` (NaN beyond the column: not reached, the lengths were checked).
+    fn at(self, i: usize) -> f64;
+    /// Rows `start..` as f32 into `out`, as many as both hold.
+    fn narrow_into(self, start: usize, out: &mut [f32]);
+    /// Whether |phi| of rows `start..` is above [`ANGLE_LIMIT`] (f64's), as
+    /// [`flags::LARGE_ANGLE`] or 0, into `out`.
+    fn large_angle_into(self, start: usize, out: &mut [u8]);
+}
+
+/// [`flags::LARGE_ANGLE`] where |phi| is above [`ANGLE_LIMIT`].
+#[inline(always)]
+fn large_angle(phi: f64) -> u8 {
+    u8::from(libm::fabs(phi) > ANGLE_LIMIT) * flags::LARGE_ANGLE
+}
+
+impl At for &[f64] {
+    #[inline(always)]
+    fn at(self, i: usize) -> f64 {
+        self.get(i).copied().unwrap_or(f64::NAN)
+    }
+    #[inline(always)]
+    fn narrow_into(self, start: usize, out: &mut [f32]) {
+        for (y, x) in out.iter_mut().zip(self.get(start..).unwrap_or_default()) {
+            *y = *x as f32;
         }
     }
+    #[inline(always)]
+    fn large_angle_into(self, start: usize, out: &mut [u8]) {
+        for (y, x) in out.iter_mut().zip(self.get(start..).unwrap_or_default()) {
+            *y = large_angle(*x);
+        }
+    }
+}
+
+/// One value for every row.
+#[derive(Clone, Copy)]
+struct Repeat(f64);
+
+impl At for Repeat {
+    #[inline(always)]
+    fn at(self, _: usize) -> f64 {
+        self.0
+    }
+    #[inline(always)]
+    fn narrow_into(self, _: usize, out: &mut [f32]) {
+        out.fill(self.0 as f32);
+    }
+    #[inline(always)]
+    fn large_angle_into(self, _: usize, out: &mut [u8]) {
+        out.fill(large_angle(self.0));
+    }
+}
+
+/// The f32 core's rows in blocks: the ellipse's hot path over each block
+/// ([`Auto::estimate_block`]), its answers written column by column; the rows off it
+/// (refused, zero, asymptotic, line contact) then one by one through [`float_row`].
+/// A row on the hot path took P and phi as f32 without a refusal of [`narrow`] (both
+/// finite, not rounded to 0 or inf, |phi| <= 1 < pi/2): it needs no other check, and
+/// its flags are [`core_flags`]' with a critical angle.
+#[inline(always)]
+fn float_rows(core: &Auto, out: &mut Outputs<'_>, n: usize, load: impl At, phi: impl At) -> usize {
+    let Some((s, f, c, r, m, g, t)) = columns(out, n) else {
+        return 0; // not reached: `rows` checked every length
+    };
+    let mut bad = 0;
+    let mut b = Block::new();
+    let mut large = [0u8; BLOCK];
+    let blocks = s
+        .chunks_mut(BLOCK)
+        .zip(f.chunks_mut(BLOCK))
+        .zip(c.chunks_mut(BLOCK))
+        .zip(r.chunks_mut(BLOCK))
+        .zip(m.chunks_mut(BLOCK))
+        .zip(g.chunks_mut(BLOCK))
+        .zip(t.chunks_mut(BLOCK));
+    for (k, ((((((s, f), c), r), m), g), t)) in blocks.enumerate() {
+        let start = k * BLOCK;
+        load.narrow_into(start, &mut b.load);
+        phi.narrow_into(start, &mut b.phi);
+        phi.large_angle_into(start, &mut large);
+        core.estimate_block(&mut b);
+        // Every row as if on the hot path, a column at a time.
+        for (y, x) in s.iter_mut().zip(&b.slip_ratio) {
+            *y = f64::from(*x);
+        }
+        for (y, x) in f.iter_mut().zip(&b.axial_force) {
+            *y = f64::from(*x);
+        }
+        for ((y, x), (flag, (&large, &near))) in c
+            .iter_mut()
+            .zip(&b.critical_angle)
+            .zip(g.iter_mut().zip(large.iter().zip(&b.near_model_switch)))
+        {
+            *y = f64::from(*x);
+            *flag = large
+                | (u8::from(*y > ANGLE_LIMIT) * flags::LARGE_ANGLE)
+                | (u8::from(near) * flags::NEAR_MODEL_SWITCH);
+        }
+        let len = r.len();
+        r.copy_from_slice(b.regime.get(..len).unwrap_or_default());
+        m.fill(model_code(ContactModel::Elliptic));
+        t.fill(OK);
+        // The rows off the hot path, over what was written for them.
+        // (A fold, not a search: one pass without a branch per row.)
+        if b.hot.iter().take(len).fold(true, |all, &hot| all & hot) {
+            continue;
+        }
+        for (j, _) in b.hot.iter().enumerate().take(len).filter(|(_, hot)| !**hot) {
+            let i = start + j;
+            let (refused, cells) = cells(float_row_cold(core, load.at(i), phi.at(i)));
+            bad += refused;
+            let row = (
+                s.get_mut(j),
+                f.get_mut(j),
+                c.get_mut(j),
+                r.get_mut(j),
+                m.get_mut(j),
+                g.get_mut(j),
+                t.get_mut(j),
+            );
+            if let (Some(s), Some(f), Some(c), Some(r), Some(m), Some(g), Some(t)) = row {
+                (*s, *f, *c, *r, *m, *g, *t) = cells;
+            }
+        }
+    }
+    no_details(out);
     bad
 }
 
@@ -349,15 +575,41 @@ pub(super) fn fixed(
     load_lsb: f64,
     angle_lsb: Option<f64>,
 ) -> usize {
-    let prepare = |s: &Scene| prepare_fixed(s, inputs.choice, load_lsb, angle_lsb);
-    let mut cache = Cache::new();
-    let mut bad = 0;
-    for i in 0..n {
-        let row = match cache.get(inputs, i, prepare) {
-            Ok(c) => fixed_row(c, inputs.load.at(i), inputs.phi.at(i)),
-            Err(e) => Err(*e),
-        };
-        bad += put(out, i, row, &NO_DETAILS);
+    by_scene(inputs, out, n, |s| {
+        prepare_fixed(s, inputs.choice, load_lsb, angle_lsb)
+    })
+}
+
+impl Core for FixedCore {
+    #[inline(always)]
+    fn row(&self, load: f64, phi: f64) -> Result<Row, Error> {
+        fixed_row(self, load, phi)
     }
+    fn rows(&self, out: &mut Outputs<'_>, n: usize, load: impl At, phi: impl At) -> usize {
+        fixed_rows(self, out, n, load, phi)
+    }
+}
+
+/// The fixed-point core's rows of one prepared scene, written straight into the
+/// output columns.
+#[inline(always)]
+fn fixed_rows(
+    core: &FixedCore,
+    out: &mut Outputs<'_>,
+    n: usize,
+    load: impl At,
+    phi: impl At,
+) -> usize {
+    let Some((s, f, c, r, m, g, t)) = columns(out, n) else {
+        return 0; // not reached: `rows` checked every length
+    };
+    let mut bad = 0;
+    let rows = s.iter_mut().zip(f).zip(c).zip(r).zip(m).zip(g).zip(t);
+    for (i, ((((((s, f), c), r), m), g), t)) in rows.enumerate() {
+        let (refused, cells) = cells(fixed_row(core, load.at(i), phi.at(i)));
+        bad += refused;
+        (*s, *f, *c, *r, *m, *g, *t) = cells;
+    }
+    no_details(out);
     bad
 }

@@ -26,8 +26,8 @@ pub struct Auto {
     /// `None` where line contact never answers and its constants do not fit f32.
     pub(super) line: Option<LineScene>,
     /// 2 / length (1/m); 0 without a length (the ellipse always fits).
-    two_over_length: f32,
-    choice: ModelChoice,
+    pub(super) two_over_length: f32,
+    pub(super) choice: ModelChoice,
     /// d/b at and above which the risk flag is raised (both models).
     risk_slip_ratio: f32,
 }

@@ -91,10 +91,20 @@ impl Tables<'static> {
 /// What an estimate is finished from: d/b, `+-mu P` with the sign of phi (the axial
 /// force in gross slip), phi0.
 #[derive(Clone, Copy)]
-struct Parts {
-    slip_ratio: f32,
-    signed_limit: f32,
-    critical_angle: Option<f32>,
+pub(super) struct Parts {
+    pub(super) slip_ratio: f32,
+    pub(super) signed_limit: f32,
+    pub(super) critical_angle: Option<f32>,
+}
+
+/// Whether a sample is in the hot path's range: |phi| <= 1 and B^3 P = `w` in
+/// [2^-81, 1/2), on the bits, each one unsigned compare with immediates: |phi| > 1
+/// includes inf and NaN, whose patterns lie above; B^3 P outside the range includes a
+/// load that is 0, negative, NaN or inf.
+#[inline(always)]
+pub(super) fn in_hot_range(abs_phi: f32, w: f32) -> bool {
+    abs_phi.to_bits() <= 1.0f32.to_bits()
+        && w.to_bits().wrapping_sub(HOT_CUBE_LOW_BITS) < HOT_CUBE_SPAN
 }
 
 /// A prepared elliptic-contact scene: the per-sample constants of eqs (4), (16), (18).
@@ -122,8 +132,8 @@ pub struct EllipticScene<'t> {
     /// path) when B^3 lies outside [2^-120, 2^39], so that B^3 P in the hot path's range
     /// [2^-81, 1/2) means a load in [2^-120, 2^119), or when c is below
     /// `HOT_MIN_RADIUS_FACTOR`.
-    cubed_critical_gain: f32,
-    tables: Tables<'t>,
+    pub(super) cubed_critical_gain: f32,
+    pub(super) tables: Tables<'t>,
 }
 
 impl EllipticScene<'static> {
@@ -230,15 +240,11 @@ impl<'t> EllipticScene<'t> {
     /// The hot path: |phi| <= 1, B^3 P in [2^-81, 1/2) (so g0 in [2^-27, 0.8) and the
     /// load in [2^-120, 2^119) N), theta on the tables; `None` for everything else (bad
     /// input, zero, the asymptotics, no critical angle, the edges), which
-    /// `general_parts` answers the same. The checks are on the bits, each one unsigned
-    /// compare with immediates: |phi| > 1 includes inf and NaN, whose patterns lie
-    /// above; B^3 P outside the range includes a load that is 0, negative, NaN or inf.
+    /// `general_parts` answers the same.
     #[inline(always)]
     fn hot_parts(&self, load: f32, phi: f32, abs_phi: f32) -> Option<Parts> {
         let w = self.cubed_critical_gain * load; // g0^3 (eq 18 at d/b = 1)
-        if abs_phi.to_bits() > 1.0f32.to_bits()
-            || w.to_bits().wrapping_sub(HOT_CUBE_LOW_BITS) >= HOT_CUBE_SPAN
-        {
+        if !in_hot_range(abs_phi, w) {
             return None;
         }
         let theta = self.radius_factor * abs_phi;
@@ -258,7 +264,7 @@ impl<'t> EllipticScene<'t> {
     /// and the risk flag, on the bits (d/b is positive or zero and not NaN, the
     /// threshold positive and finite: their order is that of their bits).
     #[inline(always)]
-    fn finish(&self, parts: Parts, abs_phi: f32) -> Estimate {
+    pub(super) fn finish(&self, parts: Parts, abs_phi: f32) -> Estimate {
         let Parts {
             slip_ratio: s,
             signed_limit,

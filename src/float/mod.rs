@@ -13,6 +13,7 @@
 //! [`Auto`] applies section 9's model choice per sample, as `reference::estimate` does.
 
 mod auto;
+pub(crate) mod block;
 mod elliptic;
 pub mod inverse;
 internal! {
