@@ -732,6 +732,119 @@ mod power_loss {
         eprintln!("{points_total} power cuts over 10 commits");
         assert!(points_total > 10 * IMAGE_LEN as u64, "{points_total}");
     }
+
+    use misalign::monitor::MonitorState;
+
+    /// The node's store (examples/firmware/persist.rs): the committed image beside the
+    /// monitor's state checkpoints, one map, one buffer for the larger record.
+    const BOTH_BUF: usize = {
+        let state = Store::<BlockingFlash<Flash>, 0>::buffer_len::<MonitorState>();
+        let image = Store::<BlockingFlash<Flash>, 0>::buffer_len::<Image>();
+        if state > image { state } else { image }
+    };
+    type Both = Store<BlockingFlash<Flash>, BOTH_BUF>;
+
+    fn open_both(flash: Flash) -> Both {
+        Store::new(BlockingFlash(flash), 0..4096, 60).unwrap()
+    }
+
+    /// What a boot finds: the commit it runs (0: none) and the state restored.
+    fn boot_both(flash: Flash) -> (Both, u32, Option<MonitorState>) {
+        let mut store = open_both(flash);
+        let image = block_on(store.restore::<Image>()).unwrap();
+        let commit = match image.value {
+            Some(image) => {
+                let mut s = server();
+                assert_eq!(s.restore(Stored::Image(&image.0)), BootSource::Committed);
+                s.monitor().config().on_delay_ms / 1000
+            }
+            None => 0,
+        };
+        let mut state = MonitorState::default();
+        let restored = matches!(
+            block_on(store.restore_into(&mut state)).unwrap(),
+            RestoreOutcome::Restored { .. }
+        );
+        (store, commit, restored.then_some(state))
+    }
+
+    /// The store as the node writes it: a state checkpoint and a commit in turn. A
+    /// power cut at every point of each leaves the other record as it was and its own
+    /// old or new, whole, through the sectors the map erases and the records it moves.
+    #[test]
+    fn a_power_cut_in_a_store_of_state_and_commits_spares_the_other_record() {
+        let mut monitor = Monitor::new(core(&Scene::DEMO), Config::default()).unwrap();
+        let mut base = Flash::new();
+        let (mut commit, mut state) = (0u32, None::<MonitorState>);
+        let mut cuts = 0u64;
+        for turn in 0..8u32 {
+            for i in 0..30 {
+                let t = turn * 30 + i;
+                monitor.process(Sample::new(t * 1000, 2e3 + t as f32, 1e-4).with_speed(2.0));
+            }
+            let new_state = monitor.snapshot();
+            let new_image = image(turn + 1);
+            // Points of a write on `base` after the boot's.
+            let points = |base: &Flash, write: &dyn Fn(&mut Both)| {
+                let (probe, ..) = boot_both(base.clone());
+                let start = probe.into_flash().0.points();
+                let (mut probe, ..) = boot_both(base.clone());
+                write(&mut probe);
+                probe.into_flash().0.points() - start
+            };
+            let write_state = |s: &mut Both| {
+                block_on(s.checkpoint(&new_state)).unwrap();
+            };
+            let write_image = |s: &mut Both| {
+                block_on(s.checkpoint(&new_image)).unwrap();
+            };
+            let state_points = points(&base, &write_state);
+            for p in 0..state_points {
+                let mut flash = base.clone();
+                flash.cut_after(p);
+                let (mut store, ..) = boot_both(flash);
+                assert!(block_on(store.checkpoint(&new_state)).is_err());
+                let mut flash = store.into_flash().0;
+                flash.restart();
+                let (_, c, st) = boot_both(flash);
+                let what = format!("state {turn}, point {p}");
+                assert_eq!(c, commit, "{what}: the commit");
+                assert!(st == state || st == Some(new_state), "{what}: the state");
+                cuts += 1;
+            }
+            let (mut store, ..) = boot_both(base);
+            write_state(&mut store);
+            base = store.into_flash().0;
+            state = Some(new_state);
+            let image_points = points(&base, &write_image);
+            for p in 0..image_points {
+                let mut flash = base.clone();
+                flash.cut_after(p);
+                let (mut store, ..) = boot_both(flash);
+                assert!(block_on(store.checkpoint(&new_image)).is_err());
+                let mut flash = store.into_flash().0;
+                flash.restart();
+                let (_, c, st) = boot_both(flash);
+                let what = format!("commit {}, point {p}", turn + 1);
+                assert!(c == commit || c == turn + 1, "{what}: {c}");
+                assert_eq!(st, state, "{what}: the state");
+                cuts += 1;
+            }
+            let (mut store, ..) = boot_both(base);
+            write_image(&mut store);
+            base = store.into_flash().0;
+            commit = turn + 1;
+            assert_eq!(boot_both(base.clone()).1, commit);
+        }
+        let erases: u32 = base.erase_counts().iter().sum();
+        eprintln!(
+            "{cuts} power cuts over 8 state checkpoints and 8 commits, {erases} sector erases"
+        );
+        assert!(
+            erases > 0,
+            "the map erased no sector: the moves were not swept"
+        );
+    }
 }
 
 /// Without the code, no write changes the configuration, the scene or the code:

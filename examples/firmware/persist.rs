@@ -23,6 +23,24 @@ use misalign::storage::{
     BlockingFlash, ConfigImage, EventQueue, RestoreOutcome, StorageEvent, Store, block_on,
 };
 
+// Test builds (`_power-cut`): a power cut a test planned, armed at the start of the
+// operation it names; nothing otherwise.
+#[cfg(feature = "_power-cut")]
+use crate::cut::{Op, arm_if_planned as cut, disarm as uncut};
+#[cfg(not(feature = "_power-cut"))]
+#[derive(Clone, Copy)]
+enum Op {
+    Commit,
+    Push,
+    Ack,
+}
+#[cfg(not(feature = "_power-cut"))]
+#[inline(always)]
+fn cut(_: Op) {}
+#[cfg(not(feature = "_power-cut"))]
+#[inline(always)]
+fn uncut() {}
+
 /// The store's region (the state's and the configuration's records).
 const STORE_SIZE: usize = 4 * SECTOR;
 /// The event queue's region.
@@ -191,16 +209,20 @@ impl Persist {
     /// checkpointed at each event and at the interval, the storage registers told.
     pub fn service<E: Estimator>(&mut self, server: &mut Server<E>) {
         while let Some(e) = server.pop_event() {
+            cut(Op::Push);
             if block_on(self.events.push(e.seq, &e)).is_err() {
                 defmt::warn!("storage: event {=u32} not stored", e.seq);
             }
+            uncut();
             server.offer_event(e);
         }
         let ack = server.acknowledged_through();
         if let Some(k) = ack.filter(|_| ack != self.acked) {
+            cut(Op::Ack);
             if block_on(self.events.acknowledge(k)).is_err() {
                 defmt::warn!("storage: acknowledgement {=u32} not stored", k);
             }
+            uncut();
             self.acked = ack;
         }
         while let Some(wanted) = server.wanted_event() {
@@ -220,8 +242,12 @@ impl Persist {
             }
         }
         let mut image = ConfigImage::<IMAGE_LEN>::new();
-        if server.take_committed(&mut image.0) && block_on(self.store.checkpoint(&image)).is_err() {
-            defmt::warn!("storage: the committed configuration not stored");
+        if server.take_committed(&mut image.0) {
+            cut(Op::Commit);
+            if block_on(self.store.checkpoint(&image)).is_err() {
+                defmt::warn!("storage: the committed configuration not stored");
+            }
+            uncut();
         }
         self.checkpoint(server.monitor());
         let q = self.events.state();

@@ -1,0 +1,206 @@
+"""Power cuts of the node with flash in QEMU, at points of a commit, of an event push
+and of an acknowledgement. The node is a test build (feature `_power-cut`,
+examples/firmware/cut.rs): the test writes a plan (`commit N`, `push N` or `ack N`)
+to MODBUS_POWER_CUT_PLAN, and the node resets itself after N points (bytes written,
+words erased) of its next such operation, as a power cut there would. The master
+then reconnects and checks: the old configuration or the new one, whole; no event
+back that was acknowledged on flash (`event_acked`); no stored event lost or changed.
+
+Points: 0, 1, 3, 7, 15, ... (2^k - 1) until the operation completes before its point;
+with MODBUS_POWER_CUT_ALL=1 every point, 0, 1, 2, ...
+"""
+
+import itertools
+import os
+import time
+
+import pytest
+
+from conftest import read_table, register_map
+from master import Map, Master, read_samples, u32_words
+from test_config import code, get, view, write
+from test_reset import ack_address, wait_serving
+
+NONE = 0xFFFFFFFF
+
+
+def points():
+    if os.environ.get("MODBUS_POWER_CUT_ALL"):
+        return itertools.count()
+    return (2 ** k - 1 for k in itertools.count())
+
+
+def plan(op, n):
+    with open(os.environ["MODBUS_POWER_CUT_PLAN"], "w") as f:
+        f.write(f"{op} {n}\n")
+
+
+def inputs():
+    return {r["name"]: r for r in register_map() if r["table"] == "input"}
+
+
+def get_input(client, name):
+    r = inputs()[name]
+    n = 2 if r["type"] in ("u32", "f32") else 1
+    w = read_table(client, "input", r["address"], n)
+    return w[0] << 16 | w[1] if n == 2 else w[0]
+
+
+def settled(client, frames):
+    """After an operation planned to be cut: reconnected once the node answers;
+    whether it was reset (its count of frames begun again). The plan must be taken."""
+    time.sleep(0.3)
+    wait_serving(client)
+    assert not os.path.exists(os.environ["MODBUS_POWER_CUT_PLAN"]), "the node took no plan"
+    return get_input(client, "bus_frames") <= frames
+
+
+def seq(event):
+    return event[0] << 16 | event[1]
+
+
+def stored_events(client, regmap):
+    """Every event the node holds on flash, from the oldest not acknowledged."""
+    acked = get_input(client, "event_acked")
+    m = Master(client, regmap)
+    m.write(regmap.event_from, u32_words(0 if acked == NONE else acked + 1))
+    m.read_events()
+    assert m.missed == 0, f"{m.missed} events lost"
+    seqs = [seq(e) for e in m.events]
+    if seqs:
+        assert seqs == list(range(seqs[0], seqs[0] + len(seqs))), seqs
+        if acked != NONE:
+            assert seqs[0] == acked + 1, f"acknowledged through {acked}, yet {seqs[0]} offered"
+    return m.events
+
+
+class Feeder:
+    """The scenario's samples, from where the monitor is (`samples`: after a cut, its
+    checkpoint), again and again, times running on."""
+
+    def __init__(self, client, regmap):
+        self.c = client
+        self.m = regmap
+        self.samples = read_samples(os.environ["MODBUS_SAMPLES"])
+        span = (self.samples[-1][0] - self.samples[0][0]) & NONE
+        self.lap = span + 1000
+
+    def sample(self, i):
+        s = self.samples[i % len(self.samples)]
+        return ((s[0] + (i // len(self.samples)) * self.lap) & NONE,) + s[1:]
+
+    def until_event(self):
+        """Samples, a block a write, until an event is raised; whether the node was cut
+        (reset) on its way."""
+        master = Master(self.c, self.m)
+        frames = get_input(self.c, "bus_frames")
+        seq_next = get_input(self.c, "event_seq_next")
+        for _ in range(len(self.samples) // self.m.full + 1):
+            i = get_input(self.c, "samples")
+            try:
+                master.feed([self.sample(i + k) for k in range(self.m.full)])
+                if get_input(self.c, "event_seq_next") != seq_next:
+                    break
+            except Exception:  # noqa: BLE001 (the node reset under the request)
+                break
+        else:
+            raise AssertionError("no event from a lap of the samples")
+        return frames
+
+
+def unlock(client):
+    assert not write(client, "unlock", code()).isError()
+
+
+def commit(client, on_delay):
+    unlock(client)
+    assert not write(client, "config_on_delay", on_delay).isError()
+    new = view(client, "config")
+    return new
+
+
+@pytest.fixture(autouse=True)
+def no_plan_left():
+    """No plan from an earlier run armed for this test's first operation."""
+    path = os.environ["MODBUS_POWER_CUT_PLAN"]
+    if os.path.exists(path):
+        os.remove(path)
+
+
+def test_a_commit_cut_anywhere_leaves_the_old_or_the_new_configuration(client):
+    commit(client, 1000)
+    assert not write(client, "command", 1).isError()
+    cuts = 0
+    for r, n in enumerate(points()):
+        old = view(client, "active")
+        new = commit(client, 2000 + r)
+        assert new != old
+        plan("commit", n)
+        frames = get_input(client, "bus_frames")
+        try:
+            write(client, "command", 1)
+        except Exception:  # noqa: BLE001 (the answer lost to the cut)
+            pass
+        cut = settled(client, frames)
+        active = view(client, "active")
+        assert active in (old, new), f"cut after {n} points: neither configuration"
+        assert get(client, "config_source") == 1
+        if not cut:
+            assert active == new, f"the commit completed before point {n}, yet is not in force"
+            break
+        cuts += 1
+    print(f"commit: {cuts} cuts, the last at point {n - 1 if cuts else None}; complete before {n}")
+    assert cuts > 0
+
+
+def test_an_event_push_cut_anywhere_loses_no_stored_event(client):
+    regmap = Map(os.environ["MODBUS_REGISTERS"])
+    feeder = Feeder(client, regmap)
+    cuts = 0
+    for n in points():
+        before = stored_events(client, regmap)
+        if len(before) > 4:
+            # Few held, so that the queue never fills and drops one.
+            Master(client, regmap).write(ack_address(), u32_words(seq(before[-4])))
+            before = stored_events(client, regmap)
+        plan("push", n)
+        frames = feeder.until_event()
+        cut = settled(client, frames)
+        after = stored_events(client, regmap)
+        assert after[:len(before)] == before, f"cut after {n} points: stored events changed"
+        if not cut:
+            assert len(after) > len(before)
+            break
+        cuts += 1
+    print(f"push: {cuts} cuts; complete before point {n}")
+    assert cuts > 0
+
+
+def test_an_acknowledgement_cut_anywhere_brings_back_no_acknowledged_event(client):
+    regmap = Map(os.environ["MODBUS_REGISTERS"])
+    feeder = Feeder(client, regmap)
+    cuts = 0
+    for n in points():
+        while len(stored_events(client, regmap)) < 2:
+            feeder.until_event()
+        before = stored_events(client, regmap)
+        old = get_input(client, "event_acked")
+        k = seq(before[0])
+        plan("ack", n)
+        frames = get_input(client, "bus_frames")
+        try:
+            Master(client, regmap).write(ack_address(), u32_words(k))
+        except Exception:  # noqa: BLE001 (the answer lost to the cut)
+            pass
+        cut = settled(client, frames)
+        durable = get_input(client, "event_acked")
+        assert durable in (old, k), f"cut after {n} points: acknowledged through {durable}"
+        after = stored_events(client, regmap)
+        kept = before if durable == NONE else [e for e in before if seq(e) > durable]
+        assert after == kept, f"cut after {n} points"
+        if not cut:
+            assert durable == k
+            break
+        cuts += 1
+    print(f"ack: {cuts} cuts; complete before point {n}")
+    assert cuts > 0
