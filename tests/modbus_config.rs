@@ -784,55 +784,19 @@ mod power_loss {
             }
             let new_state = monitor.snapshot();
             let new_image = image(turn + 1);
-            // Points of a write on `base` after the boot's.
-            let points = |base: &Flash, write: &dyn Fn(&mut Both)| {
-                let (probe, ..) = boot_both(base.clone());
-                let start = probe.into_flash().0.points();
-                let (mut probe, ..) = boot_both(base.clone());
-                write(&mut probe);
-                probe.into_flash().0.points() - start
-            };
-            let write_state = |s: &mut Both| {
-                block_on(s.checkpoint(&new_state)).unwrap();
-            };
-            let write_image = |s: &mut Both| {
-                block_on(s.checkpoint(&new_image)).unwrap();
-            };
-            let state_points = points(&base, &write_state);
-            for p in 0..state_points {
-                let mut flash = base.clone();
-                flash.cut_after(p);
-                let (mut store, ..) = boot_both(flash);
-                assert!(block_on(store.checkpoint(&new_state)).is_err());
-                let mut flash = store.into_flash().0;
-                flash.restart();
-                let (_, c, st) = boot_both(flash);
-                let what = format!("state {turn}, point {p}");
-                assert_eq!(c, commit, "{what}: the commit");
-                assert!(st == state || st == Some(new_state), "{what}: the state");
-                cuts += 1;
-            }
-            let (mut store, ..) = boot_both(base);
-            write_state(&mut store);
-            base = store.into_flash().0;
+            // A state checkpoint cut anywhere: the commit as it was, the state old or new.
+            cuts += cut_everywhere(&base, &|s| block_on(s.checkpoint(&new_state)), &|c, st| {
+                assert_eq!(c, commit, "state {turn}: the commit");
+                assert!(st == state || st == Some(new_state), "state {turn}");
+            });
+            base = written(base, &|s| block_on(s.checkpoint(&new_state)));
             state = Some(new_state);
-            let image_points = points(&base, &write_image);
-            for p in 0..image_points {
-                let mut flash = base.clone();
-                flash.cut_after(p);
-                let (mut store, ..) = boot_both(flash);
-                assert!(block_on(store.checkpoint(&new_image)).is_err());
-                let mut flash = store.into_flash().0;
-                flash.restart();
-                let (_, c, st) = boot_both(flash);
-                let what = format!("commit {}, point {p}", turn + 1);
-                assert!(c == commit || c == turn + 1, "{what}: {c}");
-                assert_eq!(st, state, "{what}: the state");
-                cuts += 1;
-            }
-            let (mut store, ..) = boot_both(base);
-            write_image(&mut store);
-            base = store.into_flash().0;
+            // A commit cut anywhere: the state as it was, the commit old or new.
+            cuts += cut_everywhere(&base, &|s| block_on(s.checkpoint(&new_image)), &|c, st| {
+                assert!(c == commit || c == turn + 1, "commit {}: {c}", turn + 1);
+                assert_eq!(st, state, "commit {}: the state", turn + 1);
+            });
+            base = written(base, &|s| block_on(s.checkpoint(&new_image)));
             commit = turn + 1;
             assert_eq!(boot_both(base.clone()).1, commit);
         }
@@ -844,6 +808,38 @@ mod power_loss {
             erases > 0,
             "the map erased no sector: the moves were not swept"
         );
+    }
+
+    type Write<'a> = &'a dyn Fn(&mut Both) -> Result<u32, StorageError<MockError>>;
+
+    /// `base` booted and `write` done.
+    fn written(base: Flash, write: Write) -> Flash {
+        let (mut store, ..) = boot_both(base);
+        write(&mut store).unwrap();
+        store.into_flash().0
+    }
+
+    /// `write` on `base` (booted) cut at each of its points; `check` of what the boot
+    /// after each cut finds (the commit, the state). The number of cuts.
+    fn cut_everywhere(
+        base: &Flash,
+        write: Write,
+        check: &dyn Fn(u32, Option<MonitorState>),
+    ) -> u64 {
+        let (probe, ..) = boot_both(base.clone());
+        let start = probe.into_flash().0.points();
+        let points = written(base.clone(), write).points() - start;
+        for p in 0..points {
+            let mut flash = base.clone();
+            flash.cut_after(p);
+            let (mut store, ..) = boot_both(flash);
+            assert!(write(&mut store).is_err(), "point {p}");
+            let mut flash = store.into_flash().0;
+            flash.restart();
+            let (_, c, st) = boot_both(flash);
+            check(c, st);
+        }
+        points
     }
 }
 

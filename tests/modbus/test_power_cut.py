@@ -127,13 +127,26 @@ def no_plan_left():
         os.remove(path)
 
 
+def sweep(op, cut_at):
+    """`cut_at(n)` at each point until the operation completes before its point
+    (`cut_at` returns whether the node was cut, after its checks)."""
+    cuts = 0
+    for n in points():
+        if not cut_at(n):
+            break
+        cuts += 1
+    print(f"{op}: cut at {cuts} points; complete before point {n}")
+    assert cuts > 0
+
+
 def test_a_commit_cut_anywhere_leaves_the_old_or_the_new_configuration(client):
     commit(client, 1000)
     assert not write(client, "command", 1).isError()
-    cuts = 0
-    for r, n in enumerate(points()):
+    rounds = itertools.count()
+
+    def cut_at(n):
         old = view(client, "active")
-        new = commit(client, 2000 + r)
+        new = commit(client, 2000 + next(rounds))
         assert new != old
         plan("commit", n)
         frames = get_input(client, "bus_frames")
@@ -145,19 +158,17 @@ def test_a_commit_cut_anywhere_leaves_the_old_or_the_new_configuration(client):
         active = view(client, "active")
         assert active in (old, new), f"cut after {n} points: neither configuration"
         assert get(client, "config_source") == 1
-        if not cut:
-            assert active == new, f"the commit completed before point {n}, yet is not in force"
-            break
-        cuts += 1
-    print(f"commit: {cuts} cuts, the last at point {n - 1 if cuts else None}; complete before {n}")
-    assert cuts > 0
+        assert cut or active == new, f"the commit completed before point {n}, yet is not in force"
+        return cut
+
+    sweep("commit", cut_at)
 
 
 def test_an_event_push_cut_anywhere_loses_no_stored_event(client):
     regmap = Map(os.environ["MODBUS_REGISTERS"])
     feeder = Feeder(client, regmap)
-    cuts = 0
-    for n in points():
+
+    def cut_at(n):
         before = stored_events(client, regmap)
         if len(before) > 4:
             # Few held, so that the queue never fills and drops one.
@@ -168,19 +179,17 @@ def test_an_event_push_cut_anywhere_loses_no_stored_event(client):
         cut = settled(client, frames)
         after = stored_events(client, regmap)
         assert after[:len(before)] == before, f"cut after {n} points: stored events changed"
-        if not cut:
-            assert len(after) > len(before)
-            break
-        cuts += 1
-    print(f"push: {cuts} cuts; complete before point {n}")
-    assert cuts > 0
+        assert cut or len(after) > len(before)
+        return cut
+
+    sweep("push", cut_at)
 
 
 def test_an_acknowledgement_cut_anywhere_brings_back_no_acknowledged_event(client):
     regmap = Map(os.environ["MODBUS_REGISTERS"])
     feeder = Feeder(client, regmap)
-    cuts = 0
-    for n in points():
+
+    def cut_at(n):
         while len(stored_events(client, regmap)) < 2:
             feeder.until_event()
         before = stored_events(client, regmap)
@@ -198,9 +207,7 @@ def test_an_acknowledgement_cut_anywhere_brings_back_no_acknowledged_event(clien
         after = stored_events(client, regmap)
         kept = before if durable == NONE else [e for e in before if seq(e) > durable]
         assert after == kept, f"cut after {n} points"
-        if not cut:
-            assert durable == k
-            break
-        cuts += 1
-    print(f"ack: {cuts} cuts; complete before point {n}")
-    assert cuts > 0
+        assert cut or durable == k
+        return cut
+
+    sweep("ack", cut_at)
