@@ -12,8 +12,10 @@
 //!   (`tests/modbus/test_reset.py`: the committed configuration and the unacknowledged
 //!   events back), and a test build of it through power cuts at points of a commit, an
 //!   event push and an acknowledgement (feature `_power-cut`,
-//!   `tests/modbus/test_power_cut.py`; `MODBUS_POWER_CUT_ALL=1`: at every point).
-//!   pymodbus and pytest, pinned, in a virtual environment under `target/modbus-venv`.
+//!   `tests/modbus/test_power_cut.py`; `MODBUS_POWER_CUT_ALL=1`: at every point). On
+//!   the Cortex-M4F, tools/commission.py also commissions the node over a serial line
+//!   (serial0 on a pseudo-terminal, `tests/modbus/test_serial.py`). pymodbus, pyserial
+//!   and pytest, pinned, in a virtual environment under `target/modbus-venv`.
 //!   With `--boards`, the node on its own samples also on the Cortex-M7 and M3 (MPS2,
 //!   CMSDK UART0) and the STM32F405 (`netduinoplus2`, USART1).
 //! - `--serve PORT [--target TRIPLE]`: boots the node and serves until killed.
@@ -39,7 +41,7 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 /// The Python packages of the tests, pinned.
-const PYTHON_PACKAGES: [&str; 2] = ["pymodbus==3.16.1", "pytest==8.4.2"];
+const PYTHON_PACKAGES: [&str; 3] = ["pymodbus==3.16.1", "pyserial==3.5", "pytest==8.4.2"];
 
 /// The register map's export, relative to the repository root.
 const REGISTERS_CSV: &str = "docs/modbus/registers.csv";
@@ -461,11 +463,16 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         let expected = dir.join(format!("expected-{id}.csv"));
         host::write_registers(fpu, &expected)?;
         host::write_other_scene(fpu, &dir.join(format!("scene-{id}.bin")))?;
-        // Commissioning after the node's registers were compared: it changes them.
-        (
-            &["tests/modbus/test_node.py", "tests/modbus/test_config.py"][..],
-            expected,
-        )
+        // Commissioning after the node's registers were compared: it changes them. On
+        // the Cortex-M4F's own board, commissioning over a serial line too (a second
+        // QEMU of the image, serial0 on a pseudo-terminal).
+        const OWN: [&str; 3] = [
+            "tests/modbus/test_node.py",
+            "tests/modbus/test_config.py",
+            "tests/modbus/test_serial.py",
+        ];
+        let serial = id == "cortex-m4f" && node.machine == node.cpu.machine;
+        (if serial { &OWN[..] } else { &OWN[..2] }, expected)
     };
     let port = free_port()?;
     let monitor = node.stored.then(free_port).transpose()?;
@@ -499,6 +506,8 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
             misalign::modbus::WRONG_CODES_MAX.to_string(),
         )
         .env("MODBUS_SAMPLES", dir.join("samples.csv"))
+        .env("MODBUS_ELF", &elf)
+        .env("MODBUS_MACHINE", node.machine)
         // The plan file of a test build's power cuts: the image's path and `.cut`.
         .env("MODBUS_POWER_CUT_PLAN", elf.with_extension("cut"))
         .env("MODBUS_EVENTS_OUT", &file)
