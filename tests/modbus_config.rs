@@ -972,10 +972,13 @@ fn every_configuration_write_needs_the_unlock() {
     write(&mut s, at("event_ack"), &[0xFFFF, 0xFFFF]).unwrap();
     assert!(!s.unlocked());
 
-    // Unlocked: taken.
+    // Unlocked: taken, each renewing the unlock as a staged write does.
     unlock(&mut s);
+    s.tick(200_000);
     coil(&mut s, 1, true).unwrap();
     assert_eq!(s.annunciator().latching(), AlarmSet::WARNING);
+    s.tick(400_000);
+    assert!(s.unlocked(), "renewed by the write 200 s ago");
     write1(&mut s, at("latching"), 0b0110).unwrap();
     assert_eq!(
         s.annunciator().latching(),
