@@ -8,8 +8,8 @@ use misalign::modbus::map::{
     SAMPLE_FULL_STRIDE, SAMPLES, SAMPLES_ADDRESS, SAMPLES_FULL_ADDRESS, TableMap,
 };
 use misalign::modbus::{
-    AlarmSet, NONE, Server, ServerConfig, crc16, event_from_registers, fault_code, fault_from_code,
-    registers_csv,
+    AlarmSet, DEFAULT_UNLOCK_CODE, NONE, Server, ServerConfig, crc16, event_from_registers,
+    fault_code, fault_from_code, registers_csv,
 };
 use misalign::monitor::{Config, Monitor, RiskState, Sample, model_for_range};
 use misalign::{Estimator, Scene};
@@ -64,6 +64,15 @@ fn request<E: Estimator>(s: &mut Server<E>, function: u8, data: &[u8]) -> Vec<u8
 
 fn be(words: &[u16]) -> Vec<u8> {
     words.iter().flat_map(|w| w.to_be_bytes()).collect()
+}
+
+/// The holding register `unlock`.
+const UNLOCK: u16 = 9;
+
+/// The site's code written to `unlock`: configuration writes allowed.
+fn unlock<E: Estimator>(s: &mut Server<E>) {
+    let data = be(&[UNLOCK, DEFAULT_UNLOCK_CODE]);
+    assert_eq!(request(s, 6, &data)[1..], data[..]);
 }
 
 /// Reads `n` registers from `address` by function 3 or 4.
@@ -221,6 +230,13 @@ fn exceptions_as_the_specification_orders_them() {
         2,
         "from the middle of event_from"
     );
+    // Configuration while locked: 01 (the unlock's refusal) before the domain's 03.
+    assert_eq!(
+        exception(&request(&mut s, 6, &be(&[3, 16])), 6),
+        1,
+        "latching above 15, locked"
+    );
+    unlock(&mut s);
     assert_eq!(
         exception(&request(&mut s, 6, &be(&[3, 16])), 6),
         3,
@@ -255,7 +271,7 @@ fn exceptions_as_the_specification_orders_them() {
         3
     );
     // Every refused request left the state alone and was counted.
-    assert_eq!(s.counters().exceptions, 18);
+    assert_eq!(s.counters().exceptions, 19);
     assert_eq!(s.annunciator().latching(), AlarmSet::NONE);
 }
 
@@ -269,7 +285,9 @@ fn no_answer_to_a_wrong_crc_another_unit_or_a_broadcast() {
     assert_eq!(s.response(), None);
     assert_eq!(ask(&mut s, &frame(&[2, 4, 0, 0, 0, 1])), None);
     assert_eq!(ask(&mut s, &frame(&[0, 4, 0, 0, 0, 1])), None);
-    // A broadcast write is applied, not answered.
+    // A broadcast write is applied, not answered (configuration after the unlock).
+    let [c0, c1] = DEFAULT_UNLOCK_CODE.to_be_bytes();
+    assert_eq!(ask(&mut s, &frame(&[0, 6, 0, UNLOCK as u8, c0, c1])), None);
     assert_eq!(ask(&mut s, &frame(&[0, 6, 0, 3, 0, 5])), None);
     assert_eq!(s.annunciator().latching().bits(), 5);
     assert_eq!(ask(&mut s, &frame(&[0, 5, 0, 5, 0xFF, 0])), None);
@@ -539,7 +557,8 @@ fn external_samples_are_processed_as_the_monitors_own() {
     let records = basic_records(&[(0, 1e3, 1e-4)]);
     assert_eq!(exception(&write(&mut s, SAMPLES_ADDRESS, &records), 16), 1);
     assert_eq!(s.monitor().statistics().samples(), 0);
-    // On by the register; 20 a write.
+    // On by the register (after the unlock); 20 a write.
+    unlock(&mut s);
     assert_eq!(request(&mut s, 6, &be(&[4, 1])), vec![6, 0, 4, 0, 1]);
     for chunk in samples.chunks(usize::from(SAMPLES)) {
         let r: Vec<_> = chunk.iter().map(|x| (x.time_ms, x.load, x.phi)).collect();

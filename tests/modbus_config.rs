@@ -5,9 +5,9 @@
 //! every word erased of a commit's record.
 
 use misalign::float::Auto;
-use misalign::modbus::map::{SCENE_ADDRESS, Table, TableMap};
+use misalign::modbus::map::{Access, SAMPLES_ADDRESS, SCENE_ADDRESS, Table, TableMap};
 use misalign::modbus::{
-    BootSource, DEFAULT_UNLOCK_CODE, IMAGE_LEN, LOCKOUT_S, Server, ServerConfig, Stored,
+    AlarmSet, BootSource, DEFAULT_UNLOCK_CODE, IMAGE_LEN, LOCKOUT_S, Server, ServerConfig, Stored,
     UNLOCK_TIMEOUT_S, WRONG_CODES_MAX, command, crc16, reason, staged,
 };
 use misalign::monitor::{Config, Monitor, Sample, Thresholds, model_for_range};
@@ -732,6 +732,115 @@ mod power_loss {
         eprintln!("{points_total} power cuts over 10 commits");
         assert!(points_total > 10 * IMAGE_LEN as u64, "{points_total}");
     }
+
+    use misalign::monitor::MonitorState;
+
+    /// The node's store (examples/firmware/persist.rs): the committed image beside the
+    /// monitor's state checkpoints, one map, one buffer for the larger record.
+    const BOTH_BUF: usize = {
+        let state = Store::<BlockingFlash<Flash>, 0>::buffer_len::<MonitorState>();
+        let image = Store::<BlockingFlash<Flash>, 0>::buffer_len::<Image>();
+        if state > image { state } else { image }
+    };
+    type Both = Store<BlockingFlash<Flash>, BOTH_BUF>;
+
+    fn open_both(flash: Flash) -> Both {
+        Store::new(BlockingFlash(flash), 0..4096, 60).unwrap()
+    }
+
+    /// What a boot finds: the commit it runs (0: none) and the state restored.
+    fn boot_both(flash: Flash) -> (Both, u32, Option<MonitorState>) {
+        let mut store = open_both(flash);
+        let image = block_on(store.restore::<Image>()).unwrap();
+        let commit = match image.value {
+            Some(image) => {
+                let mut s = server();
+                assert_eq!(s.restore(Stored::Image(&image.0)), BootSource::Committed);
+                s.monitor().config().on_delay_ms / 1000
+            }
+            None => 0,
+        };
+        let mut state = MonitorState::default();
+        let restored = matches!(
+            block_on(store.restore_into(&mut state)).unwrap(),
+            RestoreOutcome::Restored { .. }
+        );
+        (store, commit, restored.then_some(state))
+    }
+
+    /// The store as the node writes it: a state checkpoint and a commit in turn. A
+    /// power cut at every point of each leaves the other record as it was and its own
+    /// old or new, whole, through the sectors the map erases and the records it moves.
+    #[test]
+    fn a_power_cut_in_a_store_of_state_and_commits_spares_the_other_record() {
+        let mut monitor = Monitor::new(core(&Scene::DEMO), Config::default()).unwrap();
+        let mut base = Flash::new();
+        let (mut commit, mut state) = (0u32, None::<MonitorState>);
+        let mut cuts = 0u64;
+        for turn in 0..8u32 {
+            for i in 0..30 {
+                let t = turn * 30 + i;
+                monitor.process(Sample::new(t * 1000, 2e3 + t as f32, 1e-4).with_speed(2.0));
+            }
+            let new_state = monitor.snapshot();
+            let new_image = image(turn + 1);
+            // A state checkpoint cut anywhere: the commit as it was, the state old or new.
+            cuts += cut_everywhere(&base, &|s| block_on(s.checkpoint(&new_state)), &|c, st| {
+                assert_eq!(c, commit, "state {turn}: the commit");
+                assert!(st == state || st == Some(new_state), "state {turn}");
+            });
+            base = written(base, &|s| block_on(s.checkpoint(&new_state)));
+            state = Some(new_state);
+            // A commit cut anywhere: the state as it was, the commit old or new.
+            cuts += cut_everywhere(&base, &|s| block_on(s.checkpoint(&new_image)), &|c, st| {
+                assert!(c == commit || c == turn + 1, "commit {}: {c}", turn + 1);
+                assert_eq!(st, state, "commit {}: the state", turn + 1);
+            });
+            base = written(base, &|s| block_on(s.checkpoint(&new_image)));
+            commit = turn + 1;
+            assert_eq!(boot_both(base.clone()).1, commit);
+        }
+        let erases: u32 = base.erase_counts().iter().sum();
+        eprintln!(
+            "{cuts} power cuts over 8 state checkpoints and 8 commits, {erases} sector erases"
+        );
+        assert!(
+            erases > 0,
+            "the map erased no sector: the moves were not swept"
+        );
+    }
+
+    type Write<'a> = &'a dyn Fn(&mut Both) -> Result<u32, StorageError<MockError>>;
+
+    /// `base` booted and `write` done.
+    fn written(base: Flash, write: Write) -> Flash {
+        let (mut store, ..) = boot_both(base);
+        write(&mut store).unwrap();
+        store.into_flash().0
+    }
+
+    /// `write` on `base` (booted) cut at each of its points; `check` of what the boot
+    /// after each cut finds (the commit, the state). The number of cuts.
+    fn cut_everywhere(
+        base: &Flash,
+        write: Write,
+        check: &dyn Fn(u32, Option<MonitorState>),
+    ) -> u64 {
+        let (probe, ..) = boot_both(base.clone());
+        let start = probe.into_flash().0.points();
+        let points = written(base.clone(), write).points() - start;
+        for p in 0..points {
+            let mut flash = base.clone();
+            flash.cut_after(p);
+            let (mut store, ..) = boot_both(flash);
+            assert!(write(&mut store).is_err(), "point {p}");
+            let mut flash = store.into_flash().0;
+            flash.restart();
+            let (_, c, st) = boot_both(flash);
+            check(c, st);
+        }
+        points
+    }
 }
 
 /// Without the code, no write changes the configuration, the scene or the code:
@@ -778,6 +887,8 @@ fn random_writes_without_the_code_change_nothing() {
     assert_eq!(view(&mut s, "active"), before);
     assert_eq!(s.monitor().config(), &Config::default());
     assert_eq!(s.monitor().estimator().to_bytes(), scene);
+    assert_eq!(s.annunciator().latching(), AlarmSet::NONE);
+    assert!(!s.external_samples());
     assert_eq!(get(&mut s, "staged"), 0);
     assert_eq!(get(&mut s, "config_source"), 0);
     assert!(s.commissioning().refused > 0);
@@ -785,4 +896,124 @@ fn random_writes_without_the_code_change_nothing() {
     // The code is still the one it was.
     s.tick(5000 * 10 + LOCKOUT_S * 1000);
     unlock(&mut s);
+}
+
+/// The writes a locked node takes: an operator's acknowledgement, a master's reading
+/// position and receipt of events, the code itself, and a PLC's samples.
+const FREE: [&str; 5] = [
+    "acknowledge",
+    "acknowledge_alarms",
+    "event_from",
+    "event_ack",
+    "unlock",
+];
+
+/// Function 5; `Err(code)` for an exception.
+fn coil<E: Estimator>(s: &mut Server<E>, address: u16, on: bool) -> Result<(), u8> {
+    let value = if on { 0xFF00 } else { 0 };
+    answer(&request(s, 5, &words_be(&[address, value])), 5)
+}
+
+/// What a configuration write could change, beside the staged copy's registers.
+fn settings<E: Estimator>(s: &mut Server<E>) -> (AlarmSet, bool, Vec<u16>, u32) {
+    let latching = s.annunciator().latching();
+    let external = s.external_samples();
+    (latching, external, view(s, "config"), get(s, "staged"))
+}
+
+/// Every writable entry of the map (coils and holding registers), written while
+/// locked with a value in its domain: refused with exception 01, counted, nothing
+/// changed, unless it is one of the writes made in normal running ([`FREE`]); after
+/// the unlock the same writes are taken. A new writable entry is refused unless it is
+/// named here.
+#[test]
+fn every_configuration_write_needs_the_unlock() {
+    let mut s = server();
+    let mut guarded = Vec::new();
+    for table in [Table::Coil, Table::Holding] {
+        let writable = TableMap::of(table)
+            .entries
+            .iter()
+            .filter(|e| e.access == Access::Rw && !FREE.contains(&e.name));
+        for e in writable {
+            let before = settings(&mut s);
+            let refused = get(&mut s, "refused_writes");
+            let result = match (table, e.ty.words()) {
+                (Table::Coil, _) => coil(&mut s, e.address, true),
+                (_, 2) => write(&mut s, e.address, &[0, 1]),
+                _ => write1(&mut s, e.address, 1),
+            };
+            assert_eq!(result, Err(1), "{} written while locked", e.name);
+            assert_eq!(get(&mut s, "refused_writes"), refused + 1, "{}", e.name);
+            assert_eq!(settings(&mut s), before, "{}", e.name);
+            guarded.push(e.name);
+        }
+    }
+    for name in [
+        "latch_warning",
+        "external_samples",
+        "latching",
+        "external_mode",
+    ] {
+        assert!(guarded.contains(&name), "{name}");
+    }
+    // Several coils at once (function 15): an acknowledgement beside a latch is
+    // refused whole, counted once.
+    let refused = get(&mut s, "refused_writes");
+    let pdu = request(&mut s, 15, &[0, 0, 0, 2, 1, 0b11]);
+    assert_eq!(answer(&pdu, 15), Err(1));
+    assert_eq!(get(&mut s, "refused_writes"), refused + 1);
+    assert_eq!(s.annunciator().latching(), AlarmSet::NONE);
+
+    // Free while locked.
+    coil(&mut s, 0, true).unwrap();
+    write1(&mut s, at("acknowledge_alarms"), 15).unwrap();
+    write(&mut s, at("event_from"), &[0, 0]).unwrap();
+    write(&mut s, at("event_ack"), &[0xFFFF, 0xFFFF]).unwrap();
+    assert!(!s.unlocked());
+
+    // Unlocked: taken, each renewing the unlock as a staged write does.
+    unlock(&mut s);
+    s.tick(200_000);
+    coil(&mut s, 1, true).unwrap();
+    assert_eq!(s.annunciator().latching(), AlarmSet::WARNING);
+    s.tick(400_000);
+    assert!(s.unlocked(), "renewed by the write 200 s ago");
+    write1(&mut s, at("latching"), 0b0110).unwrap();
+    assert_eq!(
+        s.annunciator().latching(),
+        AlarmSet::ALARM.union(AlarmSet::SENSOR_FAULT)
+    );
+    let pdu = request(&mut s, 15, &[0, 0, 0, 2, 1, 0b11]);
+    assert_eq!(answer(&pdu, 15), Ok(()));
+    write1(&mut s, at("external_mode"), 1).unwrap();
+    assert!(s.external_samples());
+    coil(&mut s, 5, false).unwrap();
+    assert!(!s.external_samples());
+}
+
+/// A PLC's samples are process data, not configuration: with external samples on,
+/// a locked node takes them.
+#[test]
+fn external_samples_need_no_code() {
+    let monitor = Monitor::new(core(&Scene::DEMO), Config::default()).unwrap();
+    let config = ServerConfig {
+        external_samples: true,
+        ..ServerConfig::default()
+    };
+    let mut s = Server::new(monitor, config).unwrap();
+    s.tick(0);
+    assert!(!s.unlocked());
+    let (p, phi) = (2e3f32.to_bits(), 1e-4f32.to_bits());
+    let record = [
+        0,
+        1000,
+        (p >> 16) as u16,
+        p as u16,
+        (phi >> 16) as u16,
+        phi as u16,
+    ];
+    write(&mut s, SAMPLES_ADDRESS, &record).unwrap();
+    assert_eq!(s.monitor().statistics().samples(), 1);
+    assert_eq!(s.commissioning().refused, 0);
 }

@@ -9,7 +9,8 @@ them back, commits, checks that the node runs them, and prints the node's status
         --scene scene.csv --config config.csv --thresholds thresholds.csv
 
 - `--tcp HOST:PORT`: a TCP bridge carrying RTU frames (or QEMU's serial port on a
-  loopback socket); `--serial /dev/ttyUSB0 --baud 19200`: a serial line (8E1).
+  loopback socket); `--serial /dev/ttyUSB0 --baud 19200`: a serial line (8E1;
+  `--parity N`: 8N2, `--parity O`: 8O1). Needs pyserial (3.5) beside pymodbus.
 - `--scene S.csv`: the monitor example's scene file (`R1,R2,G,nu,mu[,length]`),
   prepared for the node's core (`--core f32`: `float::Auto`, `--core fixed`:
   `fixed::FixedAuto`) by `cargo run --release --example prepare`; or `--prepared B`:
@@ -368,6 +369,8 @@ def main():
     p.add_argument("--tcp", metavar="HOST:PORT", help="a TCP bridge (RTU frames over TCP)")
     p.add_argument("--serial", help="a serial device instead of --tcp")
     p.add_argument("--baud", type=int, default=19200)
+    p.add_argument("--parity", choices=["E", "O", "N"], default="E",
+                   help="the serial line's parity (default E: 8E1; N: 8N2, as Modbus asks)")
     p.add_argument("--unit", type=int, default=1)
     p.add_argument("--registers", default="docs/modbus/registers.csv")
     p.add_argument("--code", type=int, help="the site's code (without it: the status only)")
@@ -390,7 +393,8 @@ def main():
     if args.serial:
         from pymodbus.client import ModbusSerialClient
         client = ModbusSerialClient(args.serial, framer=FramerType.RTU, baudrate=args.baud,
-                                    parity="E", timeout=2)
+                                    parity=args.parity, stopbits=2 if args.parity == "N" else 1,
+                                    timeout=2)
     elif args.tcp:
         from pymodbus.client import ModbusTcpClient
         host, _, port = args.tcp.rpartition(":")

@@ -4,8 +4,8 @@
 //! reset, so it keeps what was written across a reset as flash would. Erase sets
 //! 0xFF, writes only clear bits. With a cut armed, the driver resets the core at the
 //! `cut`-th point, a byte written or a word erased (the ones before it done, that one
-//! and the rest not): a power cut at that point. Included by `#[path]` from each
-//! example.
+//! and the rest not): a power cut at that point; with the feature `_power-cut` a cut
+//! can also be armed at run time ([`armed`]). Included by `#[path]` from each example.
 
 use embedded_storage::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash, check_erase, check_read,
@@ -36,7 +36,37 @@ impl RamFlash {
         if self.cut == Some(self.points) {
             cortex_m::peripheral::SCB::sys_reset();
         }
+        #[cfg(feature = "_power-cut")]
+        armed::tick();
         self.points += 1;
+    }
+}
+
+/// A power cut armed at run time, for every `RamFlash` of the image (feature
+/// `_power-cut`, test builds only): [`arm`](armed::arm) before an operation,
+/// [`disarm`](armed::disarm) after it.
+#[cfg(feature = "_power-cut")]
+pub mod armed {
+    use core::sync::atomic::{AtomicU32, Ordering::Relaxed};
+
+    /// Points until the cut, the cut's included; 0: none armed.
+    static LEFT: AtomicU32 = AtomicU32::new(0);
+
+    /// The power cut after `done` more points: those done, the next not.
+    pub fn arm(done: u32) {
+        LEFT.store(done.saturating_add(1), Relaxed);
+    }
+
+    pub fn disarm() {
+        LEFT.store(0, Relaxed);
+    }
+
+    pub(super) fn tick() {
+        match LEFT.load(Relaxed) {
+            0 => {}
+            1 => cortex_m::peripheral::SCB::sys_reset(),
+            n => LEFT.store(n - 1, Relaxed),
+        }
     }
 }
 

@@ -49,6 +49,8 @@
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
 
+#[cfg(all(target_os = "none", feature = "_power-cut"))]
+mod cut;
 #[cfg(target_os = "none")]
 mod node;
 #[cfg(all(target_os = "none", feature = "modbus-node", feature = "modbus-flash"))]

@@ -8,8 +8,8 @@
 //! event and once a minute of monitored time) and the configuration committed over the
 //! bus (`ConfigImage`, written once per commit); an [`EventQueue`] of 2 KiB holding
 //! every event until a master acknowledges it (`event_ack`, made durable as it is
-//! written). At boot: the state restored (numbering after the newest event stored),
-//! the committed configuration restored (`config_source` says which ran), the event
+//! written). At boot: the committed configuration restored (`config_source` says which
+//! ran), then the state under it (numbering after the newest event stored), the event
 //! window fed from the queue, from its oldest unacknowledged event on.
 
 use core::mem::MaybeUninit;
@@ -19,7 +19,27 @@ use crate::ram_flash::{RamFlash, SECTOR};
 use misalign::Estimator;
 use misalign::modbus::{BootSource, IMAGE_LEN, Server, StorageStatus, Stored};
 use misalign::monitor::{Event, Monitor, MonitorState};
-use misalign::storage::{BlockingFlash, ConfigImage, EventQueue, RestoreOutcome, Store, block_on};
+use misalign::storage::{
+    BlockingFlash, ConfigImage, EventQueue, RestoreOutcome, StorageEvent, Store, block_on,
+};
+
+// Test builds (`_power-cut`): a power cut a test planned, armed at the start of the
+// operation it names; nothing otherwise.
+#[cfg(feature = "_power-cut")]
+use crate::cut::{Op, arm_if_planned as cut, disarm as uncut};
+#[cfg(not(feature = "_power-cut"))]
+#[derive(Clone, Copy)]
+enum Op {
+    Commit,
+    Push,
+    Ack,
+}
+#[cfg(not(feature = "_power-cut"))]
+#[inline(always)]
+fn cut(_: Op) {}
+#[cfg(not(feature = "_power-cut"))]
+#[inline(always)]
+fn uncut() {}
 
 /// The store's region (the state's and the configuration's records).
 const STORE_SIZE: usize = 4 * SECTOR;
@@ -43,6 +63,11 @@ const EVENT_BUF: usize = EventQueue::<Flash, Event, 0>::buffer_len();
 static mut STORE: MaybeUninit<[u8; STORE_SIZE]> = MaybeUninit::uninit();
 #[unsafe(link_section = ".uninit.misalign_node_events")]
 static mut EVENTS: MaybeUninit<[u8; EVENTS_SIZE]> = MaybeUninit::uninit();
+/// [`ERASED`] once the two regions were erased at the first power-on: QEMU starts
+/// with RAM of zeros, where a new part's flash comes erased.
+#[unsafe(link_section = ".uninit.misalign_node_erased")]
+static mut FIRST_POWER_ON: MaybeUninit<u32> = MaybeUninit::uninit();
+const ERASED: u32 = 0x4552_4153;
 
 /// The node's storage, and what it last told the server.
 pub struct Persist {
@@ -70,6 +95,16 @@ impl Persist {
                 &mut *addr_of_mut!(EVENTS).cast::<[u8; EVENTS_SIZE]>(),
             )
         };
+        // SAFETY: a u32 of RAM, kept across a reset, any bit pattern valid; read and
+        // written volatile, as memory the compiler cannot know (what the last boot
+        // left).
+        let marker = addr_of_mut!(FIRST_POWER_ON).cast::<u32>();
+        if unsafe { marker.read_volatile() } != ERASED {
+            store.fill(0xFF);
+            events.fill(0xFF);
+            // SAFETY: as above.
+            unsafe { marker.write_volatile(ERASED) };
+        }
         let store = Store::new(
             BlockingFlash(RamFlash::new(store, None)),
             0..STORE_SIZE as u32,
@@ -98,10 +133,49 @@ impl Persist {
         })
     }
 
-    /// The monitor's last checkpoint into `m` (a fresh monitor), numbering its events
-    /// after the newest stored. False if there was none (or it was damaged: the region
-    /// is then erased and the monitor starts afresh).
-    pub fn restore_state<E: Estimator>(&mut self, m: &mut Monitor<E>) -> bool {
+    /// At boot, before the first sample: the committed configuration restored into the
+    /// server first (its `config_source`), then the monitor's last checkpoint under it
+    /// (the other order would start the conditioning and the trend of a checkpoint
+    /// afresh when the committed configuration is applied), numbering its events after
+    /// the newest stored; the server told to store its events, its window fed from the
+    /// queue. Returns where the configuration came from, and whether a checkpoint was
+    /// restored (none, or a damaged one: the region is then erased and the monitor
+    /// starts afresh).
+    pub fn start<E: Estimator>(&mut self, server: &mut Server<E>) -> (BootSource, bool) {
+        let source = self.restore_config(server);
+        let restored = self.restore_state(server);
+        server.store_events(self.events.state().first);
+        self.service(server);
+        (source, restored)
+    }
+
+    /// The committed configuration's image, if any, into the server.
+    #[inline(never)]
+    fn restore_config<E: Estimator>(&mut self, server: &mut Server<E>) -> BootSource {
+        let mut image = ConfigImage::<IMAGE_LEN>::new();
+        let outcome = block_on(self.store.restore_into(&mut image));
+        if let Ok(RestoreOutcome::Rejected(why)) = outcome {
+            defmt::println!("storage: configuration record rejected: {}", why);
+        }
+        let stored = match outcome {
+            Ok(RestoreOutcome::Restored { .. } | RestoreOutcome::Migrated { .. }) => {
+                Stored::Image(&image.0)
+            }
+            // A region that never held a record of ours (a first start on flash of
+            // any contents, or a first record cut by a power loss) stored nothing.
+            Ok(RestoreOutcome::Blank | RestoreOutcome::Rejected(StorageEvent::ForeignRegion)) => {
+                Stored::Nothing
+            }
+            _ => Stored::Damaged,
+        };
+        server.restore(stored)
+    }
+
+    /// The monitor's last checkpoint into the server's monitor, under the
+    /// configuration it runs; without one, the fresh monitor numbers its events after
+    /// the newest stored.
+    #[inline(never)]
+    fn restore_state<E: Estimator>(&mut self, server: &mut Server<E>) -> bool {
         let mut state = MonitorState::default();
         let restored = match block_on(self.store.restore_into(&mut state)) {
             Ok(
@@ -114,37 +188,19 @@ impl Persist {
             state.continue_events_after(n);
         }
         if let Some(sequence) = restored {
-            m.resume(&state);
+            server.resume(&state);
+            let elapsed_ms = server.monitor().elapsed_ms();
             self.status.checkpoints = sequence;
-            self.status.last_checkpoint_ms = Some(m.elapsed_ms());
-            self.checkpointed_s = Some(m.elapsed_ms() / 1000);
+            self.status.last_checkpoint_ms = Some(elapsed_ms);
+            self.checkpointed_s = Some(elapsed_ms / 1000);
         } else if let Some(n) = newest {
             // No state, but events kept: number on after them.
-            let mut fresh = m.snapshot();
+            let mut fresh = server.monitor().snapshot();
             fresh.continue_events_after(n);
-            m.resume(&fresh);
+            server.resume(&fresh);
         }
-        self.checkpointed_seq = m.next_event_seq();
+        self.checkpointed_seq = server.monitor().next_event_seq();
         restored.is_some()
-    }
-
-    /// At boot, after [`restore_state`](Self::restore_state) and before the first
-    /// sample: the committed configuration restored into the server (its
-    /// `config_source`), the server told to store its events, its window fed from the
-    /// queue.
-    pub fn start<E: Estimator>(&mut self, server: &mut Server<E>) -> BootSource {
-        let mut image = ConfigImage::<IMAGE_LEN>::new();
-        let stored = match block_on(self.store.restore_into(&mut image)) {
-            Ok(RestoreOutcome::Restored { .. } | RestoreOutcome::Migrated { .. }) => {
-                Stored::Image(&image.0)
-            }
-            Ok(RestoreOutcome::Blank) => Stored::Nothing,
-            _ => Stored::Damaged,
-        };
-        let source = server.restore(stored);
-        server.store_events(self.events.state().first);
-        self.service(server);
-        source
     }
 
     /// After each sample and each request: new events onto the flash and into the
@@ -153,16 +209,20 @@ impl Persist {
     /// checkpointed at each event and at the interval, the storage registers told.
     pub fn service<E: Estimator>(&mut self, server: &mut Server<E>) {
         while let Some(e) = server.pop_event() {
+            cut(Op::Push);
             if block_on(self.events.push(e.seq, &e)).is_err() {
                 defmt::warn!("storage: event {=u32} not stored", e.seq);
             }
+            uncut();
             server.offer_event(e);
         }
         let ack = server.acknowledged_through();
         if let Some(k) = ack.filter(|_| ack != self.acked) {
+            cut(Op::Ack);
             if block_on(self.events.acknowledge(k)).is_err() {
                 defmt::warn!("storage: acknowledgement {=u32} not stored", k);
             }
+            uncut();
             self.acked = ack;
         }
         while let Some(wanted) = server.wanted_event() {
@@ -182,8 +242,12 @@ impl Persist {
             }
         }
         let mut image = ConfigImage::<IMAGE_LEN>::new();
-        if server.take_committed(&mut image.0) && block_on(self.store.checkpoint(&image)).is_err() {
-            defmt::warn!("storage: the committed configuration not stored");
+        if server.take_committed(&mut image.0) {
+            cut(Op::Commit);
+            if block_on(self.store.checkpoint(&image)).is_err() {
+                defmt::warn!("storage: the committed configuration not stored");
+            }
+            uncut();
         }
         self.checkpoint(server.monitor());
         let q = self.events.state();

@@ -41,28 +41,17 @@ pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut(
     uart: &mut U,
     mut clock: LineClock<T>,
 ) -> Option<core::convert::Infallible> {
-    #[allow(unused_mut)]
-    let mut monitor = match Monitor::new(core, Config::default()) {
+    let monitor = match Monitor::new(core, Config::default()) {
         Ok(m) => m,
         Err(e) => {
             defmt::error!("node: configuration refused: {}", e);
             return None;
         }
     };
-    // With flash (`modbus-flash`): the monitor goes on from its last checkpoint.
     #[cfg(feature = "modbus-flash")]
-    let mut persist = {
-        let Some(mut persist) = crate::persist::Persist::open() else {
-            defmt::error!("node: the flash cannot be opened");
-            return None;
-        };
-        let restored = persist.restore_state(&mut monitor);
-        defmt::println!(
-            "storage: state restored {=bool}, {=u64} samples monitored",
-            restored,
-            monitor.statistics().samples()
-        );
-        persist
+    let Some(mut persist) = crate::persist::Persist::open() else {
+        defmt::error!("node: the flash cannot be opened");
+        return None;
     };
     let config = ServerConfig {
         external_samples: EXTERNAL_SAMPLES,
@@ -81,8 +70,18 @@ pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut(
     };
     // Commissioning takes scenes of the node's core type over the bus.
     server.accept_scenes();
+    // With flash (`modbus-flash`): the committed configuration, then the monitor's
+    // last checkpoint under it.
     #[cfg(feature = "modbus-flash")]
-    defmt::println!("storage: configuration from {}", persist.start(&mut server));
+    {
+        let (source, restored) = persist.start(&mut server);
+        defmt::println!(
+            "storage: configuration from {}, state restored {=bool}, {=u64} samples monitored",
+            source,
+            restored,
+            server.monitor().statistics().samples()
+        );
+    }
     if !EXTERNAL_SAMPLES {
         // The scenario's samples not yet monitored (after a restored checkpoint, those
         // after it).

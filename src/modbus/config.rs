@@ -584,9 +584,10 @@ impl<E: Estimator> Commissioning<E> {
     }
 
     /// Whether a write to a protected register may go ahead: refused (01, counted)
-    /// while locked.
+    /// while locked; allowed, it renews the unlock.
     pub(crate) fn guard(&mut self) -> Result<(), Exception> {
         if self.unlocked() {
+            self.unlock_ms = UNLOCK_TIMEOUT_S * 1000;
             Ok(())
         } else {
             self.counts.refused = self.counts.refused.wrapping_add(1);

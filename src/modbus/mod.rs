@@ -116,7 +116,7 @@ pub use map::registers_csv;
 pub use rtu::{ADU_MAX, FramingCounters};
 pub use values::{DecodeError, event_from_registers, fault_code, fault_from_code};
 
-use crate::monitor::{Event, Monitor, RiskState, Sample};
+use crate::monitor::{Event, Monitor, MonitorState, RiskState, Sample};
 use crate::{Estimator, FrictionInverse};
 use config::Commissioning;
 use core::fmt;
@@ -428,6 +428,14 @@ impl<E: Estimator> Server<E> {
     pub fn restore(&mut self, stored: Stored<'_>) -> BootSource {
         let c = &mut self.core;
         c.commissioning.restore(stored, &mut c.monitor)
+    }
+
+    /// At boot, after [`restore`](Self::restore): the monitor goes on from its
+    /// checkpoint ([`Monitor::resume`]) under the configuration and scene it now runs.
+    /// In the other order a committed configuration or scene, applied after, would
+    /// start the conditioning and the trend afresh.
+    pub fn resume(&mut self, state: &MonitorState) {
+        self.core.monitor.resume(state);
     }
 
     /// The monitor back, the server given up.

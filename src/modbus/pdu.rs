@@ -311,6 +311,9 @@ impl<E: Estimator> Core<E> {
             _ => return Err(Exception::IllegalDataValue),
         };
         let l = Self::writable(Served::of(Table::Coil), address)?;
+        if protected_bit(l.entry.field) {
+            self.commissioning.guard()?;
+        }
         self.write_bit(l.entry.field, on);
         self.echo(pdu)
     }
@@ -325,8 +328,13 @@ impl<E: Estimator> Core<E> {
         }
         let map = Served::of(Table::Coil);
         in_map(map, start, quantity)?;
+        let mut protected = false;
         for i in 0..quantity {
-            Self::writable(map, start.wrapping_add(i))?;
+            protected |= protected_bit(Self::writable(map, start.wrapping_add(i))?.entry.field);
+        }
+        // One guard for the request: refused whole (and counted once) while locked.
+        if protected {
+            self.commissioning.guard()?;
         }
         for i in 0..quantity {
             let on = data
@@ -473,8 +481,16 @@ impl<E: Estimator> Core<E> {
     /// only, as `unlock` and `command` must be written).
     fn check_word(&mut self, field: Field, v: u32, alone: bool) -> Result<(), Exception> {
         let ok = match field {
-            Field::AcknowledgeAlarms | Field::LatchingAlarms => v <= 15,
-            Field::ExternalMode => v <= 1,
+            Field::AcknowledgeAlarms => v <= 15,
+            // Configuration of the alarms and of the sample source: the unlock's.
+            Field::LatchingAlarms => {
+                self.commissioning.guard()?;
+                v <= 15
+            }
+            Field::ExternalMode => {
+                self.commissioning.guard()?;
+                v <= 1
+            }
             Field::EventFrom => true,
             // Only numbers already given: a later one would acknowledge an event not
             // yet raised.
@@ -503,6 +519,7 @@ impl<E: Estimator> Core<E> {
     }
 
     fn write_bit(&mut self, field: Field, on: bool) {
+        // Guarded by the caller (`protected_bit`).
         let a = &mut self.annunciator;
         match field {
             Field::Acknowledge if on => a.acknowledge(super::AlarmSet::ALL),
@@ -543,6 +560,12 @@ impl<E: Estimator> Core<E> {
             .ok_or(Exception::IllegalDataAddress)?;
         self.commissioning.write_scene(2 * usize::from(at), data)
     }
+}
+
+/// Whether writing the coil `field` changes configuration (which alarms latch, where
+/// samples come from), and so needs the unlock; acknowledging does not.
+fn protected_bit(field: Field) -> bool {
+    matches!(field, Field::Latching(_) | Field::ExternalSamples)
 }
 
 #[cfg(test)]

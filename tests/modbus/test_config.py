@@ -65,6 +65,37 @@ def test_staged_and_active_views_agree_and_writes_need_the_code(client):
     assert get(client, "staged") == 0
 
 
+def coil_address(name):
+    return next(r["address"] for r in register_map() if r["table"] == "coil" and r["name"] == name)
+
+
+def test_latching_and_the_sample_source_need_the_code_acknowledging_does_not(client):
+    latching = get(client, "latching")
+    external = get(client, "external_mode")
+    before = get(client, "refused_writes")
+    refused(write(client, "latching", latching ^ 1), ILLEGAL_FUNCTION)
+    refused(write(client, "external_mode", external ^ 1), ILLEGAL_FUNCTION)
+    refused(client.write_coil(coil_address("latch_alarm"), True, device_id=UNIT), ILLEGAL_FUNCTION)
+    refused(client.write_coil(coil_address("external_samples"), not external, device_id=UNIT),
+            ILLEGAL_FUNCTION)
+    # Several coils in one request, an acknowledgement among them: refused whole.
+    refused(client.write_coils(coil_address("acknowledge"), [True, True], device_id=UNIT),
+            ILLEGAL_FUNCTION)
+    assert get(client, "refused_writes") == before + 5
+    assert (get(client, "latching"), get(client, "external_mode")) == (latching, external)
+    # An operator's acknowledgement needs no code.
+    assert not client.write_coil(coil_address("acknowledge"), True, device_id=UNIT).isError()
+    assert not write(client, "acknowledge_alarms", 15).isError()
+    # After the unlock the switches are taken; put back, then locked again.
+    assert not write(client, "unlock", code()).isError()
+    assert not client.write_coil(coil_address("latch_alarm"), True, device_id=UNIT).isError()
+    assert get(client, "latching") == latching | 2
+    assert not write(client, "latching", latching).isError()
+    assert get(client, "latching") == latching
+    assert not write(client, "command", 3).isError()
+    assert get(client, "unlock") == 0
+
+
 def test_a_wrong_code_is_refused_and_counted(client):
     before = get(client, "unlock_failures")
     refused(write(client, "unlock", (code() + 1) & 0xFFFF), ILLEGAL_DATA_VALUE)

@@ -11,17 +11,41 @@ MODBUS_QEMU_MONITOR: the monitor's loopback port. MODBUS_SCENE: a prepared scene
 node was not built with. MODBUS_SAMPLES: the samples (master.py's format).
 """
 
+import math
 import os
 import socket
 import subprocess
 import sys
 import time
 
-from conftest import HOST, UNIT, register_map
-from master import Map, Master, read_samples, u32_words
+from conftest import HOST, UNIT, read_table, register_map
+from master import Map, Master, f32_of, read_samples, u32_words
 from test_config import code, get
 
 ON_DELAY_MS = 4000
+
+
+def input_address(name):
+    return next(r["address"] for r in register_map() if r["table"] == "input" and r["name"] == name)
+
+
+# The input registers of the monitor's own state: from `status` up to the server's
+# (`last_sample_time` on: what the bus offered, counted since the boot); of them the
+# alarms' acknowledgement is the server's too (`alarms`, the top bits of `status`).
+MONITORED_WORDS = input_address("last_sample_time")
+ALARMS = input_address("alarms")
+STATUS = input_address("status")
+
+
+def monitor_state(words):
+    return [w & 0x0FFF if k == STATUS else w for k, w in enumerate(words) if k != ALARMS]
+
+
+def checkpoint_is_now_with_a_trend(client):
+    age = read_table(client, "input", input_address("checkpoint_age"), 2)
+    ttc = read_table(client, "input", input_address("time_to_critical"), 2)
+    finite = not math.isnan(f32_of(*ttc))
+    return (age[0] << 16 | age[1]) == 0 and finite
 
 
 def ack_address():
@@ -87,6 +111,15 @@ def test_configuration_and_unacknowledged_events_survive_a_reset(client):
         master.feed(chunk)
         i += len(chunk)
         master.read_events()
+    # On, a sample a write, until a checkpoint (one a minute of monitored time, and at
+    # each event) is of the last sample while the trend gives a time to critical: the
+    # state at the reset is then the checkpoint's, conditioning and trend included.
+    while not checkpoint_is_now_with_a_trend(client):
+        assert i < len(samples), "no checkpoint with a time to critical"
+        master.feed(samples[i:i + 1])
+        i += 1
+        master.read_events()
+    monitored = read_table(client, "input", 0, MONITORED_WORDS)
     assert master.missed == 0
     events = master.events
     seqs = [e[0] << 16 | e[1] for e in events]
@@ -102,6 +135,13 @@ def test_configuration_and_unacknowledged_events_survive_a_reset(client):
     assert get(client, "config_source") == 1, "the committed configuration runs"
     assert get(client, "active_on_delay") == ON_DELAY_MS
     assert get(client, "scene_active_crc") == scene_crc
+    # The monitor went on from its checkpoint under the committed configuration: every
+    # value it shows is the one before the reset (the trend's time to critical too,
+    # which a checkpoint restored before the committed configuration loses), but for
+    # the alarms' acknowledgement, which is the bus's, not the monitor's state.
+    again = read_table(client, "input", 0, MONITORED_WORDS)
+    assert monitor_state(again) == monitor_state(monitored), \
+        f"before the reset: {monitored}, after: {again}"
     after = Master(client, regmap)
     after.read_events()
     kept = [e[0] << 16 | e[1] for e in after.events]

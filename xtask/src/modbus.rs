@@ -10,8 +10,12 @@
 //!   event read back across the event window's wrap); and on the Cortex-M4F the node
 //!   with flash (feature `modbus-flash`) across a reset through QEMU's monitor
 //!   (`tests/modbus/test_reset.py`: the committed configuration and the unacknowledged
-//!   events back). pymodbus and pytest, pinned, in a virtual environment under
-//!   `target/modbus-venv`.
+//!   events back), and a test build of it through power cuts at points of a commit, an
+//!   event push and an acknowledgement (feature `_power-cut`,
+//!   `tests/modbus/test_power_cut.py`; `MODBUS_POWER_CUT_ALL=1`: at every point). On
+//!   the Cortex-M4F, tools/commission.py also commissions the node over a serial line
+//!   (serial0 on a pseudo-terminal, `tests/modbus/test_serial.py`). pymodbus, pyserial
+//!   and pytest, pinned, in a virtual environment under `target/modbus-venv`.
 //!   With `--boards`, the node on its own samples also on the Cortex-M7 and M3 (MPS2,
 //!   CMSDK UART0) and the STM32F405 (`netduinoplus2`, USART1).
 //! - `--serve PORT [--target TRIPLE]`: boots the node and serves until killed.
@@ -37,7 +41,7 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 /// The Python packages of the tests, pinned.
-const PYTHON_PACKAGES: [&str; 2] = ["pymodbus==3.16.1", "pytest==8.4.2"];
+const PYTHON_PACKAGES: [&str; 3] = ["pymodbus==3.16.1", "pyserial==3.5", "pytest==8.4.2"];
 
 /// The register map's export, relative to the repository root.
 const REGISTERS_CSV: &str = "docs/modbus/registers.csv";
@@ -53,6 +57,9 @@ struct Node {
     /// Built with flash (`modbus-flash`: examples/firmware/persist.rs) and
     /// tested across a reset (`tests/modbus/test_reset.py`).
     stored: bool,
+    /// A test build with flash that cuts its own power where the test plans
+    /// (`_power-cut`: examples/firmware/cut.rs, `tests/modbus/test_power_cut.py`).
+    cut: bool,
 }
 
 impl Node {
@@ -64,6 +71,7 @@ impl Node {
             memory_x: None,
             external,
             stored: false,
+            cut: false,
         }
     }
 }
@@ -213,6 +221,12 @@ fn build(node: &Node) -> Result<PathBuf, String> {
             .into_iter()
             .flatten(),
     )
+    .args(
+        node.cut
+            .then_some(["--features", "_power-cut"])
+            .into_iter()
+            .flatten(),
+    )
     .arg("--message-format=json-render-diagnostics");
     if node.external {
         cmd.env("MISALIGN_MODBUS_EXTERNAL", "1");
@@ -226,10 +240,11 @@ fn build(node: &Node) -> Result<PathBuf, String> {
     let built = cross::build(&mut cmd)?;
     let elf = cross::artifact(&built, "firmware")?;
     let kept = elf.with_file_name(format!(
-        "firmware-modbus-{}-{}{}",
+        "firmware-modbus-{}-{}{}{}",
         node.machine,
         if node.external { "external" } else { "own" },
-        if node.stored { "-stored" } else { "" }
+        if node.stored { "-stored" } else { "" },
+        if node.cut { "-cut" } else { "" }
     ));
     std::fs::copy(&elf, &kept).map_err(|e| format!("{}: {e}", kept.display()))?;
     Ok(kept)
@@ -384,6 +399,13 @@ fn tests(boards: bool) -> Result<(), String> {
         stored: true,
         ..Node::on(cpu("cortex-m4f"), true)
     });
+    // The same with power cuts at points of a commit, an event push and an
+    // acknowledgement (a test build).
+    nodes.push(Node {
+        stored: true,
+        cut: true,
+        ..Node::on(cpu("cortex-m4f"), true)
+    });
     if boards {
         nodes.extend(OTHER_BOARDS.map(|(id, machine, memory_x)| Node {
             machine,
@@ -393,6 +415,7 @@ fn tests(boards: bool) -> Result<(), String> {
     }
     for node in &nodes {
         let source = match (node.external, node.stored) {
+            (true, true) if node.cut => "the master, with flash, through power cuts",
             (true, true) => "the master, with flash, across a reset",
             (true, false) => "the master",
             _ => "the node",
@@ -423,7 +446,11 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         host::write_samples(&dir.join("samples.csv"), &host::scenario())?;
         host::write_other_scene(fpu, &dir.join(format!("scene-{id}.bin")))?;
         (
-            &["tests/modbus/test_reset.py"][..],
+            if node.cut {
+                &["tests/modbus/test_power_cut.py"][..]
+            } else {
+                &["tests/modbus/test_reset.py"][..]
+            },
             dir.join(format!("reset-{id}.csv")),
         )
     } else if node.external {
@@ -436,11 +463,16 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         let expected = dir.join(format!("expected-{id}.csv"));
         host::write_registers(fpu, &expected)?;
         host::write_other_scene(fpu, &dir.join(format!("scene-{id}.bin")))?;
-        // Commissioning after the node's registers were compared: it changes them.
-        (
-            &["tests/modbus/test_node.py", "tests/modbus/test_config.py"][..],
-            expected,
-        )
+        // Commissioning after the node's registers were compared: it changes them. On
+        // the Cortex-M4F's own board, commissioning over a serial line too (a second
+        // QEMU of the image, serial0 on a pseudo-terminal).
+        const OWN: [&str; 3] = [
+            "tests/modbus/test_node.py",
+            "tests/modbus/test_config.py",
+            "tests/modbus/test_serial.py",
+        ];
+        let serial = id == "cortex-m4f" && node.machine == node.cpu.machine;
+        (if serial { &OWN[..] } else { &OWN[..2] }, expected)
     };
     let port = free_port()?;
     let monitor = node.stored.then(free_port).transpose()?;
@@ -474,6 +506,10 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
             misalign::modbus::WRONG_CODES_MAX.to_string(),
         )
         .env("MODBUS_SAMPLES", dir.join("samples.csv"))
+        .env("MODBUS_ELF", &elf)
+        .env("MODBUS_MACHINE", node.machine)
+        // The plan file of a test build's power cuts: the image's path and `.cut`.
+        .env("MODBUS_POWER_CUT_PLAN", elf.with_extension("cut"))
         .env("MODBUS_EVENTS_OUT", &file)
         .env(
             "MODBUS_EVENT_WINDOW",
