@@ -4,7 +4,7 @@
 
 use super::config::{ConfigField, Reg};
 use super::exception::Exception;
-use super::map::{Access, Field, Located, Served, SlotBlock, Table};
+use super::map::{Access, Field, Located, Served, SlotBlock, Table, div_rem};
 use super::{ADU_MAX, Core, crc, ident};
 use crate::Estimator;
 
@@ -429,16 +429,24 @@ impl<E: Estimator> Core<E> {
             self.counters.external_refused = self.counters.external_refused.wrapping_add(1);
         }
         let records = result?;
-        for record in data
-            .chunks_exact(2 * usize::from(block.stride))
-            .take(records)
-        {
+        for record in Self::records(block, data, records) {
             if let Some(sample) = super::values::sample_from_record(block, record) {
                 self.counters.external_accepted = self.counters.external_accepted.wrapping_add(1);
                 self.process(sample);
             }
         }
         Ok(())
+    }
+
+    /// The first `records` whole records of `block` in `data` (without a division:
+    /// `chunks_exact` would link one into a Cortex-M0 node).
+    fn records<'a>(
+        block: &SlotBlock,
+        data: &'a [u8],
+        records: u16,
+    ) -> impl Iterator<Item = &'a [u8]> {
+        let n = 2 * usize::from(block.stride);
+        (0..usize::from(records)).map_while(move |k| data.get(k * n..k * n + n))
     }
 
     /// The number of whole records of a write to `block`, or why it is refused.
@@ -448,24 +456,26 @@ impl<E: Estimator> Core<E> {
         start: u16,
         quantity: u16,
         data: &[u8],
-    ) -> Result<usize, Exception> {
+    ) -> Result<u16, Exception> {
         let offset = start
             .checked_sub(block.address)
             .ok_or(Exception::IllegalDataAddress)?;
         let stride = block.stride;
-        let whole = offset.is_multiple_of(stride) && quantity.is_multiple_of(stride);
+        let split = |n| div_rem(n, stride).unwrap_or((0, 1));
+        let ((_, first), (records, rest)) = (split(offset), split(quantity));
+        let whole = first == 0 && rest == 0;
         if !whole || u32::from(start) + u32::from(quantity) > u32::from(block.end()) {
             return Err(Exception::IllegalDataAddress);
         }
         if !self.external {
             return Err(Exception::IllegalFunction);
         }
-        for record in data.chunks_exact(2 * usize::from(stride)) {
+        for record in Self::records(block, data, records) {
             if super::values::sample_from_record(block, record).is_none() {
                 return Err(Exception::IllegalDataValue);
             }
         }
-        Ok(usize::from(quantity / stride))
+        Ok(records)
     }
 
     /// Whether `v` is in the domain of the writable register `field`, and a

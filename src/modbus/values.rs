@@ -14,17 +14,27 @@ fn opt(x: Option<f32>) -> u32 {
     x.map_or(NONE, f32::to_bits)
 }
 
+/// `x / 1000` for every u32, by a multiplication: `x` times 2^41 / 1000 rounded up
+/// (2199023256, 448 / 1000 above it: less than 2^(41 - 32) / 1000, so exact for every
+/// 32-bit `x`, Granlund and Montgomery's bound), shifted down 41 bits. No division
+/// routine is linked into a node without a divider (the Cortex-M0).
+pub(crate) fn div1000(x: u32) -> u32 {
+    ((u64::from(x) * 2_199_023_256) >> 41) as u32
+}
+
 /// Whole seconds in `ms` (saturated at `u32::MAX`) and the milliseconds left over, by
-/// long division in 16-bit digits: u32 divisions only, so that no 64-bit division is
-/// linked into a Cortex-M0 node.
+/// long division in 16-bit digits ([`div1000`]), so that no 64-bit division is linked
+/// into a Cortex-M0 node; the digits by constant shifts (no 64-bit shift routine).
 fn split_seconds(ms: u64) -> (u32, u32) {
     let mut seconds = 0u64;
     let mut rest = 0u32;
-    for shift in [48, 32, 16, 0] {
+    let (high, low) = ((ms >> 32) as u32, ms as u32);
+    for digit in [high >> 16, high & 0xFFFF, low >> 16, low & 0xFFFF] {
         // rest < 1000, so the digit fits in 26 bits.
-        let digit = rest << 16 | (ms >> shift) as u32 & 0xFFFF;
-        seconds = seconds << 16 | u64::from(digit / 1000);
-        rest = digit % 1000;
+        let digit = rest << 16 | digit;
+        let q = div1000(digit);
+        seconds = seconds << 16 | u64::from(q);
+        rest = digit - q * 1000;
     }
     (u32::try_from(seconds).unwrap_or(u32::MAX), rest)
 }
@@ -416,7 +426,27 @@ impl<E: Estimator> Core<E> {
 
 #[cfg(test)]
 mod tests {
-    use super::split_seconds;
+    use super::{div1000, split_seconds};
+
+    /// Every u32 near a multiple of 1000 (where a quotient changes), the extremes and
+    /// a spread of others.
+    #[test]
+    fn div1000_is_division() {
+        let near = (0..=4_294_967u32).flat_map(|k| {
+            let m = k.wrapping_mul(1000);
+            [m, m.wrapping_sub(1), m.wrapping_add(999)]
+        });
+        let mut x = 0x2545_F491u32;
+        let spread = (0..1_000_000).map(|_| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x
+        });
+        for v in near.chain(spread).chain([u32::MAX, u32::MAX - 1, 1 << 31]) {
+            assert_eq!(div1000(v), v / 1000, "{v}");
+        }
+    }
 
     /// The long division gives what u64 division gives, saturated where the seconds
     /// pass u32.
