@@ -805,30 +805,45 @@ impl TableMap {
 // 6 KB) and none of their 40-byte entries.
 
 /// An entry as the server holds it: where it is, its type, whether a master may write
-/// it, and what it holds.
+/// it, and what it holds. Five bytes (bytes only: no padding), where the entry's
+/// address and width as u16 made eight: the single entries end below address 256 and
+/// a record is shorter (checked at compile time).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Slot {
     /// The 0-based address (in a block: the offset in the record).
-    pub address: u16,
+    address: u8,
     /// Registers the value takes ([`Type::words`]).
-    pub words: u16,
+    words: u8,
     pub access: Access,
     pub field: Field,
 }
 
 impl Slot {
     const fn of(e: &Entry) -> Slot {
+        assert!(e.end() <= 256, "a served entry's address fits a byte");
         Slot {
-            address: e.address,
-            words: e.ty.words(),
+            address: e.address as u8,
+            words: e.ty.words() as u8,
             access: e.access,
             field: e.field,
         }
     }
 
+    /// The 0-based address (in a block: the offset in the record).
+    #[inline(always)]
+    pub const fn address(&self) -> u16 {
+        self.address as u16
+    }
+
+    /// Registers the value takes ([`Type::words`]).
+    #[inline(always)]
+    pub const fn words(&self) -> u16 {
+        self.words as u16
+    }
+
     /// The address after the value.
     pub const fn end(&self) -> u16 {
-        self.address.saturating_add(self.words)
+        self.address() + self.words()
     }
 }
 
@@ -976,7 +991,7 @@ impl Served {
     pub(crate) fn single(&self, address: u16) -> Option<(usize, u16)> {
         let i = usize::from(*self.index.get(usize::from(address))?);
         let entry = self.entries.get(i)?;
-        Some((i, address.checked_sub(entry.address)?))
+        Some((i, address.checked_sub(entry.address())?))
     }
 
     /// The entry that holds `address`: the entry, the record's index (0 for a single
@@ -1000,7 +1015,7 @@ impl Served {
         Some(Located {
             entry,
             record,
-            word: at.checked_sub(entry.address)?,
+            word: at.checked_sub(entry.address())?,
             block: Some(b),
             index,
         })
@@ -1238,7 +1253,7 @@ mod tests {
             let s = Served::of(table);
             for a in 0..s.end {
                 let l = s.locate(a).expect("inside the table");
-                assert!(l.word < l.entry.words);
+                assert!(l.word < l.entry.words());
             }
             assert!(s.locate(s.end).is_none());
             // The walk from 0 steps through every value, as locating each does.
@@ -1246,7 +1261,7 @@ mod tests {
             for l in s.walk(0) {
                 let found = s.locate(at).unwrap();
                 assert_eq!((l.entry, l.record, l.word), (found.entry, found.record, 0));
-                at += l.entry.words;
+                at += l.entry.words();
             }
             assert_eq!(at, t.end());
         }

@@ -238,17 +238,18 @@ impl<E: Estimator> Core<E> {
         // single entries lead into it.
         let mut from = None;
         let mut out = Words { at: 3 };
-        if let Some((mut i, word)) = map.single(start) {
+        if let Some((i, word)) = map.single(start) {
             // A read from a value's low word: the value from the byte before.
             out.at = 3 - 2 * usize::from(word & 1);
+            // The entries by a pointer's steps, not an index's multiplication.
+            let mut entries = map.entries.get(i..).unwrap_or(&[]).iter();
             while out.at < end {
-                let Some(e) = map.entries.get(i) else {
+                let Some(e) = entries.next() else {
                     from = Some((0, 0, 0));
                     break;
                 };
                 let v = value(self, e.field, 0);
-                out.put(&mut self.response, v, e.words);
-                i += 1;
+                out.put(&mut self.response, v, e.words());
             }
         } else if let Some(l) = map.locate(start)
             && let Some(b) = l.block
@@ -274,7 +275,7 @@ impl<E: Estimator> Core<E> {
                         break 'blocks;
                     }
                     let v = value(self, e.field, record);
-                    out.put(&mut self.response, v, e.words);
+                    out.put(&mut self.response, v, e.words());
                     i += 1;
                 }
                 (record, i) = (record + 1, 0);
@@ -347,7 +348,7 @@ impl<E: Estimator> Core<E> {
                 .write_scene(address, data)
                 .and_then(|()| self.echo(pdu));
         }
-        if l.entry.words != 1 || matches!(l.entry.field, Field::Sample(_)) {
+        if l.entry.words() != 1 || matches!(l.entry.field, Field::Sample(_)) {
             // Half of a 32-bit value, or part of a sample record.
             return Err(Exception::IllegalDataAddress);
         }
@@ -394,7 +395,7 @@ impl<E: Estimator> Core<E> {
             let mut a = start;
             while a < end {
                 let l = Self::writable(map, a)?;
-                let n = l.entry.words;
+                let n = l.entry.words();
                 if l.word != 0 || a.wrapping_add(n) > end {
                     return Err(Exception::IllegalDataAddress);
                 }
@@ -582,7 +583,7 @@ mod tests {
                 .map(|a| {
                     let l = map.locate(a).unwrap();
                     let v = server.core.value_other(l.entry.field, l.record);
-                    let low = l.entry.words == 1 || l.word == 1;
+                    let low = l.entry.words() == 1 || l.word == 1;
                     (if low { v } else { v >> 16 }) as u16
                 })
                 .collect();

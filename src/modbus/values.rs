@@ -240,12 +240,12 @@ pub(crate) fn sample_from_record(block: &SlotBlock, record: &[u8]) -> Option<Sam
     let mut speed = None;
     let mut force = None;
     for e in block.fields {
-        let at = 2 * usize::from(e.address);
+        let at = 2 * usize::from(e.address());
         let word = |i: usize| -> Option<u32> {
             let b = record.get(at + 2 * i..at + 2 * i + 2)?;
             Some(u32::from(u16::from_be_bytes([b[0], b[1]])))
         };
-        let v = match e.words {
+        let v = match e.words() {
             2 => word(0)? << 16 | word(1)?,
             _ => word(0)?,
         };
