@@ -1020,59 +1020,6 @@ impl Served {
             index,
         })
     }
-
-    /// The value after `l` (its first word), in address order.
-    fn after(&self, l: &Located) -> Option<Located> {
-        let first_of = |b: usize, record: u16| {
-            let block = self.blocks.get(b)?;
-            Some(Located {
-                entry: block.fields.first()?,
-                record,
-                word: 0,
-                block: Some(b),
-                index: 0,
-            })
-        };
-        let next = l.index.wrapping_add(1);
-        match l.block {
-            None => match self.entries.get(next) {
-                Some(entry) => Some(Located {
-                    entry,
-                    record: 0,
-                    word: 0,
-                    block: None,
-                    index: next,
-                }),
-                None => first_of(0, 0),
-            },
-            Some(b) => {
-                let block = self.blocks.get(b)?;
-                if let Some(entry) = block.fields.get(next) {
-                    Some(Located {
-                        entry,
-                        index: next,
-                        word: 0,
-                        ..*l
-                    })
-                } else if l.record.wrapping_add(1) < block.count {
-                    first_of(b, l.record.wrapping_add(1))
-                } else {
-                    first_of(b.wrapping_add(1), 0)
-                }
-            }
-        }
-    }
-
-    /// The values from `address` on, in address order, the first from the word that
-    /// holds `address`: one search, then steps.
-    pub(crate) fn walk(&self, address: u16) -> impl Iterator<Item = Located> + '_ {
-        let mut next = self.locate(address);
-        core::iter::from_fn(move || {
-            let current = next?;
-            next = self.after(&current);
-            Some(current)
-        })
-    }
 }
 
 /// `n / d` and `n % d` (`None` for `d` 0) by shifts and subtractions, 16 steps: no
@@ -1256,14 +1203,14 @@ mod tests {
                 assert!(l.word < l.entry.words());
             }
             assert!(s.locate(s.end).is_none());
-            // The walk from 0 steps through every value, as locating each does.
-            let mut at = 0;
-            for l in s.walk(0) {
-                let found = s.locate(at).unwrap();
-                assert_eq!((l.entry, l.record, l.word), (found.entry, found.record, 0));
-                at += l.entry.words();
+            // The bit tables: one entry a bit, in address order, without blocks (a read
+            // of bits takes the entries from its start, `Core::read_bits`).
+            if matches!(table, Table::Coil | Table::Discrete) {
+                assert!(t.blocks.is_empty());
+                for (a, e) in (0..).zip(s.entries) {
+                    assert_eq!((e.address(), e.words()), (a, 1));
+                }
             }
-            assert_eq!(at, t.end());
         }
         let l = Served::of(Table::Input)
             .locate(EVENT_SLOTS_ADDRESS + EVENT_STRIDE + 12)

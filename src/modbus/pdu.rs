@@ -182,9 +182,13 @@ impl<E: Estimator> Core<E> {
             packed.fill(0);
         }
         // Inside the map (checked above): one value a bit, packed into the response as
-        // it is computed.
-        for (i, l) in (0..quantity).zip(map.walk(start)) {
-            let on = self.value(l.entry.field, l.record) & 1 != 0;
+        // it is computed. A bit table is one entry a bit from address 0, without blocks
+        // (the map's tests): the bits from `start` are the entries from `start`. Their
+        // values are all `value_other`'s (no copy of the registers' inline values).
+        let first = usize::from(start);
+        let entries = map.entries.get(first..first + usize::from(quantity));
+        for (i, e) in (0u16..).zip(entries.unwrap_or(&[])) {
+            let on = self.value_other(e.field, 0) & 1 != 0;
             if on && let Some(b) = self.response.get_mut(3 + usize::from(i / 8)) {
                 *b |= 1 << (i % 8);
             }
@@ -563,6 +567,56 @@ mod tests {
     use crate::monitor::{Config, Monitor, Sample, model_for_range};
     use crate::{Scene, float::Auto};
     use std::vec::Vec;
+
+    /// Every read of bits (functions 1 and 2), from every address and of every length
+    /// the table holds, answers each bit as its entry's value, with the head and the
+    /// CRC of a valid frame; one past the table is exception 02.
+    #[test]
+    fn every_read_of_bits_is_each_bits_value() {
+        let scene = Scene::DEMO;
+        let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5).unwrap()).unwrap();
+        let monitor = Monitor::new(core, Config::default()).unwrap();
+        let config = ServerConfig {
+            external_samples: true,
+            latching: super::super::AlarmSet::ALARM,
+            ..ServerConfig::default()
+        };
+        let mut server = Server::new(monitor, config).unwrap();
+        for i in 0..200u32 {
+            let load = 2e3 + 40.0 * i as f32;
+            server.process(Sample::new(i * 1000, load, 1e-4 * (i % 7) as f32).with_speed(2.0));
+        }
+        for function in [1u8, 2] {
+            let map = Served::of(table_of(function));
+            let bits: Vec<u8> = (0..map.end)
+                .map(|a| {
+                    let l = map.locate(a).unwrap();
+                    (server.core.value_other(l.entry.field, l.record) & 1) as u8
+                })
+                .collect();
+            assert!(bits.contains(&1), "{function}: some bit set");
+            for start in 0..map.end {
+                for quantity in 1..=map.end - start {
+                    let [a, b] = start.to_be_bytes();
+                    let [c, d] = quantity.to_be_bytes();
+                    let pdu = [function, a, b, c, d];
+                    let n = server.core.dispatch(function, &pdu).unwrap();
+                    let bytes = usize::from(quantity.div_ceil(8));
+                    assert_eq!(n, bytes + 2);
+                    assert_eq!(server.core.response[1..3], [function, bytes as u8]);
+                    for i in 0..usize::from(quantity) {
+                        let bit = server.core.response[3 + i / 8] >> (i % 8) & 1;
+                        let s = usize::from(start);
+                        assert_eq!(bit, bits[s + i], "{function} {start}+{quantity}: bit {i}");
+                    }
+                }
+                let [a, b] = start.to_be_bytes();
+                let [c, d] = (map.end - start + 1).to_be_bytes();
+                let past = server.core.dispatch(function, &[function, a, b, c, d]);
+                assert_eq!(past, Err(Exception::IllegalDataAddress));
+            }
+        }
+    }
 
     /// Every read of registers, from every address and of every length the table
     /// allows (up to 125), answers each register as the value that holds it, located
