@@ -90,21 +90,27 @@ impl EventWindow {
         let _ = self.events.push_back(event);
     }
 
-    /// The events at or after `from`, oldest first.
-    pub(crate) fn unread(&self) -> impl Iterator<Item = &Event> {
+    /// The `i`-th event at or after `from`, oldest first: the one walk through the
+    /// window every register of it takes (one copy of the deque's iteration in the
+    /// image).
+    #[inline(never)]
+    pub(crate) fn slot(&self, i: u16) -> Option<&Event> {
         let from = self.from;
-        self.events.iter().filter(move |e| at_or_after(e.seq, from))
+        let mut unread = self.events.iter().filter(move |e| at_or_after(e.seq, from));
+        unread.nth(usize::from(i))
     }
 
-    /// The `i`-th event at or after `from`.
-    pub(crate) fn slot(&self, i: u16) -> Option<&Event> {
-        self.unread().nth(usize::from(i))
+    /// The events in the slots (at most `slots`).
+    pub(crate) fn unread(&self, slots: u16) -> u16 {
+        (0..slots)
+            .position(|i| self.slot(i).is_none())
+            .map_or(slots, |n| n as u16)
     }
 
     /// The sequence number of slot 0: the first event held at or after `from`, or
     /// `next` (the next event's) when none is.
     pub(crate) fn first(&self, next: u32) -> u32 {
-        self.unread().next().map_or(next, |e| e.seq)
+        self.slot(0).map_or(next, |e| e.seq)
     }
 
     /// Events from `from` to slot 0 that are lost; `next` is the next event's
