@@ -24,7 +24,11 @@ fn be(pdu: &[u8], i: usize) -> Option<u16> {
 }
 
 /// Address and quantity (or value) of a request PDU.
-fn head(pdu: &[u8]) -> Result<(u16, u16), Exception> {
+type Head = (u16, u16);
+
+/// The [`Head`] of a request PDU: read once per request (`Core::handle`), not once in
+/// each function's handler.
+fn head(pdu: &[u8]) -> Result<Head, Exception> {
     match (be(pdu, 1), be(pdu, 3)) {
         (Some(a), Some(q)) => Ok((a, q)),
         _ => Err(Exception::IllegalDataValue),
@@ -112,12 +116,15 @@ impl<E: Estimator> Core<E> {
                 self.counters.responses_overwritten.wrapping_add(1);
             self.response_len = 0;
         }
+        // Address and quantity (or value) once, for every function that has them.
+        let head = head(pdu);
         // The reads of registers (a master's poll) apart from the dispatch, whose
         // other functions' set-up they then do not share.
         let result = if matches!(function, 3 | 4) {
-            self.read_registers(function, pdu).map(Reply::Adu)
+            head.and_then(|h| self.read_registers(function, h))
+                .map(Reply::Adu)
         } else {
-            self.dispatch(function, pdu).map(Reply::Pdu)
+            self.dispatch(function, pdu, head).map(Reply::Pdu)
         };
         if broadcast {
             return;
@@ -149,13 +156,18 @@ impl<E: Estimator> Core<E> {
     /// The response PDU into `self.response[1..]`; its length. Every function but the
     /// reads of registers, which [`handle`](Self::handle) answers through
     /// [`read_registers`](Self::read_registers).
-    fn dispatch(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
+    fn dispatch(
+        &mut self,
+        function: u8,
+        pdu: &[u8],
+        head: Result<Head, Exception>,
+    ) -> Result<usize, Exception> {
         match function {
-            1 | 2 => self.read_bits(function, pdu),
-            5 => self.write_coil(pdu),
-            6 => self.write_register(pdu),
-            15 => self.write_coils(pdu),
-            16 => self.write_registers(pdu),
+            1 | 2 => self.read_bits(function, head?),
+            5 => self.write_coil(pdu, head?),
+            6 => self.write_register(pdu, head?),
+            15 => self.write_coils(pdu, head?),
+            16 => self.write_registers(pdu, head?),
             43 => {
                 let out = self
                     .response
@@ -167,8 +179,7 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    fn read_bits(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
-        let (start, quantity) = head(pdu)?;
+    fn read_bits(&mut self, function: u8, (start, quantity): Head) -> Result<usize, Exception> {
         if quantity == 0 || quantity > READ_BITS_MAX {
             return Err(Exception::IllegalDataValue);
         }
@@ -198,8 +209,11 @@ impl<E: Estimator> Core<E> {
 
     /// The whole answer to a read of registers (the unit, the PDU, the CRC); its
     /// length.
-    fn read_registers(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
-        let (start, quantity) = head(pdu)?;
+    fn read_registers(
+        &mut self,
+        function: u8,
+        (start, quantity): Head,
+    ) -> Result<usize, Exception> {
         if quantity == 0 || quantity > READ_REGISTERS_MAX {
             return Err(Exception::IllegalDataValue);
         }
@@ -308,8 +322,7 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    fn write_coil(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
-        let (address, value) = head(pdu)?;
+    fn write_coil(&mut self, pdu: &[u8], (address, value): Head) -> Result<usize, Exception> {
         let on = match value {
             0xFF00 => true,
             0x0000 => false,
@@ -320,8 +333,7 @@ impl<E: Estimator> Core<E> {
         self.echo(pdu)
     }
 
-    fn write_coils(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
-        let (start, quantity) = head(pdu)?;
+    fn write_coils(&mut self, pdu: &[u8], (start, quantity): Head) -> Result<usize, Exception> {
         let bytes = usize::from(quantity.div_ceil(8));
         let data = pdu.get(6..).unwrap_or(&[]);
         let declared = pdu.get(5).map_or(0, |&n| usize::from(n));
@@ -343,8 +355,7 @@ impl<E: Estimator> Core<E> {
         self.echo(pdu)
     }
 
-    fn write_register(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
-        let (address, value) = head(pdu)?;
+    fn write_register(&mut self, pdu: &[u8], (address, value): Head) -> Result<usize, Exception> {
         let l = Self::writable(Served::of(Table::Holding), address)?;
         if l.entry.field == Field::Commission(Reg::Scene) {
             let data = pdu.get(3..5).unwrap_or(&[]);
@@ -361,8 +372,7 @@ impl<E: Estimator> Core<E> {
         self.echo(pdu)
     }
 
-    fn write_registers(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
-        let (start, quantity) = head(pdu)?;
+    fn write_registers(&mut self, pdu: &[u8], (start, quantity): Head) -> Result<usize, Exception> {
         let data = pdu.get(6..).unwrap_or(&[]);
         let declared = pdu.get(5).map_or(0, |&n| usize::from(n));
         let bytes = 2 * usize::from(quantity);
@@ -600,7 +610,7 @@ mod tests {
                     let [a, b] = start.to_be_bytes();
                     let [c, d] = quantity.to_be_bytes();
                     let pdu = [function, a, b, c, d];
-                    let n = server.core.dispatch(function, &pdu).unwrap();
+                    let n = server.core.dispatch(function, &pdu, head(&pdu)).unwrap();
                     let bytes = usize::from(quantity.div_ceil(8));
                     assert_eq!(n, bytes + 2);
                     assert_eq!(server.core.response[1..3], [function, bytes as u8]);
@@ -612,7 +622,8 @@ mod tests {
                 }
                 let [a, b] = start.to_be_bytes();
                 let [c, d] = (map.end - start + 1).to_be_bytes();
-                let past = server.core.dispatch(function, &[function, a, b, c, d]);
+                let pdu = [function, a, b, c, d];
+                let past = server.core.dispatch(function, &pdu, head(&pdu));
                 assert_eq!(past, Err(Exception::IllegalDataAddress));
             }
         }
@@ -647,7 +658,7 @@ mod tests {
                     let [c, d] = quantity.to_be_bytes();
                     let n = server
                         .core
-                        .read_registers(function, &[function, a, b, c, d])
+                        .read_registers(function, head(&[function, a, b, c, d]).unwrap())
                         .unwrap();
                     let answer = &server.core.response[..n];
                     let bytes = 2 * usize::from(quantity);
