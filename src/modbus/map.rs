@@ -1024,7 +1024,9 @@ impl Served {
 
 /// `n / d` and `n % d` (`None` for `d` 0) by shifts and subtractions, 16 steps: no
 /// division routine linked into a node without a divider (the Cortex-M0), for the few
-/// divisions by a block's stride, none of them on a poll's path.
+/// divisions by a block's stride, none of them on a poll's path. Out of line: one
+/// copy for its three callers.
+#[inline(never)]
 pub(crate) fn div_rem(n: u16, d: u16) -> Option<(u16, u16)> {
     if d == 0 {
         return None;
