@@ -10,6 +10,7 @@
 //! it cleared until it is acknowledged. An acknowledgement while the condition holds
 //! acknowledges it; the indication then ends with the condition.
 
+use super::order::{ge, nan};
 use super::{Monitor, RiskState};
 use crate::Estimator;
 
@@ -87,7 +88,9 @@ impl AlarmSet {
         let sticking = matches!(state, RiskState::Normal | RiskState::Microslip);
         let approaching = sticking
             && match (monitor.time_to_critical(), monitor.config().trend) {
-                (Some(t), Some(trend)) => t < trend.horizon_s,
+                // t < horizon, by the bits where floats are soft (`order`): no
+                // soft-float comparison linked for it (the horizon is validated finite).
+                (Some(t), Some(trend)) => !nan(t) && !ge(t, trend.horizon_s),
                 _ => false,
             };
         AlarmSet::NONE
