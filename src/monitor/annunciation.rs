@@ -167,6 +167,27 @@ impl Annunciator {
 mod tests {
     use super::*;
 
+    /// Over the built-in scenario, which raises `Approaching` (tests/monitor.rs), the
+    /// approaching alarm is the float comparison of the time to critical with the
+    /// horizon while the contact sticks, at every sample.
+    #[test]
+    fn approaching_is_the_time_to_critical_below_the_horizon() {
+        use crate::monitor::{Config, scenario};
+        let core = scenario::estimator::<crate::float::Auto>().unwrap();
+        let mut m = Monitor::new(core, Config::default()).unwrap();
+        let horizon = Config::default().trend.unwrap().horizon_s;
+        let mut raised = 0;
+        for s in scenario::Scenario::new() {
+            m.process(s);
+            let sticking = matches!(m.state(), RiskState::Normal | RiskState::Microslip);
+            let below = m.time_to_critical().is_some_and(|t| t < horizon);
+            let approaching = AlarmSet::of(&m).contains(AlarmSet::APPROACHING);
+            assert_eq!(approaching, sticking && below, "at {} ms", s.time_ms);
+            raised += usize::from(approaching);
+        }
+        assert!(raised > 0);
+    }
+
     #[test]
     fn acknowledgement_and_latching() {
         let w = AlarmSet::WARNING;
