@@ -470,7 +470,10 @@ impl<E: Estimator> Core<E> {
         records: u16,
     ) -> impl Iterator<Item = &'a [u8]> {
         let n = 2 * usize::from(block.stride);
-        (0..usize::from(records)).map_while(move |k| data.get(k * n..k * n + n))
+        (0..usize::from(records)).map_while(move |k| {
+            let at = k.checked_mul(n)?;
+            data.get(at..at.checked_add(n)?)
+        })
     }
 
     /// The number of whole records of a write to `block`, or why it is refused.

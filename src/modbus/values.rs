@@ -34,7 +34,8 @@ fn split_seconds(ms: u64) -> (u32, u32) {
         let digit = rest << 16 | digit;
         let q = div1000(digit);
         seconds = seconds << 16 | u64::from(q);
-        rest = digit - q * 1000;
+        // q * 1000 <= digit < 2^26: neither wraps.
+        rest = digit.wrapping_sub(q.wrapping_mul(1000));
     }
     (u32::try_from(seconds).unwrap_or(u32::MAX), rest)
 }
