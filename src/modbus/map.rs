@@ -188,7 +188,8 @@ pub(crate) enum EventField {
     Margin,
 }
 
-/// The fields of an external sample record.
+/// The fields of an external sample record (in this order: `sample_from_record`
+/// keeps their values by it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum SampleField {
     Flags,

@@ -2,7 +2,7 @@
 //! states, event kinds and faults; external sample records decoded; and the decoding
 //! of an event slot for a master written in Rust.
 
-use super::map::{EventField, Field, SampleField, SlotBlock};
+use super::map::{EventField, Field, SlotBlock};
 use super::{AlarmSet, Core, NONE};
 use crate::Estimator;
 use crate::monitor::{Channel, Event, EventKind, FaultCause, Reading, RiskState, Sample};
@@ -236,36 +236,24 @@ pub fn event_from_registers(regs: &[u16]) -> Result<Option<Event>, DecodeError> 
 /// The sample in one record of an external samples block (big-endian register
 /// bytes); `None` for flags with bits other than speed (0) and axial force (1).
 pub(crate) fn sample_from_record(block: &SlotBlock, record: &[u8]) -> Option<Sample> {
-    let mut sample = Sample::new(0, 0.0, 0.0);
-    let mut flags = 0u16;
-    let mut speed = None;
-    let mut force = None;
+    // Each field's bits by its `SampleField` (flags, time, P, phi, V, F), a record's
+    // fields read by one loop; a basic record has no flags (0: no V, no F).
+    let mut v = [0u32; 6];
     for e in block.fields {
+        let Field::Sample(f) = e.field else {
+            return None;
+        };
         let at = 2 * usize::from(e.address());
-        let word = |i: usize| -> Option<u32> {
-            let b = record.get(at + 2 * i..at + 2 * i + 2)?;
-            Some(u32::from(u16::from_be_bytes([b[0], b[1]])))
-        };
-        let v = match e.words() {
-            2 => word(0)? << 16 | word(1)?,
-            _ => word(0)?,
-        };
-        let x = f32::from_bits(v);
-        match e.field {
-            Field::Sample(SampleField::Flags) => flags = v as u16,
-            Field::Sample(SampleField::TimeMs) => sample.time_ms = v,
-            Field::Sample(SampleField::Load) => sample.load = x,
-            Field::Sample(SampleField::Phi) => sample.phi = x,
-            Field::Sample(SampleField::Speed) => speed = Some(x),
-            Field::Sample(SampleField::AxialForce) => force = Some(x),
-            _ => return None,
-        }
+        let bytes = record.get(at..at + 2 * usize::from(e.words()))?;
+        *v.get_mut(f as usize)? = bytes.iter().fold(0, |x, &b| x << 8 | u32::from(b));
     }
+    let [flags, time_ms, load, phi, speed, force] = v;
     if flags & !3 != 0 {
         return None;
     }
-    sample.speed = speed.filter(|_| flags & 1 != 0);
-    sample.axial_force = force.filter(|_| flags & 2 != 0);
+    let mut sample = Sample::new(time_ms, f32::from_bits(load), f32::from_bits(phi));
+    sample.speed = (flags & 1 != 0).then_some(f32::from_bits(speed));
+    sample.axial_force = (flags & 2 != 0).then_some(f32::from_bits(force));
     Some(sample)
 }
 
