@@ -313,7 +313,10 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    /// [`value`](Self::value) of the other fields.
+    /// [`value`](Self::value) of the other fields: every field of the coils, the
+    /// discrete inputs and the input registers, and the holding registers'
+    /// configuration (`active_*`); the other holding registers are
+    /// [`value_holding`](Self::value_holding)'s.
     #[inline(never)]
     pub(super) fn value_other(&self, field: Field, record: u16) -> u32 {
         let m = &self.monitor;
@@ -397,8 +400,10 @@ impl<E: Estimator> Core<E> {
                     .0
                     .min(u32::MAX - 1)
             }),
-            Field::Commission(reg) => self.commissioning.value(reg, &self.monitor),
-            Field::Staged(f) => self.commissioning.staged(f, self.monitor.config()),
+            // Holding registers that only `value_holding` reads (every read of holding
+            // registers inlines it): not read here too, so that the image holds one
+            // copy of the commissioning registers' reading, not two.
+            Field::Commission(_) | Field::Staged(_) => 0,
             Field::Active(f) => super::config::active(f, self.monitor.config()),
         }
     }
