@@ -205,6 +205,7 @@ impl Default for FrictionConfig {
 
 impl FrictionConfig {
     /// Whether the values are consistent (see the fields).
+    #[inline(always)]
     pub(crate) fn is_valid(&self) -> bool {
         positive(self.sensitivity_max)
             && positive(self.tau_s)
@@ -313,16 +314,19 @@ impl core::error::Error for ConfigError {}
 // compared (checked first), so that the order's answer is the float comparison's.
 
 /// Finite and above zero.
+#[inline(always)]
 fn positive(x: f32) -> bool {
     finite(x) && !ge(0.0, x)
 }
 
 /// Finite and at least zero (-0 included).
+#[inline(always)]
 fn non_negative(x: f32) -> bool {
     finite(x) && ge(x, 0.0)
 }
 
 /// `a < b` for values that are not NaN.
+#[inline(always)]
 fn below(a: f32, b: f32) -> bool {
     !ge(a, b)
 }
@@ -396,7 +400,9 @@ impl Config {
                 return Err(ConfigError::Trend);
             }
         }
-        if self.friction.is_some_and(|f| !f.is_valid()) {
+        if let Some(f) = &self.friction
+            && !f.is_valid()
+        {
             return Err(ConfigError::Friction);
         }
         Ok(())
