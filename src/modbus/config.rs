@@ -793,7 +793,8 @@ impl<E: Estimator> Commissioning<E> {
 /// Whole seconds in `ms`, rounded up.
 #[inline(never)]
 fn seconds(ms: u32) -> u32 {
-    ms.div_ceil(1000)
+    let s = super::values::div1000(ms);
+    s + u32::from(s.wrapping_mul(1000) != ms)
 }
 
 /// `scene_staged_crc`.

@@ -188,7 +188,8 @@ pub(crate) enum EventField {
     Margin,
 }
 
-/// The fields of an external sample record.
+/// The fields of an external sample record (in this order: `sample_from_record`
+/// keeps their values by it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum SampleField {
     Flags,
@@ -805,30 +806,45 @@ impl TableMap {
 // 6 KB) and none of their 40-byte entries.
 
 /// An entry as the server holds it: where it is, its type, whether a master may write
-/// it, and what it holds.
+/// it, and what it holds. Five bytes (bytes only: no padding), where the entry's
+/// address and width as u16 made eight: the single entries end below address 256 and
+/// a record is shorter (checked at compile time).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Slot {
     /// The 0-based address (in a block: the offset in the record).
-    pub address: u16,
+    address: u8,
     /// Registers the value takes ([`Type::words`]).
-    pub words: u16,
+    words: u8,
     pub access: Access,
     pub field: Field,
 }
 
 impl Slot {
     const fn of(e: &Entry) -> Slot {
+        assert!(e.end() <= 256, "a served entry's address fits a byte");
         Slot {
-            address: e.address,
-            words: e.ty.words(),
+            address: e.address as u8,
+            words: e.ty.words() as u8,
             access: e.access,
             field: e.field,
         }
     }
 
+    /// The 0-based address (in a block: the offset in the record).
+    #[inline(always)]
+    pub const fn address(&self) -> u16 {
+        self.address as u16
+    }
+
+    /// Registers the value takes ([`Type::words`]).
+    #[inline(always)]
+    pub const fn words(&self) -> u16 {
+        self.words as u16
+    }
+
     /// The address after the value.
     pub const fn end(&self) -> u16 {
-        self.address.saturating_add(self.words)
+        self.address() + self.words()
     }
 }
 
@@ -976,7 +992,7 @@ impl Served {
     pub(crate) fn single(&self, address: u16) -> Option<(usize, u16)> {
         let i = usize::from(*self.index.get(usize::from(address))?);
         let entry = self.entries.get(i)?;
-        Some((i, address.checked_sub(entry.address)?))
+        Some((i, address.checked_sub(entry.address())?))
     }
 
     /// The entry that holds `address`: the entry, the record's index (0 for a single
@@ -994,71 +1010,38 @@ impl Served {
         let b = self.blocks.iter().position(|b| address < b.end())?;
         let block = self.blocks.get(b)?;
         let offset = address.checked_sub(block.address)?;
-        let record = offset.checked_div(block.stride)?;
-        let at = offset.checked_rem(block.stride)?;
+        let (record, at) = div_rem(offset, block.stride)?;
         let index = block.fields.partition_point(|e| e.end() <= at);
         let entry = block.fields.get(index)?;
         Some(Located {
             entry,
             record,
-            word: at.checked_sub(entry.address)?,
+            word: at.checked_sub(entry.address())?,
             block: Some(b),
             index,
         })
     }
+}
 
-    /// The value after `l` (its first word), in address order.
-    fn after(&self, l: &Located) -> Option<Located> {
-        let first_of = |b: usize, record: u16| {
-            let block = self.blocks.get(b)?;
-            Some(Located {
-                entry: block.fields.first()?,
-                record,
-                word: 0,
-                block: Some(b),
-                index: 0,
-            })
-        };
-        let next = l.index.wrapping_add(1);
-        match l.block {
-            None => match self.entries.get(next) {
-                Some(entry) => Some(Located {
-                    entry,
-                    record: 0,
-                    word: 0,
-                    block: None,
-                    index: next,
-                }),
-                None => first_of(0, 0),
-            },
-            Some(b) => {
-                let block = self.blocks.get(b)?;
-                if let Some(entry) = block.fields.get(next) {
-                    Some(Located {
-                        entry,
-                        index: next,
-                        word: 0,
-                        ..*l
-                    })
-                } else if l.record.wrapping_add(1) < block.count {
-                    first_of(b, l.record.wrapping_add(1))
-                } else {
-                    first_of(b.wrapping_add(1), 0)
-                }
-            }
+/// `n / d` and `n % d` (`None` for `d` 0) by shifts and subtractions, 16 steps: no
+/// division routine linked into a node without a divider (the Cortex-M0), for the few
+/// divisions by a block's stride, none of them on a poll's path. Out of line: one
+/// copy for its three callers.
+#[inline(never)]
+pub(crate) fn div_rem(n: u16, d: u16) -> Option<(u16, u16)> {
+    if d == 0 {
+        return None;
+    }
+    let (mut q, mut r) = (0u16, 0u32);
+    for i in (0..16).rev() {
+        r = r << 1 | u32::from(n >> i & 1);
+        q <<= 1;
+        if r >= u32::from(d) {
+            r -= u32::from(d);
+            q |= 1;
         }
     }
-
-    /// The values from `address` on, in address order, the first from the word that
-    /// holds `address`: one search, then steps.
-    pub(crate) fn walk(&self, address: u16) -> impl Iterator<Item = Located> + '_ {
-        let mut next = self.locate(address);
-        core::iter::from_fn(move || {
-            let current = next?;
-            next = self.after(&current);
-            Some(current)
-        })
-    }
+    Some((q, r as u16))
 }
 
 /// An address located in the map.
@@ -1187,6 +1170,31 @@ mod tests {
     }
 
     #[test]
+    fn div_rem_is_division() {
+        for n in 0..=u16::MAX {
+            for d in [
+                0,
+                1,
+                2,
+                3,
+                6,
+                7,
+                11,
+                25,
+                255,
+                256,
+                1000,
+                0x7FFF,
+                0x8000,
+                u16::MAX,
+            ] {
+                let expected = n.checked_div(d).zip(n.checked_rem(d));
+                assert_eq!(div_rem(n, d), expected, "{n} {d}");
+            }
+        }
+    }
+
+    #[test]
     fn every_address_locates_its_entry() {
         for (table, t) in [Table::Coil, Table::Discrete, Table::Input, Table::Holding]
             .into_iter()
@@ -1195,17 +1203,17 @@ mod tests {
             let s = Served::of(table);
             for a in 0..s.end {
                 let l = s.locate(a).expect("inside the table");
-                assert!(l.word < l.entry.words);
+                assert!(l.word < l.entry.words());
             }
             assert!(s.locate(s.end).is_none());
-            // The walk from 0 steps through every value, as locating each does.
-            let mut at = 0;
-            for l in s.walk(0) {
-                let found = s.locate(at).unwrap();
-                assert_eq!((l.entry, l.record, l.word), (found.entry, found.record, 0));
-                at += l.entry.words;
+            // The bit tables: one entry a bit, in address order, without blocks (a read
+            // of bits takes the entries from its start, `Core::read_bits`).
+            if matches!(table, Table::Coil | Table::Discrete) {
+                assert!(t.blocks.is_empty());
+                for (a, e) in (0..).zip(s.entries) {
+                    assert_eq!((e.address(), e.words()), (a, 1));
+                }
             }
-            assert_eq!(at, t.end());
         }
         let l = Served::of(Table::Input)
             .locate(EVENT_SLOTS_ADDRESS + EVENT_STRIDE + 12)

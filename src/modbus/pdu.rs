@@ -4,7 +4,7 @@
 
 use super::config::{ConfigField, Reg};
 use super::exception::Exception;
-use super::map::{Access, Field, Located, Served, SlotBlock, Table};
+use super::map::{Access, Field, Located, Served, SlotBlock, Table, div_rem};
 use super::{ADU_MAX, Core, crc, ident};
 use crate::Estimator;
 
@@ -24,7 +24,11 @@ fn be(pdu: &[u8], i: usize) -> Option<u16> {
 }
 
 /// Address and quantity (or value) of a request PDU.
-fn head(pdu: &[u8]) -> Result<(u16, u16), Exception> {
+type Head = (u16, u16);
+
+/// The [`Head`] of a request PDU: read once per request (`Core::handle`), not once in
+/// each function's handler.
+fn head(pdu: &[u8]) -> Result<Head, Exception> {
     match (be(pdu, 1), be(pdu, 3)) {
         (Some(a), Some(q)) => Ok((a, q)),
         _ => Err(Exception::IllegalDataValue),
@@ -112,12 +116,15 @@ impl<E: Estimator> Core<E> {
                 self.counters.responses_overwritten.wrapping_add(1);
             self.response_len = 0;
         }
+        // Address and quantity (or value) once, for every function that has them.
+        let head = head(pdu);
         // The reads of registers (a master's poll) apart from the dispatch, whose
         // other functions' set-up they then do not share.
         let result = if matches!(function, 3 | 4) {
-            self.read_registers(function, pdu).map(Reply::Adu)
+            head.and_then(|h| self.read_registers(function, h))
+                .map(Reply::Adu)
         } else {
-            self.dispatch(function, pdu).map(Reply::Pdu)
+            self.dispatch(function, pdu, head).map(Reply::Pdu)
         };
         if broadcast {
             return;
@@ -149,13 +156,18 @@ impl<E: Estimator> Core<E> {
     /// The response PDU into `self.response[1..]`; its length. Every function but the
     /// reads of registers, which [`handle`](Self::handle) answers through
     /// [`read_registers`](Self::read_registers).
-    fn dispatch(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
+    fn dispatch(
+        &mut self,
+        function: u8,
+        pdu: &[u8],
+        head: Result<Head, Exception>,
+    ) -> Result<usize, Exception> {
         match function {
-            1 | 2 => self.read_bits(function, pdu),
-            5 => self.write_coil(pdu),
-            6 => self.write_register(pdu),
-            15 => self.write_coils(pdu),
-            16 => self.write_registers(pdu),
+            1 | 2 => self.read_bits(function, head?),
+            5 => self.write_coil(pdu, head?),
+            6 => self.write_register(pdu, head?),
+            15 => self.write_coils(pdu, head?),
+            16 => self.write_registers(pdu, head?),
             43 => {
                 let out = self
                     .response
@@ -167,8 +179,7 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    fn read_bits(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
-        let (start, quantity) = head(pdu)?;
+    fn read_bits(&mut self, function: u8, (start, quantity): Head) -> Result<usize, Exception> {
         if quantity == 0 || quantity > READ_BITS_MAX {
             return Err(Exception::IllegalDataValue);
         }
@@ -182,9 +193,13 @@ impl<E: Estimator> Core<E> {
             packed.fill(0);
         }
         // Inside the map (checked above): one value a bit, packed into the response as
-        // it is computed.
-        for (i, l) in (0..quantity).zip(map.walk(start)) {
-            let on = self.value(l.entry.field, l.record) & 1 != 0;
+        // it is computed. A bit table is one entry a bit from address 0, without blocks
+        // (the map's tests): the bits from `start` are the entries from `start`. Their
+        // values are all `value_other`'s (no copy of the registers' inline values).
+        let first = usize::from(start);
+        let entries = map.entries.get(first..first + usize::from(quantity));
+        for (i, e) in (0u16..).zip(entries.unwrap_or(&[])) {
+            let on = self.value_other(e.field, 0) & 1 != 0;
             if on && let Some(b) = self.response.get_mut(3 + usize::from(i / 8)) {
                 *b |= 1 << (i % 8);
             }
@@ -194,8 +209,11 @@ impl<E: Estimator> Core<E> {
 
     /// The whole answer to a read of registers (the unit, the PDU, the CRC); its
     /// length.
-    fn read_registers(&mut self, function: u8, pdu: &[u8]) -> Result<usize, Exception> {
-        let (start, quantity) = head(pdu)?;
+    fn read_registers(
+        &mut self,
+        function: u8,
+        (start, quantity): Head,
+    ) -> Result<usize, Exception> {
         if quantity == 0 || quantity > READ_REGISTERS_MAX {
             return Err(Exception::IllegalDataValue);
         }
@@ -238,17 +256,18 @@ impl<E: Estimator> Core<E> {
         // single entries lead into it.
         let mut from = None;
         let mut out = Words { at: 3 };
-        if let Some((mut i, word)) = map.single(start) {
+        if let Some((i, word)) = map.single(start) {
             // A read from a value's low word: the value from the byte before.
             out.at = 3 - 2 * usize::from(word & 1);
+            // The entries by a pointer's steps, not an index's multiplication.
+            let mut entries = map.entries.get(i..).unwrap_or(&[]).iter();
             while out.at < end {
-                let Some(e) = map.entries.get(i) else {
+                let Some(e) = entries.next() else {
                     from = Some((0, 0, 0));
                     break;
                 };
                 let v = value(self, e.field, 0);
-                out.put(&mut self.response, v, e.words);
-                i += 1;
+                out.put(&mut self.response, v, e.words());
             }
         } else if let Some(l) = map.locate(start)
             && let Some(b) = l.block
@@ -274,7 +293,7 @@ impl<E: Estimator> Core<E> {
                         break 'blocks;
                     }
                     let v = value(self, e.field, record);
-                    out.put(&mut self.response, v, e.words);
+                    out.put(&mut self.response, v, e.words());
                     i += 1;
                 }
                 (record, i) = (record + 1, 0);
@@ -295,7 +314,7 @@ impl<E: Estimator> Core<E> {
         Ok(5)
     }
 
-    /// The coil at `address`, if a master may write it.
+    /// The value at `address` in `map`, if a master may write it.
     fn writable(map: &Served, address: u16) -> Result<Located, Exception> {
         match map.locate(address) {
             Some(l) if l.entry.access == Access::Rw => Ok(l),
@@ -303,23 +322,30 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    fn write_coil(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
-        let (address, value) = head(pdu)?;
+    /// The field of the coil at `address`, if a master may write it: the coils are one
+    /// entry a bit from address 0 (the map's tests), found without a search.
+    fn writable_coil(address: u16) -> Result<Field, Exception> {
+        match Served::of(Table::Coil).entries.get(usize::from(address)) {
+            Some(e) if e.access == Access::Rw => Ok(e.field),
+            _ => Err(Exception::IllegalDataAddress),
+        }
+    }
+
+    fn write_coil(&mut self, pdu: &[u8], (address, value): Head) -> Result<usize, Exception> {
         let on = match value {
             0xFF00 => true,
             0x0000 => false,
             _ => return Err(Exception::IllegalDataValue),
         };
-        let l = Self::writable(Served::of(Table::Coil), address)?;
-        if protected_bit(l.entry.field) {
+        let field = Self::writable_coil(address)?;
+        if protected_bit(field) {
             self.commissioning.guard()?;
         }
-        self.write_bit(l.entry.field, on);
+        self.write_bit(field, on);
         self.echo(pdu)
     }
 
-    fn write_coils(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
-        let (start, quantity) = head(pdu)?;
+    fn write_coils(&mut self, pdu: &[u8], (start, quantity): Head) -> Result<usize, Exception> {
         let bytes = usize::from(quantity.div_ceil(8));
         let data = pdu.get(6..).unwrap_or(&[]);
         let declared = pdu.get(5).map_or(0, |&n| usize::from(n));
@@ -330,7 +356,7 @@ impl<E: Estimator> Core<E> {
         in_map(map, start, quantity)?;
         let mut protected = false;
         for i in 0..quantity {
-            protected |= protected_bit(Self::writable(map, start.wrapping_add(i))?.entry.field);
+            protected |= protected_bit(Self::writable_coil(start.wrapping_add(i))?);
         }
         // One guard for the request: refused whole (and counted once) while locked.
         if protected {
@@ -340,14 +366,13 @@ impl<E: Estimator> Core<E> {
             let on = data
                 .get(usize::from(i / 8))
                 .is_some_and(|b| b >> (i % 8) & 1 != 0);
-            let l = Self::writable(map, start.wrapping_add(i))?;
-            self.write_bit(l.entry.field, on);
+            let field = Self::writable_coil(start.wrapping_add(i))?;
+            self.write_bit(field, on);
         }
         self.echo(pdu)
     }
 
-    fn write_register(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
-        let (address, value) = head(pdu)?;
+    fn write_register(&mut self, pdu: &[u8], (address, value): Head) -> Result<usize, Exception> {
         let l = Self::writable(Served::of(Table::Holding), address)?;
         if l.entry.field == Field::Commission(Reg::Scene) {
             let data = pdu.get(3..5).unwrap_or(&[]);
@@ -355,7 +380,7 @@ impl<E: Estimator> Core<E> {
                 .write_scene(address, data)
                 .and_then(|()| self.echo(pdu));
         }
-        if l.entry.words != 1 || matches!(l.entry.field, Field::Sample(_)) {
+        if l.entry.words() != 1 || matches!(l.entry.field, Field::Sample(_)) {
             // Half of a 32-bit value, or part of a sample record.
             return Err(Exception::IllegalDataAddress);
         }
@@ -364,8 +389,7 @@ impl<E: Estimator> Core<E> {
         self.echo(pdu)
     }
 
-    fn write_registers(&mut self, pdu: &[u8]) -> Result<usize, Exception> {
-        let (start, quantity) = head(pdu)?;
+    fn write_registers(&mut self, pdu: &[u8], (start, quantity): Head) -> Result<usize, Exception> {
         let data = pdu.get(6..).unwrap_or(&[]);
         let declared = pdu.get(5).map_or(0, |&n| usize::from(n));
         let bytes = 2 * usize::from(quantity);
@@ -402,7 +426,7 @@ impl<E: Estimator> Core<E> {
             let mut a = start;
             while a < end {
                 let l = Self::writable(map, a)?;
-                let n = l.entry.words;
+                let n = l.entry.words();
                 if l.word != 0 || a.wrapping_add(n) > end {
                     return Err(Exception::IllegalDataAddress);
                 }
@@ -437,16 +461,27 @@ impl<E: Estimator> Core<E> {
             self.counters.external_refused = self.counters.external_refused.wrapping_add(1);
         }
         let records = result?;
-        for record in data
-            .chunks_exact(2 * usize::from(block.stride))
-            .take(records)
-        {
+        for record in Self::records(block, data, records) {
             if let Some(sample) = super::values::sample_from_record(block, record) {
                 self.counters.external_accepted = self.counters.external_accepted.wrapping_add(1);
                 self.process(sample);
             }
         }
         Ok(())
+    }
+
+    /// The first `records` whole records of `block` in `data` (without a division:
+    /// `chunks_exact` would link one into a Cortex-M0 node).
+    fn records<'a>(
+        block: &SlotBlock,
+        data: &'a [u8],
+        records: u16,
+    ) -> impl Iterator<Item = &'a [u8]> {
+        let n = 2 * usize::from(block.stride);
+        (0..usize::from(records)).map_while(move |k| {
+            let at = k.checked_mul(n)?;
+            data.get(at..at.checked_add(n)?)
+        })
     }
 
     /// The number of whole records of a write to `block`, or why it is refused.
@@ -456,24 +491,26 @@ impl<E: Estimator> Core<E> {
         start: u16,
         quantity: u16,
         data: &[u8],
-    ) -> Result<usize, Exception> {
+    ) -> Result<u16, Exception> {
         let offset = start
             .checked_sub(block.address)
             .ok_or(Exception::IllegalDataAddress)?;
         let stride = block.stride;
-        let whole = offset.is_multiple_of(stride) && quantity.is_multiple_of(stride);
+        let split = |n| div_rem(n, stride).unwrap_or((0, 1));
+        let ((_, first), (records, rest)) = (split(offset), split(quantity));
+        let whole = first == 0 && rest == 0;
         if !whole || u32::from(start) + u32::from(quantity) > u32::from(block.end()) {
             return Err(Exception::IllegalDataAddress);
         }
         if !self.external {
             return Err(Exception::IllegalFunction);
         }
-        for record in data.chunks_exact(2 * usize::from(stride)) {
+        for record in Self::records(block, data, records) {
             if super::values::sample_from_record(block, record).is_none() {
                 return Err(Exception::IllegalDataValue);
             }
         }
-        Ok(usize::from(quantity / stride))
+        Ok(records)
     }
 
     /// Whether `v` is in the domain of the writable register `field`, and a
@@ -576,6 +613,100 @@ mod tests {
     use crate::{Scene, float::Auto};
     use std::vec::Vec;
 
+    /// Every read of bits (functions 1 and 2), from every address and of every length
+    /// the table holds, answers each bit as its entry's value, with the head and the
+    /// CRC of a valid frame; one past the table is exception 02.
+    #[test]
+    fn every_read_of_bits_is_each_bits_value() {
+        let scene = Scene::DEMO;
+        let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5).unwrap()).unwrap();
+        let monitor = Monitor::new(core, Config::default()).unwrap();
+        let config = ServerConfig {
+            external_samples: true,
+            latching: super::super::AlarmSet::ALARM,
+            ..ServerConfig::default()
+        };
+        let mut server = Server::new(monitor, config).unwrap();
+        for i in 0..200u32 {
+            let load = 2e3 + 40.0 * i as f32;
+            server.process(Sample::new(i * 1000, load, 1e-4 * (i % 7) as f32).with_speed(2.0));
+        }
+        for function in [1u8, 2] {
+            let map = Served::of(table_of(function));
+            let bits: Vec<u8> = (0..map.end)
+                .map(|a| {
+                    let l = map.locate(a).unwrap();
+                    (server.core.value_other(l.entry.field, l.record) & 1) as u8
+                })
+                .collect();
+            assert!(bits.contains(&1), "{function}: some bit set");
+            for start in 0..map.end {
+                for quantity in 1..=map.end - start {
+                    let [a, b] = start.to_be_bytes();
+                    let [c, d] = quantity.to_be_bytes();
+                    let pdu = [function, a, b, c, d];
+                    let n = server.core.dispatch(function, &pdu, head(&pdu)).unwrap();
+                    let bytes = usize::from(quantity.div_ceil(8));
+                    assert_eq!(n, bytes + 2);
+                    assert_eq!(server.core.response[1..3], [function, bytes as u8]);
+                    for i in 0..usize::from(quantity) {
+                        let bit = server.core.response[3 + i / 8] >> (i % 8) & 1;
+                        let s = usize::from(start);
+                        assert_eq!(bit, bits[s + i], "{function} {start}+{quantity}: bit {i}");
+                    }
+                }
+                let [a, b] = start.to_be_bytes();
+                let [c, d] = (map.end - start + 1).to_be_bytes();
+                let pdu = [function, a, b, c, d];
+                let past = server.core.dispatch(function, &pdu, head(&pdu));
+                assert_eq!(past, Err(Exception::IllegalDataAddress));
+            }
+        }
+    }
+
+    /// Every write of coils (function 15) from every address and of every length sets
+    /// those coils and no other, as a read of coils then shows (the coil
+    /// `acknowledge` reads 0); function 5 likewise one at a time; past the table, 02.
+    #[test]
+    fn every_write_of_coils_sets_those_coils() {
+        let scene = Scene::DEMO;
+        let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5).unwrap()).unwrap();
+        let monitor = Monitor::new(core, Config::default()).unwrap();
+        let mut server = Server::new(monitor, ServerConfig::default()).unwrap();
+        let coils = |server: &mut Server<Auto>| {
+            let pdu = [1, 0, 0, 0, 6];
+            server.core.dispatch(1, &pdu, head(&pdu)).unwrap();
+            server.core.response[3]
+        };
+        let end = Served::of(Table::Coil).end;
+        assert_eq!(end, 6);
+        for pattern in [0u8, 0x3F, 0x15, 0x2A] {
+            for start in 0..end {
+                for quantity in 1..=end - start {
+                    let before = coils(&mut server);
+                    let bits = pattern >> start;
+                    let pdu = [15, 0, start as u8, 0, quantity as u8, 1, bits];
+                    let n = server.core.dispatch(15, &pdu, head(&pdu)).unwrap();
+                    assert_eq!(server.core.response[1..=n], pdu[..5]);
+                    let mask = ((1u8 << quantity) - 1) << start;
+                    let expected = (before & !mask | pattern & mask) & !1;
+                    assert_eq!(coils(&mut server), expected, "{pattern} {start}+{quantity}");
+                }
+                let on = if pattern >> start & 1 != 0 { 0xFF } else { 0 };
+                let pdu = [5, 0, start as u8, on, 0];
+                server.core.dispatch(5, &pdu, head(&pdu)).unwrap();
+                let bit = coils(&mut server) >> start & 1;
+                assert_eq!(bit, pattern >> start & 1 & u8::from(start != 0), "{start}");
+            }
+            let pdu = [15, 0, 5, 0, 2, 1, 3];
+            let past = server.core.dispatch(15, &pdu, head(&pdu));
+            assert_eq!(past, Err(Exception::IllegalDataAddress));
+            let pdu = [5, 0, 6, 0xFF, 0];
+            let past = server.core.dispatch(5, &pdu, head(&pdu));
+            assert_eq!(past, Err(Exception::IllegalDataAddress));
+        }
+    }
+
     /// Every read of registers, from every address and of every length the table
     /// allows (up to 125), answers each register as the value that holds it, located
     /// alone and computed alone, with the head and the CRC of a valid frame.
@@ -594,8 +725,17 @@ mod tests {
             let expected: Vec<u16> = (0..map.end)
                 .map(|a| {
                     let l = map.locate(a).unwrap();
-                    let v = server.core.value_other(l.entry.field, l.record);
-                    let low = l.entry.words == 1 || l.word == 1;
+                    let (field, record) = (l.entry.field, l.record);
+                    let other = server.core.value_other(field, record);
+                    // The commissioning registers are value_holding's alone; every
+                    // other value reads the same inline and out of line.
+                    let v = match field {
+                        Field::Commission(_) | Field::Staged(_) => {
+                            server.core.value_holding(field, record)
+                        }
+                        _ => other,
+                    };
+                    let low = l.entry.words() == 1 || l.word == 1;
                     (if low { v } else { v >> 16 }) as u16
                 })
                 .collect();
@@ -605,7 +745,7 @@ mod tests {
                     let [c, d] = quantity.to_be_bytes();
                     let n = server
                         .core
-                        .read_registers(function, &[function, a, b, c, d])
+                        .read_registers(function, head(&[function, a, b, c, d]).unwrap())
                         .unwrap();
                     let answer = &server.core.response[..n];
                     let bytes = 2 * usize::from(quantity);

@@ -2,7 +2,7 @@
 //! states, event kinds and faults; external sample records decoded; and the decoding
 //! of an event slot for a master written in Rust.
 
-use super::map::{EventField, Field, SampleField, SlotBlock};
+use super::map::{EventField, Field, SlotBlock};
 use super::{AlarmSet, Core, NONE};
 use crate::Estimator;
 use crate::monitor::{Channel, Event, EventKind, FaultCause, Reading, RiskState, Sample};
@@ -14,17 +14,28 @@ fn opt(x: Option<f32>) -> u32 {
     x.map_or(NONE, f32::to_bits)
 }
 
+/// `x / 1000` for every u32, by a multiplication: `x` times 2^41 / 1000 rounded up
+/// (2199023256, 448 / 1000 above it: less than 2^(41 - 32) / 1000, so exact for every
+/// 32-bit `x`, Granlund and Montgomery's bound), shifted down 41 bits. No division
+/// routine is linked into a node without a divider (the Cortex-M0).
+pub(crate) fn div1000(x: u32) -> u32 {
+    ((u64::from(x) * 2_199_023_256) >> 41) as u32
+}
+
 /// Whole seconds in `ms` (saturated at `u32::MAX`) and the milliseconds left over, by
-/// long division in 16-bit digits: u32 divisions only, so that no 64-bit division is
-/// linked into a Cortex-M0 node.
+/// long division in 16-bit digits ([`div1000`]), so that no 64-bit division is linked
+/// into a Cortex-M0 node; the digits by constant shifts (no 64-bit shift routine).
 fn split_seconds(ms: u64) -> (u32, u32) {
     let mut seconds = 0u64;
     let mut rest = 0u32;
-    for shift in [48, 32, 16, 0] {
+    let (high, low) = ((ms >> 32) as u32, ms as u32);
+    for digit in [high >> 16, high & 0xFFFF, low >> 16, low & 0xFFFF] {
         // rest < 1000, so the digit fits in 26 bits.
-        let digit = rest << 16 | (ms >> shift) as u32 & 0xFFFF;
-        seconds = seconds << 16 | u64::from(digit / 1000);
-        rest = digit % 1000;
+        let digit = rest << 16 | digit;
+        let q = div1000(digit);
+        seconds = seconds << 16 | u64::from(q);
+        // q * 1000 <= digit < 2^26: neither wraps.
+        rest = digit.wrapping_sub(q.wrapping_mul(1000));
     }
     (u32::try_from(seconds).unwrap_or(u32::MAX), rest)
 }
@@ -225,36 +236,24 @@ pub fn event_from_registers(regs: &[u16]) -> Result<Option<Event>, DecodeError> 
 /// The sample in one record of an external samples block (big-endian register
 /// bytes); `None` for flags with bits other than speed (0) and axial force (1).
 pub(crate) fn sample_from_record(block: &SlotBlock, record: &[u8]) -> Option<Sample> {
-    let mut sample = Sample::new(0, 0.0, 0.0);
-    let mut flags = 0u16;
-    let mut speed = None;
-    let mut force = None;
+    // Each field's bits by its `SampleField` (flags, time, P, phi, V, F), a record's
+    // fields read by one loop; a basic record has no flags (0: no V, no F).
+    let mut v = [0u32; 6];
     for e in block.fields {
-        let at = 2 * usize::from(e.address);
-        let word = |i: usize| -> Option<u32> {
-            let b = record.get(at + 2 * i..at + 2 * i + 2)?;
-            Some(u32::from(u16::from_be_bytes([b[0], b[1]])))
+        let Field::Sample(f) = e.field else {
+            return None;
         };
-        let v = match e.words {
-            2 => word(0)? << 16 | word(1)?,
-            _ => word(0)?,
-        };
-        let x = f32::from_bits(v);
-        match e.field {
-            Field::Sample(SampleField::Flags) => flags = v as u16,
-            Field::Sample(SampleField::TimeMs) => sample.time_ms = v,
-            Field::Sample(SampleField::Load) => sample.load = x,
-            Field::Sample(SampleField::Phi) => sample.phi = x,
-            Field::Sample(SampleField::Speed) => speed = Some(x),
-            Field::Sample(SampleField::AxialForce) => force = Some(x),
-            _ => return None,
-        }
+        let at = 2 * usize::from(e.address());
+        let bytes = record.get(at..at + 2 * usize::from(e.words()))?;
+        *v.get_mut(f as usize)? = bytes.iter().fold(0, |x, &b| x << 8 | u32::from(b));
     }
+    let [flags, time_ms, load, phi, speed, force] = v;
     if flags & !3 != 0 {
         return None;
     }
-    sample.speed = speed.filter(|_| flags & 1 != 0);
-    sample.axial_force = force.filter(|_| flags & 2 != 0);
+    let mut sample = Sample::new(time_ms, f32::from_bits(load), f32::from_bits(phi));
+    sample.speed = (flags & 1 != 0).then_some(f32::from_bits(speed));
+    sample.axial_force = (flags & 2 != 0).then_some(f32::from_bits(force));
     Some(sample)
 }
 
@@ -314,7 +313,10 @@ impl<E: Estimator> Core<E> {
         }
     }
 
-    /// [`value`](Self::value) of the other fields.
+    /// [`value`](Self::value) of the other fields: every field of the coils, the
+    /// discrete inputs and the input registers, and the holding registers'
+    /// configuration (`active_*`); the other holding registers are
+    /// [`value_holding`](Self::value_holding)'s.
     #[inline(never)]
     pub(super) fn value_other(&self, field: Field, record: u16) -> u32 {
         let m = &self.monitor;
@@ -331,7 +333,7 @@ impl<E: Estimator> Core<E> {
             Field::Indicated(w) => bit(a.indicated(), w),
             Field::Unacknowledged(w) => bit(a.unacknowledged(), w),
             Field::Running => u32::from(m.state() != RiskState::Stopped),
-            Field::EventAvailable => u32::from(self.events.unread().next().is_some()),
+            Field::EventAvailable => u32::from(self.events.slot(0).is_some()),
             Field::Status => self.status(),
             Field::Alarms => {
                 u32::from(a.indicated().bits())
@@ -382,11 +384,7 @@ impl<E: Estimator> Core<E> {
             Field::BusDiscarded => self.bus(|c| c.framing.discarded),
             Field::BusExceptions => self.bus(|c| c.exceptions),
             Field::EventFirst => self.events.first(m.next_event_seq()),
-            Field::EventCount => self
-                .events
-                .unread()
-                .take(usize::from(super::map::EVENT_SLOTS))
-                .count() as u32,
+            Field::EventCount => u32::from(self.events.unread(super::map::EVENT_SLOTS)),
             Field::EventsMissed => self.events.missed(m.next_event_seq()),
             Field::Event(f) => self.events.slot(record).map_or(0, |e| event_value(e, f)),
             Field::EventFrom => self.events.from,
@@ -402,8 +400,10 @@ impl<E: Estimator> Core<E> {
                     .0
                     .min(u32::MAX - 1)
             }),
-            Field::Commission(reg) => self.commissioning.value(reg, &self.monitor),
-            Field::Staged(f) => self.commissioning.staged(f, self.monitor.config()),
+            // Holding registers that only `value_holding` reads (every read of holding
+            // registers inlines it): not read here too, so that the image holds one
+            // copy of the commissioning registers' reading, not two.
+            Field::Commission(_) | Field::Staged(_) => 0,
             Field::Active(f) => super::config::active(f, self.monitor.config()),
         }
     }
@@ -416,7 +416,27 @@ impl<E: Estimator> Core<E> {
 
 #[cfg(test)]
 mod tests {
-    use super::split_seconds;
+    use super::{div1000, split_seconds};
+
+    /// Every u32 near a multiple of 1000 (where a quotient changes), the extremes and
+    /// a spread of others.
+    #[test]
+    fn div1000_is_division() {
+        let near = (0..=4_294_967u32).flat_map(|k| {
+            let m = k.wrapping_mul(1000);
+            [m, m.wrapping_sub(1), m.wrapping_add(999)]
+        });
+        let mut x = 0x2545_F491u32;
+        let spread = (0..1_000_000).map(|_| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x
+        });
+        for v in near.chain(spread).chain([u32::MAX, u32::MAX - 1, 1 << 31]) {
+            assert_eq!(div1000(v), v / 1000, "{v}");
+        }
+    }
 
     /// The long division gives what u64 division gives, saturated where the seconds
     /// pass u32.

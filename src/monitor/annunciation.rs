@@ -10,6 +10,7 @@
 //! it cleared until it is acknowledged. An acknowledgement while the condition holds
 //! acknowledges it; the indication then ends with the condition.
 
+use super::order::{ge, nan};
 use super::{Monitor, RiskState};
 use crate::Estimator;
 
@@ -87,7 +88,9 @@ impl AlarmSet {
         let sticking = matches!(state, RiskState::Normal | RiskState::Microslip);
         let approaching = sticking
             && match (monitor.time_to_critical(), monitor.config().trend) {
-                (Some(t), Some(trend)) => t < trend.horizon_s,
+                // t < horizon, by the bits where floats are soft (`order`): no
+                // soft-float comparison linked for it (the horizon is validated finite).
+                (Some(t), Some(trend)) => !nan(t) && !ge(t, trend.horizon_s),
                 _ => false,
             };
         AlarmSet::NONE
@@ -163,6 +166,27 @@ impl Annunciator {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Over the built-in scenario, which raises `Approaching` (tests/monitor.rs), the
+    /// approaching alarm is the float comparison of the time to critical with the
+    /// horizon while the contact sticks, at every sample.
+    #[test]
+    fn approaching_is_the_time_to_critical_below_the_horizon() {
+        use crate::monitor::{Config, scenario};
+        let core = scenario::estimator::<crate::float::Auto>().unwrap();
+        let mut m = Monitor::new(core, Config::default()).unwrap();
+        let horizon = Config::default().trend.unwrap().horizon_s;
+        let mut raised = 0;
+        for s in scenario::Scenario::new() {
+            m.process(s);
+            let sticking = matches!(m.state(), RiskState::Normal | RiskState::Microslip);
+            let below = m.time_to_critical().is_some_and(|t| t < horizon);
+            let approaching = AlarmSet::of(&m).contains(AlarmSet::APPROACHING);
+            assert_eq!(approaching, sticking && below, "at {} ms", s.time_ms);
+            raised += usize::from(approaching);
+        }
+        assert!(raised > 0);
+    }
 
     #[test]
     fn acknowledgement_and_latching() {

@@ -1,6 +1,7 @@
 //! The monitor's configuration: one value, validated when the monitor is built. Every
-//! stage reads it; it imports nothing from the monitor.
+//! stage reads it; it imports nothing from the monitor but `order`'s comparisons.
 
+use super::order::{finite, ge};
 use core::fmt;
 
 /// Capacity of the spike filter's window (samples).
@@ -204,15 +205,14 @@ impl Default for FrictionConfig {
 
 impl FrictionConfig {
     /// Whether the values are consistent (see the fields).
+    #[inline(always)]
     pub(crate) fn is_valid(&self) -> bool {
-        let positive = |x: f32| x.is_finite() && x > 0.0;
         positive(self.sensitivity_max)
             && positive(self.tau_s)
             && self.baseline_after_estimates >= 1
             && positive(self.band)
-            && self.deadband.is_finite()
-            && self.deadband >= 0.0
-            && self.deadband < self.band
+            && non_negative(self.deadband)
+            && below(self.deadband, self.band)
     }
 }
 
@@ -309,8 +309,26 @@ impl fmt::Display for ConfigError {
 
 impl core::error::Error for ConfigError {}
 
+// The checks compare by the bits where floats are soft (`order`): a node without an
+// FPU links no soft-float comparison for them. Each operand is finite where two are
+// compared (checked first), so that the order's answer is the float comparison's.
+
+/// Finite and above zero.
+#[inline(always)]
 fn positive(x: f32) -> bool {
-    x.is_finite() && x > 0.0
+    finite(x) && !ge(0.0, x)
+}
+
+/// Finite and at least zero (-0 included).
+#[inline(always)]
+fn non_negative(x: f32) -> bool {
+    finite(x) && ge(x, 0.0)
+}
+
+/// `a < b` for values that are not NaN.
+#[inline(always)]
+fn below(a: f32, b: f32) -> bool {
+    !ge(a, b)
 }
 
 impl Config {
@@ -328,10 +346,90 @@ impl Config {
                 if !(positive(warning) && positive(alarm)) {
                     return Err(ConfigError::Threshold);
                 }
+                if ge(warning, alarm) {
+                    return Err(ConfigError::WarningAboveAlarm);
+                }
+                if !(non_negative(deadband) && below(deadband, warning)) {
+                    return Err(ConfigError::Deadband);
+                }
+            }
+            Thresholds::Margin {
+                warning,
+                alarm,
+                deadband,
+            } => {
+                if !(finite(warning) && finite(alarm)) {
+                    return Err(ConfigError::Threshold);
+                }
+                if ge(alarm, warning) {
+                    return Err(ConfigError::WarningAboveAlarm);
+                }
+                if !non_negative(deadband) {
+                    return Err(ConfigError::Deadband);
+                }
+            }
+        }
+        if !(positive(self.stop_load) && non_negative(self.stop_speed)) {
+            return Err(ConfigError::Stop);
+        }
+        if !positive(self.nominal_speed) {
+            return Err(ConfigError::NominalSpeed);
+        }
+        let range_ok = finite(self.load_min)
+            && finite(self.load_max)
+            && below(self.load_min, self.load_max)
+            && below(self.stop_load, self.load_max)
+            && positive(self.angle_max)
+            && positive(self.speed_max)
+            && positive(self.force_max);
+        if !range_ok {
+            return Err(ConfigError::Range);
+        }
+        if let Some(s) = self.spikes {
+            let window_ok = (3..=SPIKE_WINDOW_CAPACITY).contains(&usize::from(s.window));
+            if !(window_ok && positive(s.k) && positive(s.load_floor) && positive(s.angle_floor)) {
+                return Err(ConfigError::SpikeWindow);
+            }
+        }
+        if !non_negative(self.smoothing_tau_s) {
+            return Err(ConfigError::Smoothing);
+        }
+        if let Some(t) = self.trend {
+            let points_ok = (3..=TREND_CAPACITY).contains(&usize::from(t.points));
+            if !(t.interval_ms > 0 && points_ok && positive(t.horizon_s)) {
+                return Err(ConfigError::Trend);
+            }
+        }
+        if let Some(f) = &self.friction
+            && !f.is_valid()
+        {
+            return Err(ConfigError::Friction);
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The checks as float comparisons (what `validate` compares by the bits).
+    fn validate_by_floats(c: &Config) -> Result<(), ConfigError> {
+        let positive = |x: f32| x.is_finite() && x > 0.0;
+        let non_negative = |x: f32| x.is_finite() && x >= 0.0;
+        match c.thresholds {
+            Thresholds::SlipRatio {
+                warning,
+                alarm,
+                deadband,
+            } => {
+                if !(positive(warning) && positive(alarm)) {
+                    return Err(ConfigError::Threshold);
+                }
                 if warning >= alarm {
                     return Err(ConfigError::WarningAboveAlarm);
                 }
-                if !(deadband.is_finite() && deadband >= 0.0 && deadband < warning) {
+                if !(non_negative(deadband) && deadband < warning) {
                     return Err(ConfigError::Deadband);
                 }
             }
@@ -346,45 +444,155 @@ impl Config {
                 if warning <= alarm {
                     return Err(ConfigError::WarningAboveAlarm);
                 }
-                if !(deadband.is_finite() && deadband >= 0.0) {
+                if !non_negative(deadband) {
                     return Err(ConfigError::Deadband);
                 }
             }
         }
-        if !(positive(self.stop_load) && self.stop_speed.is_finite() && self.stop_speed >= 0.0) {
+        if !(positive(c.stop_load) && non_negative(c.stop_speed)) {
             return Err(ConfigError::Stop);
         }
-        if !positive(self.nominal_speed) {
+        if !positive(c.nominal_speed) {
             return Err(ConfigError::NominalSpeed);
         }
-        let range_ok = self.load_min.is_finite()
-            && self.load_max.is_finite()
-            && self.load_min < self.load_max
-            && self.load_max > self.stop_load
-            && positive(self.angle_max)
-            && positive(self.speed_max)
-            && positive(self.force_max);
-        if !range_ok {
+        if !(c.load_min.is_finite()
+            && c.load_max.is_finite()
+            && c.load_min < c.load_max
+            && c.load_max > c.stop_load
+            && positive(c.angle_max)
+            && positive(c.speed_max)
+            && positive(c.force_max))
+        {
             return Err(ConfigError::Range);
         }
-        if let Some(s) = self.spikes {
-            let window_ok = (3..=SPIKE_WINDOW_CAPACITY).contains(&usize::from(s.window));
-            if !(window_ok && positive(s.k) && positive(s.load_floor) && positive(s.angle_floor)) {
-                return Err(ConfigError::SpikeWindow);
-            }
+        if let Some(s) = c.spikes
+            && !((3..=7).contains(&s.window)
+                && positive(s.k)
+                && positive(s.load_floor)
+                && positive(s.angle_floor))
+        {
+            return Err(ConfigError::SpikeWindow);
         }
-        if !(self.smoothing_tau_s.is_finite() && self.smoothing_tau_s >= 0.0) {
+        if !non_negative(c.smoothing_tau_s) {
             return Err(ConfigError::Smoothing);
         }
-        if let Some(t) = self.trend {
-            let points_ok = (3..=TREND_CAPACITY).contains(&usize::from(t.points));
-            if !(t.interval_ms > 0 && points_ok && positive(t.horizon_s)) {
-                return Err(ConfigError::Trend);
-            }
+        if let Some(t) = c.trend
+            && !(t.interval_ms > 0 && (3..=16).contains(&t.points) && positive(t.horizon_s))
+        {
+            return Err(ConfigError::Trend);
         }
-        if self.friction.is_some_and(|f| !f.is_valid()) {
+        if let Some(f) = c.friction
+            && !(positive(f.sensitivity_max)
+                && positive(f.tau_s)
+                && f.baseline_after_estimates >= 1
+                && positive(f.band)
+                && non_negative(f.deadband)
+                && f.deadband < f.band)
+        {
             return Err(ConfigError::Friction);
         }
         Ok(())
+    }
+
+    /// Every f32 of the configuration, set to each of the values where float and bit
+    /// comparisons could part (zeros of both signs, NaN of both signs, infinities,
+    /// subnormals, the extremes), alone and paired with each other f32 compared with
+    /// it, from the defaults under both kinds of thresholds: the same answer as the
+    /// float comparisons.
+    #[test]
+    fn validate_compares_as_floats_do() {
+        let edges = [
+            0.0,
+            -0.0,
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::from_bits(1),
+            -f32::from_bits(1),
+            f32::MIN_POSITIVE,
+            f32::MAX,
+            f32::MIN,
+            0.05,
+            0.8,
+            1.0,
+            -1.0,
+            2e3,
+        ];
+        type Set = fn(&mut Config, f32);
+        fn thresholds(c: &mut Config, i: usize, x: f32) {
+            let (Thresholds::SlipRatio {
+                warning,
+                alarm,
+                deadband,
+            }
+            | Thresholds::Margin {
+                warning,
+                alarm,
+                deadband,
+            }) = &mut c.thresholds;
+            *[warning, alarm, deadband].into_iter().nth(i).unwrap() = x;
+        }
+        let fields: [Set; 21] = [
+            |c, x| thresholds(c, 0, x),
+            |c, x| thresholds(c, 1, x),
+            |c, x| thresholds(c, 2, x),
+            |c, x| c.stop_load = x,
+            |c, x| c.stop_speed = x,
+            |c, x| c.nominal_speed = x,
+            |c, x| c.load_min = x,
+            |c, x| c.load_max = x,
+            |c, x| c.angle_max = x,
+            |c, x| c.speed_max = x,
+            |c, x| c.force_max = x,
+            |c, x| c.smoothing_tau_s = x,
+            |c, x| c.spikes.as_mut().unwrap().k = x,
+            |c, x| c.spikes.as_mut().unwrap().load_floor = x,
+            |c, x| c.spikes.as_mut().unwrap().angle_floor = x,
+            |c, x| c.trend.as_mut().unwrap().horizon_s = x,
+            |c, x| c.friction.as_mut().unwrap().sensitivity_max = x,
+            |c, x| c.friction.as_mut().unwrap().tau_s = x,
+            |c, x| c.friction.as_mut().unwrap().band = x,
+            |c, x| c.friction.as_mut().unwrap().deadband = x,
+            |c, _| c.friction = None,
+        ];
+        // The fields compared with each other (indices into `fields`).
+        let pairs = [(0, 1), (0, 2), (3, 7), (6, 7), (18, 19)];
+        let d = Config {
+            friction: Some(FrictionConfig::default()),
+            ..Config::default()
+        };
+        let margin = Config {
+            thresholds: Thresholds::Margin {
+                warning: 1e-4,
+                alarm: 0.0,
+                deadband: 1e-5,
+            },
+            ..d
+        };
+        let mut checked = 0;
+        for base in [d, margin] {
+            assert_eq!(base.validate(), Ok(()));
+            for set in fields {
+                for x in edges {
+                    let mut c = base;
+                    set(&mut c, x);
+                    assert_eq!(c.validate(), validate_by_floats(&c), "{c:?}");
+                    checked += 1;
+                }
+            }
+            for (i, j) in pairs {
+                for x in edges {
+                    for y in edges {
+                        let mut c = base;
+                        fields[i](&mut c, x);
+                        fields[j](&mut c, y);
+                        assert_eq!(c.validate(), validate_by_floats(&c), "{c:?}");
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 2 * (21 + 5 * 16) * 16);
     }
 }
