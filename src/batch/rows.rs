@@ -143,15 +143,36 @@ fn core_flags(phi: f64, critical_angle: Option<f64>, near_model_switch: bool) ->
     bits
 }
 
-/// The reference's answer for one row, and its further numbers.
+/// The reference's answer for one row, and its further numbers: by the reference's
+/// fast path where it answers and no details are wanted, else by the reference.
 #[inline]
 fn reference_row(
     scene: &Scene,
+    fast: Option<&reference::fast::Prepared>,
+    details: bool,
     load: f64,
     phi: f64,
     choice: ModelChoice,
 ) -> Result<(Row, [f64; 12]), Error> {
-    let est = reference::estimate_with(scene, load, phi, choice)?;
+    use reference::fast::Answer;
+    let answer = fast
+        .filter(|_| !details)
+        .and_then(|f| f.estimate(load, phi));
+    let est = match answer {
+        Some(Answer::Elliptic(e)) => {
+            let row = Row {
+                slip_ratio: e.slip_ratio,
+                axial_force: e.axial_force,
+                critical_angle: Some(e.critical_angle),
+                regime: e.regime,
+                model: ContactModel::Elliptic,
+                flags: flag_bits(&e.validity, false),
+            };
+            return Ok((row, NO_DETAILS));
+        }
+        Some(Answer::Line(l)) => reference::Solution::Line(l),
+        None => reference::estimate_with(scene, load, phi, choice)?,
+    };
     let force = est.axial_force(scene);
     Ok(match est {
         reference::Solution::Elliptic(e) => (
@@ -206,15 +227,22 @@ fn reference_row(
 }
 
 pub(super) fn reference(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) -> usize {
+    let details = out.details.is_some();
+    let prepare = |s: &Scene| Ok((*s, reference::fast::Prepared::new(s, inputs.choice)));
+    let mut cache = Cache::new();
     let mut bad = 0;
-    let one = inputs.one_scene_for_all().then(|| inputs.scene(0));
     for i in 0..n {
-        let scene = match &one {
-            Some(s) => *s,
-            None => inputs.scene(i),
+        let answer = match cache.get(inputs, i, prepare) {
+            Ok((scene, fast)) => reference_row(
+                scene,
+                fast.as_ref(),
+                details,
+                inputs.load.at(i),
+                inputs.phi.at(i),
+                inputs.choice,
+            ),
+            Err(e) => Err(*e),
         };
-        let answer = scene
-            .and_then(|s| reference_row(&s, inputs.load.at(i), inputs.phi.at(i), inputs.choice));
         bad += match answer {
             Ok((row, details)) => put(out, i, Ok(row), &details),
             Err(e) => put(out, i, Err(e), &NO_DETAILS),

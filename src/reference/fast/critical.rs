@@ -1,0 +1,28 @@
+//! theta0 where `g(theta) = m n theta` takes a given value (eq 18 with d/b = 1: the
+//! critical angle), from `g^3`: a seed from
+//! [`KPRIME_SQUARED_OF_G_CUBED`](super::seeds::KPRIME_SQUARED_OF_G_CUBED), one evaluation
+//! ([`Point`](super::point::Point)) and one Newton step in `ln k'` on
+//! `ln(g(k')^3 / g^3) / 3`, theta carried over the step to first order.
+//!
+//! Domain: `g^3` in the table's range (theta0 from about 2^-40 to 2^-3; outside,
+//! `None`: the reference answers). Error: theta0 within 6 ulps of the reference
+//! (tests/data/vectors_mn.csv); the step's own error below 1e-18. Cost: one seed, one
+//! point, a square root, two divisions.
+
+use super::point::{Point, STEP_MAX, U_MAX, ln_near_one};
+use super::seeds::KPRIME_SQUARED_OF_G_CUBED;
+
+/// theta0 (rad) with `g(theta0)^3 = g_cubed`, in the domain, else `None`.
+#[inline(always)]
+pub fn theta_of_g_cubed(g_cubed: f64) -> Option<f64> {
+    let p = KPRIME_SQUARED_OF_G_CUBED.eval(g_cubed)?;
+    let at = Point::at(libm::sqrt(p), p);
+    let theta = at.theta;
+    let g3 = at.mn_cubed * (theta * theta * theta);
+    let u = g3 / g_cubed - 1.0;
+    let dw = -ln_near_one(u) / (3.0 * (at.mn_slope + at.theta_slope));
+    if !(libm::fabs(u) < U_MAX && libm::fabs(dw) < STEP_MAX) {
+        return None;
+    }
+    Some(theta + theta * (at.theta_slope * dw))
+}
