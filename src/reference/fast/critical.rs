@@ -5,9 +5,9 @@
 //! `ln(g(k')^3 / g^3) / 3`, theta carried over the step to first order.
 //!
 //! Domain: `g^3` in the table's range (theta0 from about 2^-40 to 2^-3; outside,
-//! `None`: the reference answers). Error: theta0 within 6 ulps of the reference
-//! (tests/data/vectors_mn.csv); the step's own error below 1e-18. Cost: one seed, one
-//! point, a square root, two divisions.
+//! `None`: the reference answers). Error: theta0 within 6 ulps of the 50-digit values
+//! (tests/reference_fast.rs); the step's own error below 1e-18. Cost: one seed, a
+//! square root, one point, one division.
 
 use super::point::{Point, STEP_MAX, U_MAX, ln_near_one};
 use super::seeds::KPRIME_SQUARED_OF_G_CUBED;
@@ -19,10 +19,17 @@ pub fn theta_of_g_cubed(g_cubed: f64) -> Option<f64> {
     let at = Point::at(libm::sqrt(p), p);
     let theta = at.theta;
     let g3 = at.mn_cubed * (theta * theta * theta);
-    let u = g3 / g_cubed - 1.0;
-    let dw = -ln_near_one(u) / (3.0 * (at.mn_slope + at.theta_slope));
+    // d ln g / dw = theta_num/theta_den + mn_num/mn_den = num / den; u = g3/g_cubed - 1,
+    // the step -ln(1 + u) / (3 num/den) and theta's change over it by one division.
+    let num = at.theta_num * at.mn_den + at.mn_num * at.theta_den;
+    let den = at.theta_den * at.mn_den;
+    let z = 1.0 / (g_cubed * num);
+    let u = (g3 - g_cubed) * num * z;
+    let step = -ln_near_one(u) * g_cubed * z * (1.0 / 3.0);
+    let dw = step * den;
     if !(libm::fabs(u) < U_MAX && libm::fabs(dw) < STEP_MAX) {
         return None;
     }
-    Some(theta + theta * (at.theta_slope * dw))
+    // d ln theta = (theta_num / theta_den) dw = theta_num mn_den step.
+    Some(theta + theta * (at.theta_num * at.mn_den * step))
 }

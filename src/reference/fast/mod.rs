@@ -53,8 +53,11 @@ const DECISION_GUARD: f64 = 1e-12;
 pub struct Prepared {
     scene: Scene,
     choice: ModelChoice,
-    /// c of eq (4), theta = c |phi|.
+    /// c of eq (4), theta = c |phi|, and 1/c.
     c: f64,
+    inverse_c: f64,
+    /// `2 mu PRESSURE_LIMIT`: p0 / G above the limit where |phi| > this d/b.
+    pressure_per_slip: f64,
     /// `(pi G v^2 / (3 mu))^3`: `(d/b)^3 = this (m n)^3 |phi|^3 / P` (eq 15).
     slip_cubed: f64,
     /// `(c 3 mu / pi)^3 / (G h^2 R^2)`, h = 1.5 (1 - nu): `g(theta0)^3 = this P` (eqs
@@ -119,11 +122,14 @@ impl Prepared {
             scene: *scene,
             choice,
             c,
+            inverse_c: 1.0 / c,
+            pressure_per_slip: 2.0 * mu * PRESSURE_LIMIT,
             slip_cubed: slip * slip * slip,
             g_cubed_per_load: chain(&[c, c, c, k, k, k], &[g, h, h, r, r]),
             ratio_cubed_per_load: scene.length().map(|l| chain(&[8.0, v, v, v], &[l, l, l])),
         };
         let normal = c.is_normal()
+            && prepared.inverse_c.is_normal()
             && prepared.slip_cubed.is_normal()
             && prepared.g_cubed_per_load.is_normal()
             && prepared.ratio_cubed_per_load.is_none_or(f64::is_normal);
@@ -152,13 +158,14 @@ impl Prepared {
         }
         let s = libm::cbrt(s3);
         let theta0 = theta_of_g_cubed(self.g_cubed_per_load * load)?;
-        let phi0 = theta0 / self.c;
-        // p0 = 3 P^(1/3) / (2 pi m n v^2), so p0 / G = |phi| / (2 mu (d/b)) (eq 15).
-        let pressure = abs_phi / (2.0 * self.scene.friction() * s);
+        let phi0 = theta0 * self.inverse_c;
+        // p0 = 3 P^(1/3) / (2 pi m n v^2), so p0 / G = |phi| / (2 mu (d/b)) (eq 15):
+        // p0 / G > PRESSURE_LIMIT where |phi| > PRESSURE_LIMIT 2 mu (d/b).
+        let pressure = self.pressure_per_slip * s;
         if !(phi0 <= FRAC_PI_2
             && clear_of(s, 1.0)
             && clear_of(phi0, ANGLE_LIMIT)
-            && clear_of(pressure, PRESSURE_LIMIT)
+            && clear_of(abs_phi, pressure)
             && clear_of(shape.kprime * SLENDER_LIMIT, 1.0))
         {
             return None;
@@ -166,7 +173,7 @@ impl Prepared {
         let (longer, near) = match self.ratio_cubed_per_load {
             None => (false, false),
             Some(k) => {
-                let r3 = k * shape.m_cubed * load;
+                let r3 = k * shape.m_cubed() * load;
                 let (lo, hi) = (1.0 / MODEL_SWITCH_BAND, MODEL_SWITCH_BAND);
                 let (lo3, hi3) = (lo * lo * lo, hi * hi * hi);
                 if !(r3.is_normal() && clear_of(r3, 1.0) && clear_of(r3, lo3) && clear_of(r3, hi3))
@@ -191,7 +198,7 @@ impl Prepared {
             regime: Regime::of(s),
             validity: Validity {
                 large_angle: abs_phi > ANGLE_LIMIT || phi0 > ANGLE_LIMIT,
-                high_pressure: pressure > PRESSURE_LIMIT,
+                high_pressure: abs_phi > pressure,
                 longer_than_rollers: longer,
                 near_model_switch: near,
                 round_ellipse: shape.kprime * SLENDER_LIMIT > 1.0,

@@ -4,10 +4,10 @@
 //! the results carried over the step to first order.
 //!
 //! Domain: theta in [2^-40, 2^-3) (outside, `None`: the reference answers). Error: k'
-//! and `m n` within 6 ulps of the reference's values (tests/data/vectors_mn.csv: the
-//! 50-digit ones); the step's own error is below 1e-18 (`None` where a seed misses by
-//! more than [`STEP_MAX`](super::point::STEP_MAX), which the tables never do).
-//! Cost: one seed (a table segment, degree 6), one point, two divisions.
+//! and `m n` within 6 ulps of the 50-digit values (tests/reference_fast.rs over
+//! tests/data/vectors_mn.csv); the step's own error is below 1e-18 (`None` where a seed
+//! misses by more than [`STEP_MAX`](super::point::STEP_MAX), which the tables never do).
+//! Cost: one seed (a table segment, degree 6), one point, one division.
 
 use super::point::{Point, STEP_MAX, U_MAX, ln_near_one};
 use super::seeds::KPRIME_OF_THETA;
@@ -19,8 +19,17 @@ pub struct Shape {
     pub kprime: f64,
     /// `(m n)^3`.
     pub mn_cubed: f64,
-    /// `m^3`.
-    pub m_cubed: f64,
+    /// The point evaluated and the step from it, for [`Shape::m_cubed`].
+    at: Point,
+    dw: f64,
+}
+
+impl Shape {
+    /// `m^3` (one division more).
+    #[inline(always)]
+    pub fn m_cubed(&self) -> f64 {
+        self.at.m_cubed(self.dw)
+    }
 }
 
 /// The shape at theta in the domain, else `None`.
@@ -28,15 +37,17 @@ pub struct Shape {
 pub fn shape(theta: f64) -> Option<Shape> {
     let seed = KPRIME_OF_THETA.eval(theta)?;
     let at = Point::at(seed, seed * seed);
-    let u = at.theta / theta - 1.0;
-    let dw = -ln_near_one(u) / at.theta_slope;
+    // u = theta(k')/theta - 1 and the step -ln(1 + u) / (d ln theta / dw) by one division.
+    let z = 1.0 / (theta * at.theta_num);
+    let u = (at.theta - theta) * at.theta_num * z;
+    let dw = -ln_near_one(u) * at.theta_den * theta * z;
     if !(libm::fabs(u) < U_MAX && libm::fabs(dw) < STEP_MAX) {
         return None;
     }
-    // ln m = (ln(m n) - w) / 2.
     Some(Shape {
         kprime: seed + seed * (dw + 0.5 * dw * dw),
-        mn_cubed: at.mn_cubed * (1.0 + 3.0 * at.mn_slope * dw),
-        m_cubed: at.m_cubed * (1.0 + 1.5 * (at.mn_slope - 1.0) * dw),
+        mn_cubed: at.mn_cubed + at.mn_cubed_slope * dw,
+        at,
+        dw,
     })
 }
