@@ -8,10 +8,7 @@ mod carlson;
 mod chain;
 #[cfg(test)]
 mod cost;
-internal! {
-    /// The reference's answer at a fraction of its cost, for the batch.
-    mod fast;
-}
+pub mod fast;
 pub mod inverse;
 pub mod line;
 pub mod normal;

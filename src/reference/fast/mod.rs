@@ -1,16 +1,18 @@
 //! The reference's answer at a fraction of its cost, for the batch: the same equations
-//! to the same exactness (at most a few ulps from the reference, which is itself within
+//! to the same exactness (within a few ulps of the reference, which is itself within
 //! 1.1e-15 of the 50-digit data), over the practical domain, the reference itself
 //! answering every other row.
 //!
 //! Where the reference solves for k' from a generic seed (several Newton steps, each a
 //! Carlson R_D pair of about 15 square roots), this path starts from an f64 table good
-//! to 1e-9 ([`seeds`], fitted to the reference by `cargo xtask tables`) and takes one
-//! Newton step, with K - E and E - k'^2 K from their series about k' = 0 ([`series`],
-//! exact below k' = 0.032) and theta from a short atan series ([`atan`]); the step's
-//! own error is below 1e-18 ([`point`]). The shape at theta is [`shape`], theta0 at a
-//! load [`critical`]; d/b comes from `(d/b)^3` with one cube root, and phi0 from
-//! `g(theta0)^3 = (c target)^3`, proportional to P, without one.
+//! to 1e-9 (seeds.rs, fitted to the reference by `cargo xtask tables`; its format in
+//! table.rs) and takes one Newton step, with K - E and E - k'^2 K from their series
+//! about k' = 0 (series.rs, exact up to k' = 0.032) and theta from a short atan series
+//! (atan.rs); the step's own error is below 1e-18 (point.rs). The shape at theta is
+//! shape.rs, theta0 at a load critical.rs; d/b comes from `(d/b)^3` with one cube root,
+//! phi0 from `g(theta0)^3 = (c target)^3`, proportional to P, without one. Each file
+//! states its error bound and cost; each is tested against the reference or the
+//! 50-digit data.
 //!
 //! Domain: theta and theta0 in [2^-40, 2^-3) (k' below 0.032), the scene's theta
 //! relation eq (4) (small angle), an elliptic or section-9 model choice; every
@@ -20,21 +22,33 @@
 //! [`Prepared::estimate`] answer `None` and the caller asks the reference.
 //!
 //! Error: d/b, F and phi0 within 8 ulps of the reference (tests/reference_fast.rs, over
-//! the 50-digit data and a million random rows); regime, model and flags equal to its.
-//! Cost: `reference_cost` in the Python package prints it (docs/measurements-python.md).
+//! the 50-digit data, 200 000 benchmark rows and 200 000 random scenes); regime, model
+//! and flags the reference's. Cost: about a sixth of the reference's per row
+//! (`misalign._misalign.reference_cost` in the Python package prints both).
 
 mod atan;
 mod critical;
 mod point;
-#[rustfmt::skip]
-pub mod seeds;
 mod series;
 mod shape;
-pub mod table;
+internal! {
+    /// The generated seed tables.
+    #[rustfmt::skip]
+    mod seeds;
+}
+internal! {
+    /// The seed tables' format.
+    mod table;
+}
 
+#[cfg(feature = "_internals")]
+#[doc(hidden)]
 pub use critical::theta_of_g_cubed;
+#[cfg(feature = "_internals")]
+#[doc(hidden)]
 pub use shape::{Shape, shape};
-
+#[cfg(not(feature = "_internals"))]
+use {critical::theta_of_g_cubed, shape::shape};
 
 use super::chain::chain;
 use super::{

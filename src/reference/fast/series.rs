@@ -55,7 +55,11 @@ const fn coefficients() -> [[f64; TERMS]; 4] {
     while j < TERMS {
         out[0][j] = kl[j] - el[j];
         out[1][j] = k0[j] - e0[j];
-        let (kl_prev, k0_prev) = if j == 0 { (0.0, 0.0) } else { (kl[j - 1], k0[j - 1]) };
+        let (kl_prev, k0_prev) = if j == 0 {
+            (0.0, 0.0)
+        } else {
+            (kl[j - 1], k0[j - 1])
+        };
         out[2][j] = el[j] - kl_prev;
         out[3][j] = e0[j] - k0_prev;
         j += 1;
