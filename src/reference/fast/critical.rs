@@ -13,10 +13,26 @@ use super::point::{Point, STEP_MAX, U_MAX, ln_near_one};
 use super::seeds::KPRIME_SQUARED_OF_G_CUBED;
 
 /// theta0 (rad) with `g(theta0)^3 = g_cubed`, in the domain, else `None`.
+#[cfg(any(test, feature = "_internals"))]
 #[inline(always)]
 pub fn theta_of_g_cubed(g_cubed: f64) -> Option<f64> {
-    let p = KPRIME_SQUARED_OF_G_CUBED.eval(g_cubed)?;
-    let at = Point::at(libm::sqrt(p), p);
+    let [t] = thetas_of_g_cubed(&[g_cubed]);
+    t
+}
+
+/// [`theta_of_g_cubed`] of N values, each stage for all of them before the next.
+#[inline(always)]
+pub fn thetas_of_g_cubed<const N: usize>(g_cubed: &[f64; N]) -> [Option<f64>; N] {
+    let seeds: [Option<f64>; N] =
+        core::array::from_fn(|i| KPRIME_SQUARED_OF_G_CUBED.eval(g_cubed[i]));
+    let points: [Option<Point>; N] =
+        core::array::from_fn(|i| seeds[i].map(|p| Point::at(libm::sqrt(p), p)));
+    core::array::from_fn(|i| step(g_cubed[i], points[i]?))
+}
+
+/// The Newton step from the seed's point.
+#[inline(always)]
+fn step(g_cubed: f64, at: Point) -> Option<f64> {
     let theta = at.theta;
     let g3 = at.mn_cubed * (theta * theta * theta);
     // d ln g / dw = theta_num/theta_den + mn_num/mn_den = num / den; u = g3/g_cubed - 1,

@@ -33,10 +33,26 @@ impl Shape {
 }
 
 /// The shape at theta in the domain, else `None`.
+#[cfg(any(test, feature = "_internals"))]
 #[inline(always)]
 pub fn shape(theta: f64) -> Option<Shape> {
-    let seed = KPRIME_OF_THETA.eval(theta)?;
-    let at = Point::at(seed, seed * seed);
+    let [s] = shapes(&[theta]);
+    s
+}
+
+/// [`shape`] of N angles, each stage for all of them before the next (their latency
+/// chains side by side).
+#[inline(always)]
+pub fn shapes<const N: usize>(theta: &[f64; N]) -> [Option<Shape>; N] {
+    let seeds: [Option<f64>; N] = core::array::from_fn(|i| KPRIME_OF_THETA.eval(theta[i]));
+    let points: [Option<Point>; N] =
+        core::array::from_fn(|i| seeds[i].map(|k| Point::at(k, k * k)));
+    core::array::from_fn(|i| step(theta[i], seeds[i]?, points[i]?))
+}
+
+/// The Newton step from the seed's point.
+#[inline(always)]
+fn step(theta: f64, seed: f64, at: Point) -> Option<Shape> {
     // u = theta(k')/theta - 1 and the step -ln(1 + u) / (d ln theta / dw) by one division.
     let z = 1.0 / (theta * at.theta_num);
     let u = (at.theta - theta) * at.theta_num * z;
