@@ -161,3 +161,33 @@ fn fast_path_is_the_reference_on_random_rows() {
     assert!(Prepared::new(&exact, ModelChoice::Section9).is_none());
     assert!(Prepared::new(&demo, ModelChoice::Line).is_none());
 }
+
+/// Eight rows at a time (the batch's way) give the numbers of one at a time, bit for
+/// bit, including rows the fast path leaves to the reference.
+#[test]
+fn rows_at_a_time_are_rows_one_at_a_time() {
+    let mut rng = Rng(11);
+    let scene = Scene::new(0.05, 0.08, 79.3e9, 0.3, 0.3)
+        .unwrap()
+        .with_length(0.1)
+        .unwrap();
+    let fast = Prepared::new(&scene, ModelChoice::Section9).unwrap();
+    for _ in 0..20_000 {
+        let load: [f64; 8] = core::array::from_fn(|_| rng.log_uniform(1e-3, 1e6));
+        let phi: [f64; 8] = core::array::from_fn(|i| match i {
+            0 => f64::NAN,
+            1 => -rng.log_uniform(1e-14, 1.0),
+            _ => rng.log_uniform(1e-9, 0.3),
+        });
+        let many = fast.estimate_rows(&load, &phi);
+        for i in 0..8 {
+            assert_eq!(
+                many[i],
+                fast.estimate(load[i], phi[i]),
+                "P={} phi={}",
+                load[i],
+                phi[i]
+            );
+        }
+    }
+}
