@@ -21,10 +21,11 @@
 //! length), so that every decision is the reference's. Elsewhere [`Prepared::new`] or
 //! [`Prepared::estimate`] answer `None` and the caller asks the reference.
 //!
-//! Error: d/b, F and phi0 within 8 ulps of the reference (tests/reference_fast.rs, over
-//! the 50-digit data, 200 000 benchmark rows and 200 000 random scenes); regime, model
-//! and flags the reference's. Cost: about a sixth of the reference's per row
-//! (`misalign._misalign.reference_cost` in the Python package prints both).
+//! Error: d/b, F and phi0 within 3e-15 of the reference (asserted by
+//! tests/reference_fast.rs over the 50-digit data, 200 000 benchmark rows and 200 000
+//! random scenes); regime, model and flags the reference's. Cost:
+//! `misalign._misalign.reference_cost` in the Python package times it beside the
+//! reference's pieces (docs/measurements-python.md).
 
 mod atan;
 mod critical;
@@ -162,7 +163,7 @@ impl Prepared {
 
     /// [`Prepared::estimate`] of N rows, each stage for all of them before the next, so
     /// that their latency chains (logarithm, series, divisions, cube root) run side by
-    /// side: the same numbers, bit for bit, in four fifths of the time a row at N = 8.
+    /// side: the same numbers, bit for bit, in less time a row.
     #[inline]
     pub fn estimate_rows<const N: usize>(
         &self,

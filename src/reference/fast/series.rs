@@ -13,9 +13,10 @@
 //!
 //! Error: for `k' <= KPRIME_MAX` (p <= 1.03e-3) the first term left out is below 2e-21 of
 //! either sum; below `p = SHORT_BELOW` (k' < 0.0039) the series stops after `k'^6`,
-//! its first term left out below 2e-19 of either sum; the evaluation rounds each to within 2 ulps given `ln(1/k')` (tested
-//! against Carlson's R_D, whose own error is a few ulps). Cost: four Horner chains of
-//! degree 6 (3 below `SHORT_BELOW`) run side by side, no division.
+//! its first term left out below 2e-19 of either sum; the evaluation rounds each to
+//! within 6 ulps of Carlson's R_D given `ln(1/k')` (asserted below; R_D's own error is
+//! a few ulps). Cost: four Horner chains of degree 6 (3 below `SHORT_BELOW`) run side
+//! by side, no division.
 
 /// Largest `k'` the truncated series is exact for (to below 2e-21 relative).
 #[cfg(test)]
