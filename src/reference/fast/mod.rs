@@ -9,8 +9,9 @@
 //! table.rs) and takes one Newton step, with K - E and E - k'^2 K from their series
 //! about k' = 0 (series.rs, exact up to k' = 0.032) and theta from a short atan series
 //! (atan.rs); the step's own error is below 1e-18 (point.rs). The shape at theta is
-//! shape.rs, theta0 at a load critical.rs; d/b comes from `(d/b)^3` with one cube root,
-//! phi0 from `g(theta0)^3 = (c target)^3`, proportional to P, without one. Each file
+//! shape.rs, theta0 at a load critical.rs; d/b comes from `(d/b)^3` by a cube root
+//! without a division (cbrt.rs), phi0 from `g(theta0)^3 = (c target)^3`, proportional
+//! to P, with no cube root. Each file
 //! states its error bound and cost; each is tested against the reference or the
 //! 50-digit data.
 //!
@@ -28,6 +29,7 @@
 //! reference's pieces (docs/measurements-python.md).
 
 mod atan;
+mod cbrt;
 mod critical;
 mod point;
 mod series;
@@ -196,7 +198,7 @@ impl Prepared {
         if !(x.is_normal() && y.is_normal() && s3.is_normal()) {
             return None;
         }
-        let s = libm::cbrt(s3);
+        let s = cbrt::cbrt(s3);
         let phi0 = theta0 * self.inverse_c;
         // p0 = 3 P^(1/3) / (2 pi m n v^2), so p0 / G = |phi| / (2 mu (d/b)) (eq 15):
         // p0 / G > PRESSURE_LIMIT where |phi| > PRESSURE_LIMIT 2 mu (d/b).
