@@ -9,6 +9,7 @@
 //! (asserted by tests/reference_fast.rs); the step's own error below 1e-18. Cost: one
 //! seed, a square root, one point, one division.
 
+use super::each;
 use super::point::{Point, STEP_MAX, U_MAX, ln_near_one};
 use super::seeds::KPRIME_SQUARED_OF_G_CUBED;
 
@@ -23,11 +24,9 @@ pub fn theta_of_g_cubed(g_cubed: f64) -> Option<f64> {
 /// [`theta_of_g_cubed`] of N values, each stage for all of them before the next.
 #[inline(always)]
 pub fn thetas_of_g_cubed<const N: usize>(g_cubed: &[f64; N]) -> [Option<f64>; N] {
-    let seeds: [Option<f64>; N] =
-        core::array::from_fn(|i| KPRIME_SQUARED_OF_G_CUBED.eval(g_cubed[i]));
-    let points: [Option<Point>; N] =
-        core::array::from_fn(|i| seeds[i].map(|p| Point::at(libm::sqrt(p), p)));
-    core::array::from_fn(|i| step(g_cubed[i], points[i]?))
+    let seeds: [Option<f64>; N] = each(|i| KPRIME_SQUARED_OF_G_CUBED.eval(g_cubed[i]));
+    let points: [Option<Point>; N] = each(|i| seeds[i].map(|p| Point::at(libm::sqrt(p), p)));
+    each(|i| step(g_cubed[i], points[i]?))
 }
 
 /// The Newton step from the seed's point.

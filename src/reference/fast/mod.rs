@@ -113,6 +113,17 @@ pub struct Elliptic {
     pub validity: Validity,
 }
 
+/// `[f(0), .., f(N - 1)]` by a plain loop, which inlines `f` (`core::array::from_fn`
+/// left the stages' closures as calls, one a row).
+#[inline(always)]
+fn each<T: Copy + Default, const N: usize>(mut f: impl FnMut(usize) -> T) -> [T; N] {
+    let mut out = [T::default(); N];
+    for (i, x) in out.iter_mut().enumerate() {
+        *x = f(i);
+    }
+    out
+}
+
 /// `x` is not within [`DECISION_GUARD`] of `limit`.
 #[inline(always)]
 fn clear_of(x: f64, limit: f64) -> bool {
@@ -173,7 +184,7 @@ impl Prepared {
         phi: &[f64; N],
     ) -> [Option<Answer>; N] {
         // Refused input (the reference's errors) and the table's misses alike: None.
-        let theta: [f64; N] = core::array::from_fn(|i| {
+        let theta: [f64; N] = each(|i| {
             let abs_phi = libm::fabs(phi[i]);
             if load[i] > 0.0 && load[i] < f64::INFINITY && abs_phi <= FRAC_PI_2 {
                 self.c * abs_phi
@@ -182,9 +193,9 @@ impl Prepared {
             }
         });
         let shapes = shapes(&theta);
-        let g_cubed: [f64; N] = core::array::from_fn(|i| self.g_cubed_per_load * load[i]);
+        let g_cubed: [f64; N] = each(|i| self.g_cubed_per_load * load[i]);
         let theta0 = thetas_of_g_cubed(&g_cubed);
-        core::array::from_fn(|i| self.finish(load[i], phi[i], shapes[i]?, theta0[i]?))
+        each(|i| self.finish(load[i], phi[i], shapes[i]?, theta0[i]?))
     }
 
     /// The row's answer from its shape and theta0.

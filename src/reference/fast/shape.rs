@@ -9,6 +9,7 @@
 //! misses by more than [`STEP_MAX`](super::point::STEP_MAX), which the tables never do).
 //! Cost: one seed (a table segment, degree 6), one point, one division.
 
+use super::each;
 use super::point::{Point, STEP_MAX, U_MAX, ln_near_one};
 use super::seeds::KPRIME_OF_THETA;
 
@@ -44,10 +45,9 @@ pub fn shape(theta: f64) -> Option<Shape> {
 /// chains side by side).
 #[inline(always)]
 pub fn shapes<const N: usize>(theta: &[f64; N]) -> [Option<Shape>; N] {
-    let seeds: [Option<f64>; N] = core::array::from_fn(|i| KPRIME_OF_THETA.eval(theta[i]));
-    let points: [Option<Point>; N] =
-        core::array::from_fn(|i| seeds[i].map(|k| Point::at(k, k * k)));
-    core::array::from_fn(|i| step(theta[i], seeds[i]?, points[i]?))
+    let seeds: [Option<f64>; N] = each(|i| KPRIME_OF_THETA.eval(theta[i]));
+    let points: [Option<Point>; N] = each(|i| seeds[i].map(|k| Point::at(k, k * k)));
+    each(|i| step(theta[i], seeds[i]?, points[i]?))
 }
 
 /// The Newton step from the seed's point.
