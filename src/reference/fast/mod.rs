@@ -7,7 +7,8 @@
 //! Carlson R_D pair of about 15 square roots), this path starts from an f64 table good
 //! to 1e-9 (seeds.rs, fitted to the reference by `cargo xtask tables`; its format in
 //! table.rs) and takes one Newton step, with K - E and E - k'^2 K from their series
-//! about k' = 0 (series.rs, exact up to k' = 0.032) and theta from a short atan series
+//! about k' = 0 (series.rs, exact up to k' = 0.032; their ln k' from a table made at
+//! compile time, ln.rs) and theta from a short atan series
 //! (atan.rs); the step's own error is below 1e-18 (point.rs). The shape at theta is
 //! shape.rs, theta0 at a load critical.rs; d/b comes from `(d/b)^3` by a cube root
 //! without a division (cbrt.rs), phi0 from `g(theta0)^3 = (c target)^3`, proportional
@@ -31,6 +32,7 @@
 mod atan;
 mod cbrt;
 mod critical;
+mod ln;
 mod point;
 mod series;
 mod shape;

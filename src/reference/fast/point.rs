@@ -15,10 +15,11 @@
 //! (`m^3` is eq 5 with `sin^2(theta/2) = pA / (pA + B)`.) The slopes are kept as
 //! fractions, so that a Newton step and what it carries cost one division.
 //! Error: theta and `(m n)^3` a few roundings from exact given the point (the series,
-//! one logarithm, a square root and a few products); the slopes to 1e-15, far more than a step of 1e-9
+//! one logarithm (ln.rs), a square root and a few products); the slopes to 1e-15, far more than a step of 1e-9
 //! needs. Cost: one logarithm, the series, one square root, two divisions.
 
 use super::atan::atan_ratio;
+use super::ln::ln;
 use super::series::differences;
 use core::f64::consts::PI;
 
@@ -50,7 +51,7 @@ impl Point {
     #[inline(always)]
     pub fn at(kprime: f64, p: f64) -> Point {
         let k2 = 1.0 - p;
-        let (a, b) = differences(p, -0.5 * libm::log(p));
+        let (a, b) = differences(p, -0.5 * ln(p));
         let pa = p * a;
         let t2 = pa / b;
         let r = atan_ratio(t2);
