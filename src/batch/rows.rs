@@ -143,6 +143,35 @@ fn core_flags(phi: f64, critical_angle: Option<f64>, near_model_switch: bool) ->
     bits
 }
 
+/// The fast path's elliptic answer as a row.
+#[inline(always)]
+fn fast_row(e: &reference::fast::Elliptic) -> Row {
+    Row {
+        slip_ratio: e.slip_ratio,
+        axial_force: e.axial_force,
+        critical_angle: Some(e.critical_angle),
+        regime: e.regime,
+        model: ContactModel::Elliptic,
+        flags: flag_bits(&e.validity, false),
+    }
+}
+
+/// A row the fast path left to the reference (or answered with line contact), out of
+/// the eight-row loop.
+#[cold]
+#[inline(never)]
+fn other_row(
+    out: &mut Outputs<'_>,
+    i: usize,
+    scene: &Scene,
+    answer: Option<reference::fast::Answer>,
+    load: f64,
+    phi: f64,
+    choice: ModelChoice,
+) -> usize {
+    put_reference(out, i, reference_row(scene, answer, load, phi, choice))
+}
+
 /// The reference's answer for one row, and its further numbers: the fast path's
 /// `answer` where it has one, else the reference's.
 #[inline]
@@ -155,17 +184,7 @@ fn reference_row(
 ) -> Result<(Row, [f64; 12]), Error> {
     use reference::fast::Answer;
     let est = match answer {
-        Some(Answer::Elliptic(e)) => {
-            let row = Row {
-                slip_ratio: e.slip_ratio,
-                axial_force: e.axial_force,
-                critical_angle: Some(e.critical_angle),
-                regime: e.regime,
-                model: ContactModel::Elliptic,
-                flags: flag_bits(&e.validity, false),
-            };
-            return Ok((row, NO_DETAILS));
-        }
+        Some(Answer::Elliptic(e)) => return Ok((fast_row(&e), NO_DETAILS)),
         Some(Answer::Line(l)) => reference::Solution::Line(l),
         None => reference::estimate_with(scene, load, phi, choice)?,
     };
@@ -254,8 +273,21 @@ pub(super) fn reference(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) ->
             let phi: [f64; LANES] = core::array::from_fn(|k| inputs.phi.at(start + k));
             let answers = fast.estimate_rows(&load, &phi);
             for (k, answer) in answers.into_iter().enumerate() {
-                let row = reference_row(&scene, answer, load[k], phi[k], inputs.choice);
-                bad += put_reference(out, start + k, row);
+                bad += match answer {
+                    // The ellipse's rows (most) straight into the columns.
+                    Some(reference::fast::Answer::Elliptic(e)) => {
+                        put(out, start + k, Ok(fast_row(&e)), &NO_DETAILS)
+                    }
+                    _ => other_row(
+                        out,
+                        start + k,
+                        &scene,
+                        answer,
+                        load[k],
+                        phi[k],
+                        inputs.choice,
+                    ),
+                };
             }
             start += LANES;
         }
