@@ -15,8 +15,9 @@
 //! (`m^3` is eq 5 with `sin^2(theta/2) = pA / (pA + B)`.) The slopes are kept as
 //! fractions, so that a Newton step and what it carries cost one division.
 //! Error: theta and `(m n)^3` a few roundings from exact given the point (the series,
-//! one logarithm (ln.rs), a square root and a few products); the slopes to 1e-15, far more than a step of 1e-9
-//! needs. Cost: one logarithm, the series, one square root, two divisions.
+//! one logarithm (ln.rs), a square root and a few products); the slopes to 1e-15, far
+//! more than a step of 1e-9 needs. Cost: one logarithm (a table read, no division), the
+//! series, one square root, two divisions.
 
 use super::atan::atan_ratio;
 use super::ln::ln;
