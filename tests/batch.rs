@@ -504,3 +504,47 @@ fn every_model_of_a_batch_draws_the_right_angle_at_f64s() {
         assert_eq!(out.status, [0, angle, 0, angle], "{model:?}");
     }
 }
+
+/// The batch without details (the reference's fast path) against the batch with them
+/// (the reference itself): a scene per row over the 50-digit scenes, and one scene with
+/// a length over the benchmark's loads (section 9 switching to line contact at small
+/// angles).
+#[test]
+fn reference_without_details_is_the_reference() {
+    let rows = read_rows("vectors_scene.csv");
+    let cols = read_inputs(&rows);
+    let (mut load, mut phi) = (Vec::new(), Vec::new());
+    for i in 0..20_000 {
+        load.push(200.0 * 100f64.powf((i % 97) as f64 / 96.0));
+        phi.push(1e-6 * 1e5f64.powf((i % 89) as f64 / 88.0) * if i % 2 == 0 { 1.0 } else { -1.0 });
+    }
+    let scene = Scene::new(0.05, 0.05, 79.3e9, 0.3, 0.3)
+        .unwrap()
+        .with_length(0.2)
+        .unwrap();
+    let cases = [
+        inputs(&cols, ModelChoice::Section9),
+        Inputs::one_scene(&scene, Column::Each(&load), Column::Each(&phi)),
+    ];
+    for (case, inputs) in cases.iter().enumerate() {
+        let n = if case == 0 { rows.len() } else { load.len() };
+        let (mut fast, mut slow) = (Owned::new(n), Owned::new(n));
+        batch::estimate(inputs, &mut fast.outputs(false), Model::Reference).unwrap();
+        batch::estimate(inputs, &mut slow.outputs(true), Model::Reference).unwrap();
+        let mut worst = Worst::default();
+        for i in 0..n {
+            worst.add("s", i, fast.s[i], slow.s[i]);
+            worst.add("F", i, fast.f[i], slow.f[i]);
+            worst.add("phi0", i, fast.phi0[i], slow.phi0[i]);
+        }
+        // Both within a few ulps of the exact values.
+        worst.assert_below(3e-15);
+        assert_eq!(fast.regime, slow.regime);
+        assert_eq!(fast.model, slow.model);
+        assert_eq!(fast.flags, slow.flags);
+        assert_eq!(fast.status, slow.status);
+        if case == 1 {
+            assert!(slow.model.contains(&0) && slow.model.contains(&1));
+        }
+    }
+}

@@ -815,9 +815,11 @@ fn thresholds(
 }
 
 /// Where the reference's time goes per row, on one thread, for the demo scene over
-/// the given loads (N) and angles (rad): ns per row of the ellipse's shape (k', m, n
-/// from theta, eqs 4-6), the critical angle (phi0 at the load, eqs 18, 30), the whole
-/// elliptic solution, and the batch (the same plus writing the columns).
+/// the given loads (N) and angles (rad): ns per row of the reference's ellipse shape
+/// (k', m, n from theta, eqs 4-6), its critical angle (phi0 at the load, eqs 18, 30),
+/// its whole elliptic solution; of the fast path the batch takes
+/// (`reference::fast::Prepared::estimate`: d/b, F, phi0, flags); and the batch (the
+/// fast path plus writing the columns).
 #[pyfunction]
 fn reference_cost<'py>(
     py: Python<'py>,
@@ -857,6 +859,14 @@ fn reference_cost<'py>(
                 let _ = black_box(reference::elliptic(&scene, x, y));
             }
         });
+        let fast = reference::fast::Prepared::new(&scene, reference::ModelChoice::Section9);
+        let fast_estimate = per_row(&|| {
+            if let Some(fast) = &fast {
+                for (&x, &y) in p.iter().zip(a) {
+                    black_box(fast.estimate(x, y));
+                }
+            }
+        });
         let m = p.len();
         let (mut s, mut f, mut c) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
         let (mut r, mut mo, mut fl, mut st) =
@@ -889,13 +899,22 @@ fn reference_cost<'py>(
                 }
             }
         });
-        [shape, critical, elliptic, batch, f32_core, f32_batch]
+        [
+            shape,
+            critical,
+            elliptic,
+            fast_estimate,
+            batch,
+            f32_core,
+            f32_batch,
+        ]
     });
     let d = PyDict::new(py);
     for (name, x) in [
         "ellipse_shape",
         "critical_angle",
         "elliptic",
+        "fast_estimate",
         "batch",
         "f32_core",
         "f32_batch",

@@ -187,15 +187,51 @@ fn core_flags(phi: f64, critical_angle: Option<f64>, near_model_switch: bool) ->
     bits
 }
 
-/// The reference's answer for one row, and its further numbers.
+/// The fast path's elliptic answer as a row.
+#[inline(always)]
+fn fast_row(e: &reference::fast::Elliptic) -> Row {
+    Row {
+        slip_ratio: e.slip_ratio,
+        axial_force: e.axial_force,
+        critical_angle: Some(e.critical_angle),
+        regime: e.regime,
+        model: ContactModel::Elliptic,
+        flags: flag_bits(&e.validity, false),
+    }
+}
+
+/// A row the fast path left to the reference (or answered with line contact), out of
+/// the eight-row loop.
+#[cold]
+#[inline(never)]
+fn other_row(
+    out: &mut Outputs<'_>,
+    i: usize,
+    scene: &Scene,
+    answer: Option<reference::fast::Answer>,
+    load: f64,
+    phi: f64,
+    choice: ModelChoice,
+) -> usize {
+    put_reference(out, i, reference_row(scene, answer, load, phi, choice))
+}
+
+/// The reference's answer for one row, and its further numbers: the fast path's
+/// `answer` where it has one, else the reference's.
 #[inline]
 fn reference_row(
     scene: &Scene,
+    answer: Option<reference::fast::Answer>,
     load: f64,
     phi: f64,
     choice: ModelChoice,
 ) -> Result<(Row, [f64; 12]), Error> {
-    let est = reference::estimate_with(scene, load, phi, choice)?;
+    use reference::fast::Answer;
+    let est = match answer {
+        Some(Answer::Elliptic(e)) => return Ok((fast_row(&e), NO_DETAILS)),
+        Some(Answer::Line(l)) => reference::Solution::Line(l),
+        None => reference::estimate_with(scene, load, phi, choice)?,
+    };
     let force = est.axial_force(scene);
     Ok(match est {
         reference::Solution::Elliptic(e) => (
@@ -249,20 +285,69 @@ fn reference_row(
     })
 }
 
+/// Rows the reference's fast path takes at a time (their latency chains side by side).
+const LANES: usize = 8;
+
+/// Writes a reference row; returns 1 for a refused row.
+fn put_reference(
+    out: &mut Outputs<'_>,
+    i: usize,
+    answer: Result<(Row, [f64; 12]), Error>,
+) -> usize {
+    match answer {
+        Ok((row, details)) => put(out, i, Ok(row), &details),
+        Err(e) => put(out, i, Err(e), &NO_DETAILS),
+    }
+}
+
 pub(super) fn reference(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) -> usize {
+    let details = out.details.is_some();
+    let prepare = |s: &Scene| Ok((*s, reference::fast::Prepared::new(s, inputs.choice)));
+    let mut cache = Cache::new();
     let mut bad = 0;
-    let one = inputs.one_scene_for_all().then(|| inputs.scene(0));
-    for i in 0..n {
-        let scene = match &one {
-            Some(s) => *s,
-            None => inputs.scene(i),
+    let mut start = 0;
+    // One scene for every row and no details: the fast path LANES rows at a time.
+    if !details
+        && inputs.one_scene_for_all()
+        && let Ok((scene, Some(fast))) = cache.get(inputs, 0, prepare)
+    {
+        let (scene, fast) = (*scene, *fast);
+        while start + LANES <= n {
+            let load: [f64; LANES] = core::array::from_fn(|k| inputs.load.at(start + k));
+            let phi: [f64; LANES] = core::array::from_fn(|k| inputs.phi.at(start + k));
+            let answers = fast.estimate_rows(&load, &phi);
+            for (k, answer) in answers.into_iter().enumerate() {
+                bad += match answer {
+                    // The ellipse's rows (most) straight into the columns.
+                    Some(reference::fast::Answer::Elliptic(e)) => {
+                        put(out, start + k, Ok(fast_row(&e)), &NO_DETAILS)
+                    }
+                    _ => other_row(
+                        out,
+                        start + k,
+                        &scene,
+                        answer,
+                        load[k],
+                        phi[k],
+                        inputs.choice,
+                    ),
+                };
+            }
+            start += LANES;
+        }
+    }
+    for i in start..n {
+        let (load, phi) = (inputs.load.at(i), inputs.phi.at(i));
+        let answer = match cache.get(inputs, i, prepare) {
+            Ok((scene, fast)) => {
+                let answer = fast
+                    .filter(|_| !details)
+                    .and_then(|f| f.estimate(load, phi));
+                reference_row(scene, answer, load, phi, inputs.choice)
+            }
+            Err(e) => Err(*e),
         };
-        let answer = scene
-            .and_then(|s| reference_row(&s, inputs.load.at(i), inputs.phi.at(i), inputs.choice));
-        bad += match answer {
-            Ok((row, details)) => put(out, i, Ok(row), &details),
-            Err(e) => put(out, i, Err(e), &NO_DETAILS),
-        };
+        bad += put_reference(out, i, answer);
     }
     bad
 }

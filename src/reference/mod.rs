@@ -8,6 +8,7 @@ mod carlson;
 mod chain;
 #[cfg(test)]
 mod cost;
+pub mod fast;
 pub mod inverse;
 pub mod line;
 pub mod normal;

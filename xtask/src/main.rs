@@ -15,6 +15,7 @@ mod modbus;
 mod node;
 mod nopanic;
 mod records;
+mod seeds;
 mod shapes;
 mod sweep;
 mod tables;

@@ -223,9 +223,10 @@ fn segment_text(c: &[f32], width: usize) -> String {
 }
 
 /// The generated files: `(path under the repository root, text)`.
-pub fn generated() -> [(&'static str, String); 3] {
+pub fn generated() -> [(&'static str, String); 4] {
     [
         ("src/float/tables.rs", source()),
+        ("src/reference/fast/seeds.rs", crate::seeds::source()),
         ("src/fixed/tables.rs", crate::fixed_tables::source()),
         ("examples/firmware/trace.rs", crate::trace::source()),
     ]
