@@ -177,8 +177,8 @@ impl Prepared {
     }
 
     /// [`Prepared::estimate`] of N rows, each stage for all of them before the next, so
-    /// that their latency chains (logarithm, series, divisions, cube root) run side by
-    /// side: the same numbers, bit for bit, in less time a row.
+    /// that their latency chains (logarithm, series, divisions, cube root, arc cosine)
+    /// run side by side: the same numbers, bit for bit, in less time a row.
     #[inline]
     pub fn estimate_rows<const N: usize>(
         &self,
@@ -197,21 +197,46 @@ impl Prepared {
         let shapes = shapes(&theta);
         let g_cubed: [f64; N] = each(|i| self.g_cubed_per_load * load[i]);
         let theta0 = thetas_of_g_cubed(&g_cubed);
-        each(|i| self.finish(load[i], phi[i], shapes[i]?, theta0[i]?))
+        // d/b and F/(mu P) each in a pass of its own, the branches and decisions after.
+        let s: [f64; N] = each(|i| match shapes[i] {
+            Some(shape) => cbrt::cbrt(self.slip_cubed_of(load[i], phi[i], shape)),
+            None => f64::NAN,
+        });
+        let force: [f64; N] = each(|i| tangential::axial_force_ratio(s[i]));
+        each(|i| self.finish(load[i], phi[i], shapes[i]?, theta0[i]?, s[i], force[i]))
     }
 
-    /// The row's answer from its shape and theta0.
+    /// `(d/b)^3` (eq 15), NaN unless each partial product is normal (else the
+    /// reference's chain is needed).
     #[inline(always)]
-    fn finish(&self, load: f64, phi: f64, shape: Shape, theta0: f64) -> Option<Answer> {
+    fn slip_cubed_of(&self, load: f64, phi: f64, shape: Shape) -> f64 {
         let abs_phi = libm::fabs(phi);
-        // (d/b)^3, each partial product normal (else the reference's chain is needed).
         let x = self.slip_cubed * shape.mn_cubed;
         let y = x * (abs_phi * abs_phi * abs_phi);
         let s3 = y / load;
-        if !(x.is_normal() && y.is_normal() && s3.is_normal()) {
+        if x.is_normal() && y.is_normal() && s3.is_normal() {
+            s3
+        } else {
+            f64::NAN
+        }
+    }
+
+    /// The row's answer from its shape, theta0, d/b `s` (NaN where the reference must
+    /// answer) and `force = F/(mu P)` at `s`.
+    #[inline(always)]
+    fn finish(
+        &self,
+        load: f64,
+        phi: f64,
+        shape: Shape,
+        theta0: f64,
+        s: f64,
+        force: f64,
+    ) -> Option<Answer> {
+        if s.is_nan() {
             return None;
         }
-        let s = cbrt::cbrt(s3);
+        let abs_phi = libm::fabs(phi);
         let phi0 = theta0 * self.inverse_c;
         // p0 = 3 P^(1/3) / (2 pi m n v^2), so p0 / G = |phi| / (2 mu (d/b)) (eq 15):
         // p0 / G > PRESSURE_LIMIT where |phi| > PRESSURE_LIMIT 2 mu (d/b).
@@ -245,7 +270,7 @@ impl Prepared {
         let mu = self.scene.friction();
         Some(Answer::Elliptic(Elliptic {
             slip_ratio: s,
-            axial_force: libm::copysign(mu * (load * tangential::axial_force_ratio(s)), phi),
+            axial_force: libm::copysign(mu * (load * force), phi),
             critical_angle: phi0,
             critical_theta: theta0,
             kprime: shape.kprime,
