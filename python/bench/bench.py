@@ -195,7 +195,9 @@ def page(args, load, speed, err_digits, digit_rows, err_rows, samples, fleet_s, 
         "`misalign._misalign.reference_cost`): the ellipse's shape "
         f"(k', m, n from theta, eqs 4-6) {cost['ellipse_shape']:.0f}, the critical angle "
         f"(phi0 at the load, eqs 18, 30) {cost['critical_angle']:.0f}, the whole elliptic "
-        f"solution {cost['elliptic']:.0f}, the batch with its columns {cost['batch']:.0f}; "
+        f"solution {cost['elliptic']:.0f}; `reference::fast`, which answers the batch's rows "
+        f"where it can to the same digits, {cost['fast_estimate']:.0f} a row called row by "
+        f"row and {cost['batch']:.0f} in the batch with its columns, eight rows at a time; "
         f"the peer's whole row takes {1e9 / speed['peer']:.0f} ns on one core. The f32 "
         f"core: {cost['f32_core']:.0f} ns per row called row by row, {cost['f32_batch']:.0f} "
         "in the batch with its columns (one thread).",
