@@ -673,6 +673,10 @@ mod tests {
         let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5).unwrap()).unwrap();
         let monitor = Monitor::new(core, Config::default()).unwrap();
         let mut server = Server::new(monitor, ServerConfig::default()).unwrap();
+        // The latching and sample-source coils need the unlock (the site's code).
+        let code = crate::modbus::config::DEFAULT_UNLOCK_CODE.to_be_bytes();
+        let unlock = [6, 0, 9, code[0], code[1]];
+        server.core.dispatch(6, &unlock, head(&unlock)).unwrap();
         let coils = |server: &mut Server<Auto>| {
             let pdu = [1, 0, 0, 0, 6];
             server.core.dispatch(1, &pdu, head(&pdu)).unwrap();
