@@ -198,6 +198,20 @@ fn sweep() -> (Vec<f64>, Vec<f64>) {
     (load, phi)
 }
 
+/// The columns of `scene` repeated on every row, then the load and the angle.
+fn scene_per_row(scene: &Scene, load: &[f64], phi: &[f64]) -> [Vec<f64>; 7] {
+    let n = load.len();
+    [
+        vec![scene.r1(); n],
+        vec![scene.r2(); n],
+        vec![scene.shear_modulus(); n],
+        vec![scene.poisson_ratio(); n],
+        vec![scene.friction(); n],
+        load.to_vec(),
+        phi.to_vec(),
+    ]
+}
+
 #[test]
 fn cores_in_a_batch_answer_as_row_by_row() {
     let scene = Scene::DEMO.with_length(0.2).unwrap();
@@ -205,15 +219,7 @@ fn cores_in_a_batch_answer_as_row_by_row() {
     let n = load.len();
     let one = Inputs::one_scene(&scene, Column::Each(&load), Column::Each(&phi));
     // The same scene given per row: prepared once per run of equal constants.
-    let per_row_cols = [
-        vec![scene.r1(); n],
-        vec![scene.r2(); n],
-        vec![scene.shear_modulus(); n],
-        vec![scene.poisson_ratio(); n],
-        vec![scene.friction(); n],
-        load.clone(),
-        phi.clone(),
-    ];
+    let per_row_cols = scene_per_row(&scene, &load, &phi);
     let lengths = vec![0.2; n];
     let per_row = Inputs {
         length: Some(Column::Each(&lengths)),
@@ -317,15 +323,7 @@ fn one_scene_answers_every_column_as_a_scene_per_row() {
             ModelChoice::Section9,
         ),
     ] {
-        let cols = [
-            vec![scene.r1(); n],
-            vec![scene.r2(); n],
-            vec![scene.shear_modulus(); n],
-            vec![scene.poisson_ratio(); n],
-            vec![scene.friction(); n],
-            load.clone(),
-            phi.clone(),
-        ];
+        let cols = scene_per_row(&scene, &load, &phi);
         let lengths = scene.length().map(|l| vec![l; n]);
         let per_row = Inputs {
             length: lengths.as_deref().map(Column::Each),

@@ -613,20 +613,25 @@ mod tests {
     use crate::{Scene, float::Auto};
     use std::vec::Vec;
 
+    /// A server over the demo scene's f32 core and the default monitor.
+    fn server(config: ServerConfig) -> Server<Auto> {
+        let scene = Scene::DEMO;
+        let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5).unwrap()).unwrap();
+        let monitor = Monitor::new(core, Config::default()).unwrap();
+        Server::new(monitor, config).unwrap()
+    }
+
     /// Every read of bits (functions 1 and 2), from every address and of every length
     /// the table holds, answers each bit as its entry's value, with the head and the
     /// CRC of a valid frame; one past the table is exception 02.
     #[test]
     fn every_read_of_bits_is_each_bits_value() {
-        let scene = Scene::DEMO;
-        let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5).unwrap()).unwrap();
-        let monitor = Monitor::new(core, Config::default()).unwrap();
         let config = ServerConfig {
             external_samples: true,
             latching: super::super::AlarmSet::ALARM,
             ..ServerConfig::default()
         };
-        let mut server = Server::new(monitor, config).unwrap();
+        let mut server = server(config);
         for i in 0..200u32 {
             let load = 2e3 + 40.0 * i as f32;
             server.process(Sample::new(i * 1000, load, 1e-4 * (i % 7) as f32).with_speed(2.0));
@@ -669,10 +674,7 @@ mod tests {
     /// `acknowledge` reads 0); function 5 likewise one at a time; past the table, 02.
     #[test]
     fn every_write_of_coils_sets_those_coils() {
-        let scene = Scene::DEMO;
-        let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5).unwrap()).unwrap();
-        let monitor = Monitor::new(core, Config::default()).unwrap();
-        let mut server = Server::new(monitor, ServerConfig::default()).unwrap();
+        let mut server = server(ServerConfig::default());
         // The latching and sample-source coils need the unlock (the site's code).
         let code = crate::modbus::config::DEFAULT_UNLOCK_CODE.to_be_bytes();
         let unlock = [6, 0, 9, code[0], code[1]];
@@ -716,10 +718,7 @@ mod tests {
     /// alone and computed alone, with the head and the CRC of a valid frame.
     #[test]
     fn every_read_of_registers_is_each_registers_value() {
-        let scene = Scene::DEMO;
-        let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5).unwrap()).unwrap();
-        let monitor = Monitor::new(core, Config::default()).unwrap();
-        let mut server = Server::new(monitor, ServerConfig::default()).unwrap();
+        let mut server = server(ServerConfig::default());
         for i in 0..200u32 {
             let load = 2e3 + 10.0 * i as f32;
             server.process(Sample::new(i * 1000, load, 1e-4 * (i % 7) as f32).with_speed(2.0));
