@@ -567,7 +567,10 @@ fn the_committed_image_restores_at_boot() {
     let demo = fresh.monitor().estimator().to_bytes();
     let mut cases: Vec<Vec<u8>> = vec![image[..IMAGE_LEN - 1].to_vec(), vec![0; IMAGE_LEN]];
     let mut bad = image;
-    bad[0] = 2; // a newer image version
+    bad[0] = 3; // a newer image version
+    cases.push(bad.to_vec());
+    let mut bad = image;
+    bad[1] |= 4; // a flag no version has
     cases.push(bad.to_vec());
     let mut bad = image;
     bad[4 + 2 * 31] = 0; // spike_window 9: the configuration fails validate
@@ -587,6 +590,82 @@ fn the_committed_image_restores_at_boot() {
         assert_eq!(b.monitor().estimator().to_bytes(), demo, "{i}");
         write1(&mut b, at("unlock"), DEFAULT_UNLOCK_CODE).unwrap();
     }
+}
+
+/// Which alarms latch and where samples come from are switched at once (behind the
+/// unlock) and kept as a commit is: each switch hands the application an image to
+/// store, and a node booted from it switches as it did. A version 1 image (from before
+/// the image kept them) still restores its configuration, the switches the build's.
+#[test]
+fn latching_and_the_samples_source_are_kept_through_a_reset() {
+    let mut s = server();
+    let mut image = [0; IMAGE_LEN];
+    unlock(&mut s);
+    coil(&mut s, at_coil("latch_alarm"), true).unwrap();
+    assert!(s.take_committed(&mut image), "a switch is kept");
+    assert!(!s.take_committed(&mut [0; IMAGE_LEN]), "once");
+    assert_eq!(get(&mut s, "config_source"), 1);
+    write1(&mut s, at("external_mode"), 1).unwrap();
+    write1(&mut s, at("latching"), 0b1001).unwrap();
+    assert!(s.take_committed(&mut image));
+    // The same values again (a master writing them cyclically): nothing to store.
+    write1(&mut s, at("latching"), 0b1001).unwrap();
+    coil(&mut s, at_coil("external_samples"), true).unwrap();
+    assert!(!s.take_committed(&mut [0; IMAGE_LEN]));
+    let mut booted = server();
+    assert_eq!(booted.restore(Stored::Image(&image)), BootSource::Committed);
+    assert_eq!(
+        booted.annunciator().latching(),
+        AlarmSet::WARNING.union(AlarmSet::APPROACHING)
+    );
+    assert!(booted.external_samples());
+
+    // A commit keeps them too; switched off, they stay off.
+    unlock(&mut booted);
+    coil(&mut booted, at_coil("external_samples"), false).unwrap();
+    put(&mut booted, "config_on_delay", 4000).unwrap();
+    cmd(&mut booted, command::COMMIT).unwrap();
+    assert!(booted.take_committed(&mut image));
+    let mut again = server();
+    assert_eq!(again.restore(Stored::Image(&image)), BootSource::Committed);
+    assert_eq!(again.monitor().config().on_delay_ms, 4000);
+    assert_eq!(
+        again.annunciator().latching(),
+        booted.annunciator().latching()
+    );
+    assert!(!again.external_samples());
+
+    // Version 1: the configuration, and the build's switches.
+    let mut v1 = image;
+    v1[0] = 1;
+    v1[1] &= 1;
+    let monitor = Monitor::new(core(&Scene::DEMO), Config::default()).unwrap();
+    let built = ServerConfig {
+        latching: AlarmSet::SENSOR_FAULT,
+        external_samples: true,
+        ..ServerConfig::default()
+    };
+    let mut old = Server::new(monitor, built).unwrap();
+    old.accept_scenes();
+    assert_eq!(old.restore(Stored::Image(&v1)), BootSource::Committed);
+    assert_eq!(old.monitor().config().on_delay_ms, 4000);
+    assert_eq!(old.annunciator().latching(), AlarmSet::SENSOR_FAULT);
+    assert!(old.external_samples());
+    let mut bad = v1;
+    bad[1] = 0x11; // switches in a version 1 image
+    assert_eq!(
+        server().restore(Stored::Image(&bad)),
+        BootSource::DefaultsDamaged
+    );
+}
+
+fn at_coil(name: &str) -> u16 {
+    TableMap::of(Table::Coil)
+        .entries
+        .iter()
+        .find(|e| e.name == name)
+        .unwrap_or_else(|| panic!("no coil {name}"))
+        .address
 }
 
 /// The commit's record on the mock flash: a power cut at every byte written and every
@@ -666,11 +745,11 @@ mod power_loss {
         assert!(s.take_committed(&mut image.0));
         let i = &image.0;
         assert_eq!(i[..4], [misalign::modbus::IMAGE_VERSION, 1, 0xEF, 0xBE]);
-        assert_eq!(
-            misalign::modbus::IMAGE_VERSION,
-            1,
-            "the page documents version 1"
+        let version = format!(
+            "| 0 | 1 | image version: {} |",
+            misalign::modbus::IMAGE_VERSION
         );
+        assert!(spec.contains(&version), "docs/formats.md lacks {version}");
         // The registers from config_thresholds_on, each u16 little-endian.
         let offset = usize::from(at("config_on_delay") - at("config_thresholds_on"));
         assert_eq!(i[4 + 2 * offset..][..4], [0x02, 0x01, 0x04, 0x03]);

@@ -16,8 +16,10 @@ them back, commits, checks that the node runs them, and prints the node's status
   `fixed::FixedAuto`) by `cargo run --release --example prepare`; or `--prepared B`:
   bytes that `examples/prepare.rs --out` wrote.
 - `--config C.csv`: `name,value` lines, a `config_*` register of the map (the prefix may
-  be left out, here and in `--set`) or `new_code`; `--set NAME=VALUE` adds or
-  overrides one.
+  be left out, here and in `--set`), `new_code`, or one of the switches `latching` (the
+  alarms that latch, bits 0-3) and `external_mode` (1: samples from the bus), which
+  the node applies as they are written and keeps with the commit; `--set NAME=VALUE`
+  adds or overrides one.
   `cargo xtask modbus --default-config C.csv` writes the defaults.
 - `--thresholds T.csv`: the planner's table (`P,phi0,phi_warning,...`). It holds no
   register (its angles follow from the scene and the configuration's thresholds): it is
@@ -124,6 +126,11 @@ def u32(words):
     return words[0] << 16 | words[1]
 
 
+# Switches the node applies as written (behind the unlock) and keeps with the
+# committed configuration.
+SWITCHES = ("latching", "external_mode")
+
+
 def commission(node, code, settings, scene):
     if scene is not None:
         want = node.read("scene_bytes")[0]
@@ -138,10 +145,13 @@ def commission(node, code, settings, scene):
         raise Failed(f"locked out for {node.read('lockout')[0]} s after wrong codes")
     if x is not None:
         raise Failed(f"unlock: exception {x}")
+    # The switches as they were, put back if the commit fails.
+    switched = {name: node.read(name) for name, _ in settings if name in SWITCHES}
     try:
         for name, value in settings:
-            if not (name.startswith("config_") or name == "new_code"):
-                raise Failed(f"{name} is not a configuration register (config_*, new_code)")
+            if not (name.startswith("config_") or name in ("new_code",) + SWITCHES):
+                raise Failed(f"{name} is not a configuration register "
+                             f"(config_*, new_code, {', '.join(SWITCHES)})")
             words = node.words(name, value)
             x = node.write(name, words)
             if x is not None:
@@ -160,11 +170,15 @@ def commission(node, code, settings, scene):
             why = node.read("commit_error")[0]
             raise Failed(f"commit refused: {REASONS.get(why, why)} (commit_error {why:#x})")
     except Failed:
+        for name, words in switched.items():
+            node.write(name, words)
         node.write("command", [2])  # revert
         node.write("command", [3])  # lock
         raise
     # What the node runs now.
     for name, value in settings:
+        if name in SWITCHES and node.read(name) != node.words(name, value):
+            raise Failed(f"{name} reads {node.read(name)} after the commit")
         if name.startswith("config_"):
             active = "active_" + name[len("config_"):]
             if node.read(active) != node.words(name, value):
@@ -179,7 +193,9 @@ STATES = {0: "stopped", 1: "normal", 2: "microslip", 3: "gross slip", 4: "sensor
 
 def register(name):
     """A configuration register's name: `config_` added to a field's name."""
-    return name if name == "new_code" or name.startswith("config_") else "config_" + name
+    if name in ("new_code",) + SWITCHES or name.startswith("config_"):
+        return name
+    return "config_" + name
 
 
 def read_config(path):

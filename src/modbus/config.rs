@@ -15,6 +15,7 @@
 //! millisecond counter (u32, wrapping). Without ticks no unlock expires and no lock-out
 //! ends, so an application calls it at least once a second.
 
+use super::AlarmSet;
 use super::exception::Exception;
 use crate::monitor::{
     Config, ConfigError, FrictionConfig, Monitor, SpikeFilter, Thresholds, TrendConfig,
@@ -38,8 +39,25 @@ pub const WRONG_CODES_MAX: u8 = 3;
 pub const LOCKOUT_S: u32 = 300;
 /// Bytes of the committed configuration's image ([`Server::take_committed`](super::Server::take_committed)).
 pub const IMAGE_LEN: usize = 4 + 2 * CONFIG_WORDS + 2 + SCENE_BYTES_MAX;
-/// The image's format version (its byte 0).
-pub const IMAGE_VERSION: u8 = 1;
+/// The image's format version (its byte 0). Version 1 held no switches: its
+/// latching and samples' source stay the build's.
+pub const IMAGE_VERSION: u8 = 2;
+
+/// The image's byte 1: bit 0 a scene follows, bit 1 external samples are taken,
+/// bits 4-7 the alarms that latch ([`AlarmSet`]'s bits).
+mod flags {
+    pub const SCENE: u8 = 1;
+    pub const EXTERNAL: u8 = 2;
+    pub const LATCHING_SHIFT: u8 = 4;
+}
+
+/// The server's switches an image keeps beside the configuration: which alarms latch,
+/// whether external samples are taken.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Switches {
+    pub(crate) latching: AlarmSet,
+    pub(crate) external: bool,
+}
 
 /// The values of the register `command`.
 pub mod command {
@@ -717,11 +735,19 @@ impl<E: Estimator> Commissioning<E> {
         Ok(())
     }
 
-    /// The committed configuration's image into `out`, if a commit awaits being
-    /// persisted.
+    /// A write switched latching or the samples' source (the guard passed): applied
+    /// at once, and kept as a commit is.
+    pub(crate) fn switched(&mut self) {
+        self.source = BootSource::Committed;
+        self.unsaved = true;
+    }
+
+    /// The committed configuration's image, with `switches`, into `out`, if a commit
+    /// or a switch awaits being persisted.
     pub(crate) fn take_committed(
         &mut self,
         monitor: &Monitor<E>,
+        switches: Switches,
         out: &mut [u8; IMAGE_LEN],
     ) -> bool {
         if !self.unsaved {
@@ -730,13 +756,19 @@ impl<E: Estimator> Commissioning<E> {
         self.unsaved = false;
         out.fill(0);
         out[0] = IMAGE_VERSION;
+        out[1] = switches.latching.bits() << flags::LATCHING_SHIFT
+            | if switches.external {
+                flags::EXTERNAL
+            } else {
+                0
+            };
         out[2..4].copy_from_slice(&self.code.to_le_bytes());
         let words = config_words(monitor.config());
         for (o, w) in out[4..4 + 2 * CONFIG_WORDS].chunks_exact_mut(2).zip(words) {
             o.copy_from_slice(&w.to_le_bytes());
         }
         if let Some(io) = self.io {
-            out[1] = 1;
+            out[1] |= flags::SCENE;
             let at = 4 + 2 * CONFIG_WORDS;
             out[at..at + 2].copy_from_slice(&(io.bytes as u16).to_le_bytes());
             (io.save)(monitor.estimator(), &mut out[at + 2..]);
@@ -744,28 +776,43 @@ impl<E: Estimator> Commissioning<E> {
         true
     }
 
-    /// Applies what the application found stored at boot.
-    pub(crate) fn restore(&mut self, stored: Stored<'_>, monitor: &mut Monitor<E>) -> BootSource {
+    /// Applies what the application found stored at boot; the switches an image
+    /// kept, for the server to apply.
+    pub(crate) fn restore(
+        &mut self,
+        stored: Stored<'_>,
+        monitor: &mut Monitor<E>,
+    ) -> (BootSource, Option<Switches>) {
+        let mut switches = None;
         self.source = match stored {
             Stored::Nothing => BootSource::Defaults,
             Stored::Damaged => BootSource::DefaultsDamaged,
             Stored::Image(image) => match self.apply_image(image, monitor) {
-                Some(()) => BootSource::Committed,
+                Some(s) => {
+                    switches = s;
+                    BootSource::Committed
+                }
                 None => BootSource::DefaultsDamaged,
             },
         };
         self.revert();
-        self.source
+        (self.source, switches)
     }
 
-    /// An image's configuration, code and scene checked, then applied; `None` (and
-    /// nothing applied) for an image that is not one.
-    fn apply_image(&mut self, image: &[u8], monitor: &mut Monitor<E>) -> Option<()> {
+    /// An image's configuration, code and scene checked, then applied, and its
+    /// switches (none in a version 1 image); `None` (and nothing applied) for an image
+    /// that is not one.
+    fn apply_image(&mut self, image: &[u8], monitor: &mut Monitor<E>) -> Option<Option<Switches>> {
         let image: &[u8; IMAGE_LEN] = image.try_into().ok()?;
         let (&[version, flags], rest) = image.split_first_chunk::<2>()?;
-        if version != IMAGE_VERSION || flags > 1 {
-            return None;
-        }
+        let switches = match version {
+            1 if flags <= flags::SCENE => None,
+            IMAGE_VERSION if flags & 0x0C == 0 => Some(Switches {
+                latching: AlarmSet::from_bits(flags >> flags::LATCHING_SHIFT),
+                external: flags & flags::EXTERNAL != 0,
+            }),
+            _ => return None,
+        };
         let (code, rest) = rest.split_first_chunk::<2>()?;
         let (config, rest) = rest.split_first_chunk::<{ 2 * CONFIG_WORDS }>()?;
         let (len, scene) = rest.split_first_chunk::<2>()?;
@@ -774,7 +821,7 @@ impl<E: Estimator> Commissioning<E> {
             *w = u16::from_le_bytes([b[0], b[1]]);
         }
         let config = config_from_words(&words).ok()?;
-        let estimator = match (flags, self.io) {
+        let estimator = match (flags & flags::SCENE, self.io) {
             (0, _) => None,
             (_, Some(io)) if usize::from(u16::from_le_bytes(*len)) == io.bytes => {
                 Some((io.load)(scene.get(..io.bytes)?).ok()?)
@@ -786,7 +833,7 @@ impl<E: Estimator> Commissioning<E> {
             monitor.set_estimator(e);
         }
         self.code = u16::from_le_bytes(*code);
-        Some(())
+        Some(switches)
     }
 }
 

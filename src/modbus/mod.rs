@@ -411,13 +411,19 @@ impl<E: Estimator> Server<E> {
     }
 
     /// The image of the configuration committed over the bus ([`IMAGE_LEN`] bytes: its
-    /// configuration, the site's code and, with [`accept_scenes`](Self::accept_scenes),
-    /// the scene's prepared bytes) into `out`, once per commit: `true` when a commit
-    /// awaits being persisted. Call it after each request, and store `out` (the storage
-    /// layer's `ConfigImage` record) before the next commit.
+    /// configuration, the site's code, the alarms that latch, whether external samples
+    /// are taken and, with [`accept_scenes`](Self::accept_scenes), the scene's prepared
+    /// bytes) into `out`, once per commit and once per write that switched latching or
+    /// the samples' source: `true` when such a change awaits being persisted. Call it
+    /// after each request, and store `out` (the storage layer's `ConfigImage` record)
+    /// before the next change.
     pub fn take_committed(&mut self, out: &mut [u8; IMAGE_LEN]) -> bool {
         let c = &mut self.core;
-        c.commissioning.take_committed(&c.monitor, out)
+        let switches = config::Switches {
+            latching: c.annunciator.latching(),
+            external: c.external,
+        };
+        c.commissioning.take_committed(&c.monitor, switches, out)
     }
 
     /// At boot: applies the configuration the application restored from its storage,
@@ -427,7 +433,12 @@ impl<E: Estimator> Server<E> {
     /// reads after it.
     pub fn restore(&mut self, stored: Stored<'_>) -> BootSource {
         let c = &mut self.core;
-        c.commissioning.restore(stored, &mut c.monitor)
+        let (source, switches) = c.commissioning.restore(stored, &mut c.monitor);
+        if let Some(s) = switches {
+            c.annunciator.set_latching(s.latching);
+            c.external = s.external;
+        }
+        source
     }
 
     /// At boot, after [`restore`](Self::restore): the monitor goes on from its

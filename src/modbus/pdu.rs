@@ -557,12 +557,22 @@ impl<E: Estimator> Core<E> {
 
     fn write_bit(&mut self, field: Field, on: bool) {
         // Guarded by the caller (`protected_bit`).
-        let a = &mut self.annunciator;
+        let latching = self.annunciator.latching();
         match field {
-            Field::Acknowledge if on => a.acknowledge(super::AlarmSet::ALL),
-            Field::Latching(which) => a.set_latching(a.latching().with(which, on)),
-            Field::ExternalSamples => self.external = on,
+            Field::Acknowledge if on => self.annunciator.acknowledge(super::AlarmSet::ALL),
+            Field::Latching(which) => self.switch(latching.with(which, on), self.external),
+            Field::ExternalSamples => self.switch(latching, on),
             _ => {}
+        }
+    }
+
+    /// Latching and the samples' source set (the guard passed); a change is kept as a
+    /// commit is (`Server::take_committed`), a write of the same values stores nothing.
+    fn switch(&mut self, latching: super::AlarmSet, external: bool) {
+        if (latching, external) != (self.annunciator.latching(), self.external) {
+            self.annunciator.set_latching(latching);
+            self.external = external;
+            self.commissioning.switched();
         }
     }
 
@@ -578,8 +588,8 @@ impl<E: Estimator> Core<E> {
                 }
             }
             Field::AcknowledgeAlarms => self.annunciator.acknowledge(bits),
-            Field::LatchingAlarms => self.annunciator.set_latching(bits),
-            Field::ExternalMode => self.external = v != 0,
+            Field::LatchingAlarms => self.switch(bits, self.external),
+            Field::ExternalMode => self.switch(self.annunciator.latching(), v != 0),
             Field::Staged(f) => c.write_staged(f, v, self.monitor.config()),
             Field::Commission(Reg::NewCode) => c.write_new_code(v as u16),
             Field::Commission(Reg::Unlock) => c.unlock(v as u16)?,

@@ -23,6 +23,8 @@ from master import Map, Master, f32_of, read_samples, u32_words
 from test_config import code, get
 
 ON_DELAY_MS = 4000
+# The alarms that latch, committed with the configuration: warning and sensor fault.
+LATCHING = 0b0101
 
 
 def input_address(name):
@@ -88,7 +90,8 @@ def test_configuration_and_unacknowledged_events_survive_a_reset(client):
     done = subprocess.run(
         [sys.executable, "tools/commission.py", "--tcp", f"127.0.0.1:{os.environ['MODBUS_PORT']}",
          "--registers", os.environ["MODBUS_REGISTERS"], "--code", str(code()),
-         "--prepared", os.environ["MODBUS_SCENE"], "--set", f"config_on_delay={ON_DELAY_MS}"],
+         "--prepared", os.environ["MODBUS_SCENE"], "--set", f"config_on_delay={ON_DELAY_MS}",
+         "--set", f"latching={LATCHING}"],
         capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
     time.sleep(0.1)
@@ -134,6 +137,7 @@ def test_configuration_and_unacknowledged_events_survive_a_reset(client):
 
     assert get(client, "config_source") == 1, "the committed configuration runs"
     assert get(client, "active_on_delay") == ON_DELAY_MS
+    assert get(client, "latching") == LATCHING
     assert get(client, "scene_active_crc") == scene_crc
     # The monitor went on from its checkpoint under the committed configuration: every
     # value it shows is the one before the reset (the trend's time to critical too,
