@@ -41,15 +41,34 @@ fn sample(i: u32) -> Sample {
     s
 }
 
-/// A request of `function` with `data` to unit 1; the answer's PDU.
-fn pdu<E: Estimator>(s: &mut Server<E>, function: u8, data: &[u8]) -> Vec<u8> {
+/// A request of `function` with `data` to unit 1.
+fn send<E: Estimator>(s: &mut Server<E>, function: u8, data: &[u8]) {
     let mut f = vec![1, function];
     f.extend_from_slice(data);
     f.extend_from_slice(&crc16(&f).to_le_bytes());
     f.iter().for_each(|&b| s.receive(b));
+}
+
+/// The answer's PDU, sent.
+fn take<E: Estimator>(s: &mut Server<E>) -> Vec<u8> {
     let answer = s.response().expect("an answer").to_vec();
     s.sent();
     answer[1..answer.len() - 2].to_vec()
+}
+
+/// A request of `function` with `data` to unit 1; the answer's PDU.
+fn pdu<E: Estimator>(s: &mut Server<E>, function: u8, data: &[u8]) -> Vec<u8> {
+    send(s, function, data);
+    take(s)
+}
+
+/// A write under store-and-forward: its answer held until the application's part has
+/// run (`service`); the answer's PDU.
+fn write_stored(s: &mut Server<Auto>, q: &mut Q, function: u8, data: &[u8]) -> Vec<u8> {
+    send(s, function, data);
+    assert!(s.response().is_none(), "answered before it was stored");
+    service(s, q);
+    take(s)
 }
 
 fn words(pdu: &[u8]) -> Vec<u16> {
@@ -75,18 +94,28 @@ fn input<E: Estimator>(s: &mut Server<E>, name: &str) -> u32 {
     u32_at(&words(&pdu(s, 4, &[a, b, 0, 2])), 0)
 }
 
-/// Writes `event_ack` (holding 7, two registers); the answer's PDU.
-fn ack<E: Estimator>(s: &mut Server<E>, n: u32) -> Vec<u8> {
+/// The request writing `event_ack` (holding 7, two registers) with `n`.
+fn ack_request(n: u32) -> [u8; 9] {
     let [a, b, c, d] = n.to_be_bytes();
-    pdu(s, 16, &[0, 7, 0, 2, 4, a, b, c, d])
+    [0, 7, 0, 2, 4, a, b, c, d]
 }
 
-/// The master's read of the window: `event_from` written (the number after the last
-/// event it read, if any), then the events and the missed count.
-fn read_window<E: Estimator>(s: &mut Server<E>, from: Option<u32>) -> (Vec<Event>, u32) {
+/// Writes `event_ack`; the answer's PDU.
+fn ack<E: Estimator>(s: &mut Server<E>, n: u32) -> Vec<u8> {
+    pdu(s, 16, &ack_request(n))
+}
+
+/// Writes `event_ack` under store-and-forward; the answer's PDU.
+fn ack_stored(s: &mut Server<Auto>, q: &mut Q, n: u32) -> Vec<u8> {
+    write_stored(s, q, 16, &ack_request(n))
+}
+
+/// The master's read of the window under store-and-forward: `event_from` written (the
+/// number after the last event it read, if any), then the events and the missed count.
+fn read_window(s: &mut Server<Auto>, q: &mut Q, from: Option<u32>) -> (Vec<Event>, u32) {
     if let Some(from) = from {
         let [a, b, c, d] = from.to_be_bytes();
-        assert_eq!(pdu(s, 16, &[0, 0, 0, 2, 4, a, b, c, d])[0], 16);
+        assert_eq!(write_stored(s, q, 16, &[0, 0, 0, 2, 4, a, b, c, d])[0], 16);
     }
     let n = EVENT_SLOTS_ADDRESS - EVENT_WINDOW_ADDRESS + EVENT_SLOTS * EVENT_STRIDE;
     let [a, b] = EVENT_WINDOW_ADDRESS.to_be_bytes();
@@ -102,7 +131,7 @@ fn read_window<E: Estimator>(s: &mut Server<E>, from: Option<u32>) -> (Vec<Event
 
 /// The application's part after each sample or request: new events onto flash and
 /// into the window, the master's acknowledgement made durable, the window fed from
-/// flash while it is behind, the registers told.
+/// flash while it is behind, the registers told, the held answer released.
 fn service(s: &mut Server<Auto>, q: &mut Q) {
     while let Some(e) = s.pop_event() {
         block_on(q.push(e.seq, &e)).unwrap();
@@ -131,6 +160,7 @@ fn service(s: &mut Server<Auto>, q: &mut Q) {
         events_overwritten: q.dropped(),
         ..s.storage_status()
     });
+    s.stored(true);
 }
 
 fn open_queue(flash: Flash) -> Q {
@@ -212,7 +242,7 @@ fn every_event_is_read_once_in_order_across_resets_and_beyond_the_window() {
         }
         // The master: reads the window twice, acknowledges what it read.
         for _ in 0..2 {
-            let (events, missed) = read_window(&mut s, read.last().map(|l| l + 1));
+            let (events, missed) = read_window(&mut s, &mut q, read.last().map(|l| l + 1));
             assert_eq!(missed, 0, "round {round}");
             for e in &events {
                 if let Some(&last) = read.last() {
@@ -221,8 +251,7 @@ fn every_event_is_read_once_in_order_across_resets_and_beyond_the_window() {
                 read.push(e.seq);
             }
             if let Some(last) = events.last() {
-                assert_eq!(ack(&mut s, last.seq)[0], 16);
-                service(&mut s, &mut q);
+                assert_eq!(ack_stored(&mut s, &mut q, last.seq)[0], 16);
             }
         }
         // A reset every few rounds, from a checkpoint taken then or one older (its
@@ -243,14 +272,13 @@ fn every_event_is_read_once_in_order_across_resets_and_beyond_the_window() {
     }
     // Drain what is left.
     loop {
-        let (events, _) = read_window(&mut s, read.last().map(|l| l + 1));
+        let (events, _) = read_window(&mut s, &mut q, read.last().map(|l| l + 1));
         let Some(last) = events.last() else { break };
         for e in &events {
             assert_eq!(e.seq, read.last().map_or(0, |l| l + 1));
             read.push(e.seq);
         }
-        ack(&mut s, last.seq);
-        service(&mut s, &mut q);
+        ack_stored(&mut s, &mut q, last.seq);
     }
     let raised = s.monitor().next_event_seq();
     assert_eq!(read, (0..raised).collect::<Vec<_>>());
@@ -347,7 +375,7 @@ fn a_full_flash_drops_the_oldest_and_the_master_sees_the_gap() {
     let (mut gaps, mut last) = (0, None::<u32>);
     loop {
         let expected = last.map_or(0, |l| l + 1);
-        let (events, missed) = read_window(&mut s, last.map(|l| l + 1));
+        let (events, missed) = read_window(&mut s, &mut q, last.map(|l| l + 1));
         // The gap before slot 0 is the one counted as missed.
         if let Some(first) = events.first() {
             assert_eq!(missed, first.seq - expected);
@@ -362,12 +390,48 @@ fn a_full_flash_drops_the_oldest_and_the_master_sees_the_gap() {
             gaps += e.seq - expected;
             last = Some(e.seq);
         }
-        assert_eq!(ack(&mut s, newest)[0], 16);
-        service(&mut s, &mut q);
+        assert_eq!(ack_stored(&mut s, &mut q, newest)[0], 16);
     }
     assert_eq!(last, Some(s.monitor().next_event_seq() - 1));
     // The numbers jump by no more than flash dropped (some of those the window still
     // held in RAM, and the master read).
     assert!(gaps > 0 && gaps <= overwritten, "{gaps} of {overwritten}");
     assert_eq!(input(&mut s, "events_stored"), 0);
+}
+
+/// Under store-and-forward a write is answered only once the application has stored
+/// what it changed: a master that has the answer has it on flash. A write the storage
+/// failed is answered with exception 04; reads are answered at once.
+#[test]
+fn a_write_is_answered_once_stored() {
+    let (mut s, mut q) = boot(Flash::new(), &monitor(None).snapshot());
+    let mut i = 0;
+    while s.monitor().next_event_seq() < 3 {
+        s.process(sample(i));
+        service(&mut s, &mut q);
+        i += 1;
+    }
+    // A read: at once.
+    assert_eq!(pdu(&mut s, 3, &[0, 7, 0, 2])[0], 3);
+    // The acknowledgement: held until stored, then on flash when answered.
+    send(&mut s, 16, &ack_request(1));
+    assert!(s.response().is_none());
+    assert_eq!(q.state().acknowledged, None);
+    service(&mut s, &mut q);
+    assert_eq!(q.state().acknowledged, Some(1));
+    assert_eq!(take(&mut s), [16, 0, 7, 0, 2]);
+    // A failed store: exception 04, counted.
+    let exceptions = s.counters().exceptions;
+    send(&mut s, 16, &ack_request(2));
+    assert!(s.response().is_none());
+    s.stored(false);
+    assert_eq!(take(&mut s), [0x90, 4]);
+    assert_eq!(s.counters().exceptions, exceptions + 1);
+    // An exception stays itself: a number not yet given is 03.
+    send(&mut s, 16, &ack_request(1000));
+    s.stored(false);
+    assert_eq!(take(&mut s), [0x90, 3]);
+    // Without store-and-forward every answer is due at once.
+    let mut plain = Server::new(monitor(None), ServerConfig::default()).unwrap();
+    assert_eq!(pdu(&mut plain, 16, &[0, 0, 0, 2, 4, 0, 0, 0, 0])[0], 16);
 }

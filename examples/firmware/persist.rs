@@ -6,9 +6,10 @@
 //!
 //! Two regions: a [`Store`] of 4 KiB holding the monitor's state (checkpointed at each
 //! event and once a minute of monitored time) and the configuration committed over the
-//! bus (`ConfigImage`, written once per commit); an [`EventQueue`] of 2 KiB holding
-//! every event until a master acknowledges it (`event_ack`, made durable as it is
-//! written). At boot: the committed configuration restored (`config_source` says which
+//! bus (`ConfigImage`, written once per commit or switch of latching or the samples'
+//! source); an [`EventQueue`] of 2 KiB holding every event until a master
+//! acknowledges it (`event_ack`). The answer to a master's write waits until what it
+//! changed is stored (`Server::stored`). At boot: the committed configuration restored (`config_source` says which
 //! ran), then the state under it (numbering after the newest event stored), the event
 //! window fed from the queue, from its oldest unacknowledged event on.
 
@@ -206,12 +207,16 @@ impl Persist {
     /// After each sample and each request: new events onto the flash and into the
     /// window, the master's acknowledgement made durable, the window fed from the
     /// flash while it is behind, a committed configuration persisted, the state
-    /// checkpointed at each event and at the interval, the storage registers told.
+    /// checkpointed at each event and at the interval, the storage registers told;
+    /// then the server told that the write it holds the answer to is stored (or that
+    /// a write failed: exception 04).
     pub fn service<E: Estimator>(&mut self, server: &mut Server<E>) {
+        let mut ok = true;
         while let Some(e) = server.pop_event() {
             cut(Op::Push);
             if block_on(self.events.push(e.seq, &e)).is_err() {
                 defmt::warn!("storage: event {=u32} not stored", e.seq);
+                ok = false;
             }
             uncut();
             server.offer_event(e);
@@ -221,6 +226,7 @@ impl Persist {
             cut(Op::Ack);
             if block_on(self.events.acknowledge(k)).is_err() {
                 defmt::warn!("storage: acknowledgement {=u32} not stored", k);
+                ok = false;
             }
             uncut();
             self.acked = ack;
@@ -246,6 +252,7 @@ impl Persist {
             cut(Op::Commit);
             if block_on(self.store.checkpoint(&image)).is_err() {
                 defmt::warn!("storage: the committed configuration not stored");
+                ok = false;
             }
             uncut();
         }
@@ -255,6 +262,7 @@ impl Persist {
         self.status.events_stored = q.unacknowledged;
         self.status.events_overwritten = self.events.dropped();
         server.set_storage_status(self.status);
+        server.stored(ok);
     }
 
     /// The monitor's state checkpointed when it raised an event since the last

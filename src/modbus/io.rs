@@ -28,7 +28,8 @@ impl<E: Estimator> Server<E> {
     }
 
     /// Blocking: reads until a request is answered and writes the answer. Returns
-    /// `false` at the end of the input (a read of 0 bytes).
+    /// `false` at the end of the input (a read of 0 bytes). Not for store-and-forward,
+    /// whose writes wait for `stored` between the request and the answer: `poll` then.
     ///
     /// # Errors
     /// The UART's.

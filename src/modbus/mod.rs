@@ -41,7 +41,7 @@
 //! `counters`, `into_monitor`; for events kept on flash until acknowledged
 //! (store-and-forward, docs/modbus.md) `store_events`, `pop_event`, `offer_event`,
 //! `wanted_event`, `offer_stored_event`, `end_backlog`, `acknowledged_through`,
-//! `set_storage_status` ([`StorageStatus`]), `storage_status`; for commissioning
+//! `stored`, `set_storage_status` ([`StorageStatus`]), `storage_status`; for commissioning
 //! `accept_scenes`, `tick`, `unlocked`, `commissioning`, `config_source`,
 //! `take_committed`, `restore` (see below). The server stores nothing itself (it does
 //! not depend on `misalign::storage`): the application moves the events and the
@@ -227,6 +227,8 @@ pub struct Server<E> {
 struct Core<E> {
     /// The response's length; 0: none due.
     response_len: usize,
+    /// The response waits for the application's storage ([`Server::stored`]).
+    held: bool,
     unit: u8,
     step: Step<E>,
     ident: Identification,
@@ -289,6 +291,7 @@ impl<E: Estimator> Server<E> {
                 storage: StorageStatus::default(),
                 response: [0; ADU_MAX],
                 response_len: 0,
+                held: false,
             },
         };
         server.core.drain();
@@ -329,13 +332,32 @@ impl<E: Estimator> Server<E> {
         self.framer.clear();
     }
 
-    /// The answer to send, CRC included; `None` while none is due. Send it, then
-    /// call [`sent`](Self::sent). A request completed before then replaces it
-    /// (counted: [`Counters::responses_overwritten`]).
+    /// The answer to send, CRC included; `None` while none is due, or while a write's
+    /// answer waits for [`stored`](Self::stored). Send it, then call
+    /// [`sent`](Self::sent). A request completed before then replaces it (counted:
+    /// [`Counters::responses_overwritten`]).
     pub fn response(&self) -> Option<&[u8]> {
         match self.core.response_len {
+            _ if self.core.held => None,
             0 => None,
             n => self.core.response.get(..n),
+        }
+    }
+
+    /// Store-and-forward ([`store_events`](Self::store_events)): the application has
+    /// stored what the last requests changed (the events they raised, the
+    /// acknowledgement, a committed image), `ok` if every write reached its flash.
+    /// A write's answer waits for this call, so a master that got the answer knows it
+    /// is stored; when `ok` is false the answer becomes exception 04 (what the write
+    /// changed in RAM stays, but would not survive a reset).
+    pub fn stored(&mut self, ok: bool) {
+        let c = &mut self.core;
+        if core::mem::take(&mut c.held) && !ok {
+            let function = c.response[1];
+            if function & 0x80 == 0 {
+                let len = c.exception(function, Exception::ServerDeviceFailure);
+                c.seal(len);
+            }
         }
     }
 
@@ -460,7 +482,8 @@ impl<E: Estimator> Server<E> {
     /// master has not read, and falls behind instead, fed from the store
     /// ([`wanted_event`](Self::wanted_event)). `first`: the oldest unacknowledged event
     /// the store holds at start-up, which the window wants first and `event_from`
-    /// points at. Call it once, before the first sample.
+    /// points at. Call it once, before the first sample. From then on every write
+    /// (functions 5, 6, 15, 16) is answered only after [`stored`](Self::stored).
     pub fn store_events(&mut self, first: Option<u32>) {
         let next = self.core.monitor.next_event_seq();
         let w = &mut self.core.events;

@@ -115,6 +115,7 @@ impl<E: Estimator> Core<E> {
             self.counters.responses_overwritten =
                 self.counters.responses_overwritten.wrapping_add(1);
             self.response_len = 0;
+            self.held = false;
         }
         // Address and quantity (or value) once, for every function that has them.
         let head = head(pdu);
@@ -135,14 +136,25 @@ impl<E: Estimator> Core<E> {
                 return;
             }
             Ok(Reply::Pdu(n)) => n,
-            Err(x) => {
-                self.counters.exceptions = self.counters.exceptions.wrapping_add(1);
-                if let Some(b) = self.response.get_mut(1..3) {
-                    b.copy_from_slice(&[function | 0x80, x as u8]);
-                }
-                2
-            }
+            Err(x) => self.exception(function, x),
         };
+        // Store-and-forward: a write is answered once the application has stored
+        // what it changed (`Server::stored`).
+        self.held = self.events.stored && matches!(function, 5 | 6 | 15 | 16);
+        self.seal(len);
+    }
+
+    /// The exception `x` to `function` into the response's PDU; its length.
+    pub(super) fn exception(&mut self, function: u8, x: Exception) -> usize {
+        self.counters.exceptions = self.counters.exceptions.wrapping_add(1);
+        if let Some(b) = self.response.get_mut(1..3) {
+            b.copy_from_slice(&[function | 0x80, x as u8]);
+        }
+        2
+    }
+
+    /// The unit and the CRC around the response's PDU of `len` bytes: the answer due.
+    pub(super) fn seal(&mut self, len: usize) {
         self.response[0] = self.unit;
         // The PDU is at most 253 bytes: the ADU at most 256.
         let end = len.min(253) + 1;

@@ -4,7 +4,9 @@ examples/firmware/cut.rs): the test writes a plan (`commit N`, `push N` or `ack 
 to MODBUS_POWER_CUT_PLAN, and the node resets itself after N points (bytes written,
 words erased) of its next such operation, as a power cut there would. The master
 then reconnects and checks: the old configuration or the new one, whole; no event
-back that was acknowledged on flash (`event_acked`); no stored event lost or changed.
+back that was acknowledged on flash (`event_acked`); no stored event lost or changed;
+and a commit or an acknowledgement the node answered is in force (it answers a write
+once it is on flash).
 
 Points: 0, 1, 3, 7, 15, ... (2^k - 1) until the operation completes before its point;
 with MODBUS_POWER_CUT_ALL=1 every point, 0, 1, 2, ...
@@ -173,8 +175,9 @@ def test_a_commit_cut_anywhere_leaves_the_old_or_the_new_configuration(client):
         assert new != old
         plan("commit", n)
         frames = frames_now(client)
+        answered = False
         try:
-            write(client, "command", 1)
+            answered = not write(client, "command", 1).isError()
         except Exception:  # noqa: BLE001 (the answer lost to the cut)
             pass
         cut = settled(client, frames)
@@ -182,6 +185,7 @@ def test_a_commit_cut_anywhere_leaves_the_old_or_the_new_configuration(client):
             return None
         active = view(client, "active")
         assert active in (old, new), f"cut after {n} points: neither configuration"
+        assert not answered or active == new, f"cut after {n} points: answered, yet not in force"
         assert get(client, "config_source") == 1
         assert cut or active == new, f"the commit completed before point {n}, yet is not in force"
         return cut
@@ -224,8 +228,10 @@ def test_an_acknowledgement_cut_anywhere_brings_back_no_acknowledged_event(clien
         k = seq(before[0])
         plan("ack", n)
         frames = frames_now(client)
+        answered = False
         try:
             Master(client, regmap).write(ack_address(), u32_words(k))
+            answered = True
         except Exception:  # noqa: BLE001 (the answer lost to the cut)
             pass
         cut = settled(client, frames)
@@ -233,6 +239,7 @@ def test_an_acknowledgement_cut_anywhere_brings_back_no_acknowledged_event(clien
             return None
         durable = get_input(client, "event_acked")
         assert durable in (old, k), f"cut after {n} points: acknowledged through {durable}"
+        assert not answered or durable == k, f"cut after {n} points: answered, yet not on flash"
         after = stored_events(client, regmap)
         kept = before if durable == NONE else [e for e in before if seq(e) > durable]
         assert after == kept, f"cut after {n} points"
