@@ -659,6 +659,42 @@ fn latching_and_the_samples_source_are_kept_through_a_reset() {
     );
 }
 
+/// Resetting the statistics (command 4) changes state: refused while locked, counted,
+/// nothing reset; after the unlock the counts, times and energies start afresh while
+/// the state, the events and the unlock go on.
+#[test]
+fn resetting_the_statistics_needs_the_unlock_and_keeps_state_and_events() {
+    let mut s = server();
+    for i in 0..400u32 {
+        let phi = if i < 200 { 1e-4 } else { 3e-3 };
+        let noise = (i % 7) as f32;
+        s.process(Sample::new(i * 1000, 2e3 + noise, phi + 1e-8 * noise).with_speed(2.0));
+    }
+    let stats = *s.monitor().statistics();
+    assert!(stats.samples() == 400 && stats.total_energy() > 0.0);
+    let (state, next) = (s.monitor().state(), s.monitor().next_event_seq());
+    assert!(next > 0, "events raised");
+
+    let refused = get(&mut s, "refused_writes");
+    assert_eq!(cmd(&mut s, command::RESET_STATISTICS), Err(1));
+    assert_eq!(get(&mut s, "refused_writes"), refused + 1);
+    assert_eq!(*s.monitor().statistics(), stats);
+
+    unlock(&mut s);
+    cmd(&mut s, command::RESET_STATISTICS).unwrap();
+    let fresh = s.monitor().statistics();
+    assert_eq!(fresh.samples(), 0);
+    assert_eq!(fresh.total_energy(), 0.0);
+    assert_eq!(fresh.time_in_state_ms(state), 0);
+    assert_eq!(s.monitor().state(), state);
+    assert_eq!(s.monitor().next_event_seq(), next);
+    assert!(s.unlocked());
+    // Counting goes on from zero.
+    s.process(Sample::new(400_000, 2e3, 3e-3).with_speed(2.0));
+    assert_eq!(s.monitor().statistics().samples(), 1);
+    assert!(s.monitor().statistics().total_energy() > 0.0);
+}
+
 fn at_coil(name: &str) -> u16 {
     TableMap::of(Table::Coil)
         .entries

@@ -29,6 +29,9 @@ them back, commits, checks that the node runs them, and prints the node's status
   format (decoded as `misalign::modbus::event_from_registers` does), from its
   `event_from` or `--events-from SEQ`; read through the window, `event_from` put back,
   nothing acknowledged.
+- `--reset-statistics`: the node's statistics (counts, time and energy per state,
+  extremes) start afresh, after a roller change say (the command 4, before anything
+  is written); alone, nothing is committed.
 - Without `--code`, nothing is written: the node's status and events only.
 
 Register names and types come from the register map (`--registers`, default
@@ -131,7 +134,7 @@ def u32(words):
 SWITCHES = ("latching", "external_mode")
 
 
-def commission(node, code, settings, scene):
+def commission(node, code, settings, scene, reset_statistics=False):
     if scene is not None:
         want = node.read("scene_bytes")[0]
         if want == 0:
@@ -145,6 +148,14 @@ def commission(node, code, settings, scene):
         raise Failed(f"locked out for {node.read('lockout')[0]} s after wrong codes")
     if x is not None:
         raise Failed(f"unlock: exception {x}")
+    if reset_statistics:
+        x = node.write("command", [4])
+        if x is not None:
+            node.write("command", [3])  # lock
+            raise Failed(f"reset of the statistics: exception {x}")
+        if not settings and scene is None:
+            node.write("command", [3])  # lock
+            return node.read("config_source")[0]
     # The switches as they were, put back if the commit fails.
     switched = {name: node.read(name) for name, _ in settings if name in SWITCHES}
     try:
@@ -396,7 +407,10 @@ def main():
     p.add_argument("--prepared", help="prepared scene bytes (examples/prepare.rs --out)")
     p.add_argument("--config", help="a configuration file: name,value lines")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help="a configuration register (config_*, new_code) and its value")
+                   help="a configuration register (config_*, new_code, latching, external_mode) "
+                        "and its value")
+    p.add_argument("--reset-statistics", action="store_true",
+                   help="start the node's statistics afresh (needs --code)")
     p.add_argument("--thresholds", help="the monitor example's --thresholds table, checked")
     p.add_argument("--events", metavar="OUT.csv",
                    help="the events the node holds, as the monitor example's --events")
@@ -440,8 +454,8 @@ def main():
         node = Node(client, args.registers, args.unit)
         planned = check_thresholds(node, args.thresholds, settings) if args.thresholds else None
         if args.code is not None:
-            source = commission(node, args.code, settings, scene)
-        elif settings or scene:
+            source = commission(node, args.code, settings, scene, args.reset_statistics)
+        elif settings or scene or args.reset_statistics:
             raise Failed("writing needs the site's code (--code)")
         lines = status(node, args.events, args.events_from)
     except Failed as e:
@@ -449,7 +463,9 @@ def main():
         return 1
     finally:
         client.close()
-    if args.code is not None:
+    if args.reset_statistics:
+        print("statistics reset")
+    if args.code is not None and (settings or scene):
         print(f"commissioned: {len(settings)} registers{' and the scene' if scene else ''} "
               f"committed, config_source {source}")
     if planned:

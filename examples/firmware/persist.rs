@@ -79,6 +79,9 @@ pub struct Persist {
     /// The next event number at the last checkpoint, and its monitored time (s).
     checkpointed_seq: u32,
     checkpointed_s: Option<u64>,
+    /// The samples the statistics had counted at the last checkpoint: fewer now, and
+    /// a master reset them.
+    checkpointed_samples: u64,
     status: StorageStatus,
 }
 
@@ -130,6 +133,7 @@ impl Persist {
             acked: found.acknowledged,
             checkpointed_seq: 0,
             checkpointed_s: None,
+            checkpointed_samples: 0,
             status: StorageStatus::default(),
         })
     }
@@ -201,6 +205,7 @@ impl Persist {
             server.resume(&fresh);
         }
         self.checkpointed_seq = server.monitor().next_event_seq();
+        self.checkpointed_samples = server.monitor().statistics().samples();
         restored.is_some()
     }
 
@@ -256,7 +261,7 @@ impl Persist {
             }
             uncut();
         }
-        self.checkpoint(server.monitor());
+        ok &= self.checkpoint(server.monitor());
         let q = self.events.state();
         self.status.events_acknowledged = q.acknowledged;
         self.status.events_stored = q.unacknowledged;
@@ -266,23 +271,31 @@ impl Persist {
     }
 
     /// The monitor's state checkpointed when it raised an event since the last
-    /// checkpoint, or when [`INTERVAL_S`] of monitored time have passed.
-    fn checkpoint<E: Estimator>(&mut self, m: &Monitor<E>) {
+    /// checkpoint, when a master reset its statistics, or when [`INTERVAL_S`] of
+    /// monitored time have passed. False if the checkpoint failed.
+    fn checkpoint<E: Estimator>(&mut self, m: &Monitor<E>) -> bool {
         let now_s = m.elapsed_ms() / 1000;
         let due = self
             .checkpointed_s
             .is_none_or(|last| now_s.saturating_sub(last) >= u64::from(INTERVAL_S));
-        if m.next_event_seq() == self.checkpointed_seq && !due {
-            return;
+        let samples = m.statistics().samples();
+        let reset = samples < self.checkpointed_samples;
+        if m.next_event_seq() == self.checkpointed_seq && !due && !reset {
+            return true;
         }
         self.checkpointed_seq = m.next_event_seq();
         self.checkpointed_s = Some(now_s);
+        self.checkpointed_samples = samples;
         match block_on(self.store.checkpoint(&m.snapshot())) {
             Ok(sequence) => {
                 self.status.checkpoints = sequence;
                 self.status.last_checkpoint_ms = Some(m.elapsed_ms());
+                true
             }
-            Err(_) => defmt::warn!("storage: checkpoint failed"),
+            Err(_) => {
+                defmt::warn!("storage: checkpoint failed");
+                false
+            }
         }
     }
 }

@@ -67,6 +67,9 @@ pub mod command {
     pub const REVERT: u16 = 2;
     /// End the unlock now.
     pub const LOCK: u16 = 3;
+    /// Start the monitor's statistics afresh (`Monitor::reset_statistics`); the
+    /// unlock stays.
+    pub const RESET_STATISTICS: u16 = 4;
 }
 
 /// Where the configuration the monitor runs came from (the register `config_source`).
@@ -694,6 +697,10 @@ impl<E: Estimator> Commissioning<E> {
             }
             command::LOCK => {
                 self.unlock_ms = 0;
+                Ok(())
+            }
+            command::RESET_STATISTICS => {
+                monitor.reset_statistics();
                 Ok(())
             }
             _ => Err(Exception::IllegalDataValue),

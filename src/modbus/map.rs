@@ -579,7 +579,7 @@ pub static HOLDINGS: TableMap = TableMap {
         e!(Holding, 9, "unlock", U16, "s", Rw, F::Commission(K::Unlock),
             "write the site's code: commissioning writes are allowed until a commit, the command lock or 300 s after the last of them; 3 wrong codes in a row lock out every code for 300 s; reads the seconds the unlock has left (0 locked)"),
         e!(Holding, 10, "command", U16, "", Rw, F::Commission(K::Command),
-            "needs the unlock: 1 commit the staged copy (validated, applied whole, then locked; refused with exception 03 and commit_error), 2 revert (discard it), 3 lock; reads 0"),
+            "needs the unlock: 1 commit the staged copy (validated, applied whole, then locked; refused with exception 03 and commit_error), 2 revert (discard it), 3 lock, 4 reset the statistics (counts, time and energy per state, extremes); reads 0"),
         e!(Holding, 11, "commit_error", U16, "", R, F::Commission(K::CommitError),
             "the last commit's reason: 0 applied, 1 nothing staged, 0x10 + the configuration's error, 0x20 + the scene's error (docs/modbus.md)"),
         e!(Holding, 12, "config_source", U16, "", R, F::Commission(K::Source),

@@ -243,6 +243,13 @@ impl<E: Estimator> Monitor<E> {
         &self.stats
     }
 
+    /// Starts the statistics afresh (after a roller change, say): the counts, the time
+    /// and energy per state, the extremes. The state, the events and their numbers, the
+    /// conditioning, the trend and the clock go on.
+    pub fn reset_statistics(&mut self) {
+        self.stats = Statistics::new();
+    }
+
     /// The last valid running reading, if any: the conditioned load P (N) and
     /// misalignment phi (rad), d/b, the axial force F (N), the critical angle phi0
     /// (rad) and the margin phi0 - |phi| (rad).

@@ -1,6 +1,7 @@
 """Commissioning over the bus, through pymodbus: the staged and active views, the
 unlock and wrong codes, a commit and a refused one with its reason, a scene that is
-not one, and last a burst of wrong codes that locks the node out.
+not one, the commissioning tool, a reset of the statistics, and last a burst of wrong
+codes that locks the node out.
 
 Run after test_node.py (whose first test must see the node untouched). The
 environment adds MODBUS_UNLOCK_CODE (the node's code, the library's default) and
@@ -215,6 +216,25 @@ def test_the_commissioning_tool_takes_what_an_engineer_planned(client, tmp_path)
     held = events.read_text().splitlines()
     assert held[0] == "t,seq,state,from,kind,fault,P,phi,s,F,phi0,margin,time_to_critical,time_ms"
     assert len(held) - 1 == int(out.split(" events held")[0].split()[-1]) > 0, out
+
+
+def samples_counted(client):
+    r = next(r for r in register_map() if r["table"] == "input" and r["name"] == "samples")
+    w = read_table(client, "input", r["address"], 2)
+    return w[0] << 16 | w[1]
+
+
+def test_the_commissioning_tool_resets_the_statistics(client):
+    """Command 4 changes state: refused while locked; through the tool after the
+    unlock, the statistics start afresh and the node is locked again."""
+    counted = samples_counted(client)
+    assert counted > 0
+    refused(write(client, "command", 4), ILLEGAL_FUNCTION)
+    assert samples_counted(client) == counted
+    status, out = commission(client, "--code", str(code()), "--reset-statistics")
+    assert status == 0 and "statistics reset" in out, out
+    assert samples_counted(client) == 0
+    assert get(client, "unlock") == 0
 
 
 # Last: the lock-out lasts minutes of the node's time.

@@ -5,7 +5,8 @@ every device reset, the image restarted from its reset vector, the `.uninit` RAM
 stands for flash kept), as a power cycle does without the node's cooperation. After
 it the node runs the committed configuration (`config_source` 1, the active values
 the committed ones) and offers exactly the events not acknowledged, in order, with
-their own numbers and contents; no acknowledged one comes back.
+their own numbers and contents; no acknowledged one comes back. Then a reset of the
+statistics (command 4), answered once it is checkpointed, holds across a second reset.
 
 MODBUS_QEMU_MONITOR: the monitor's loopback port. MODBUS_SCENE: a prepared scene the
 node was not built with. MODBUS_SAMPLES: the samples (master.py's format).
@@ -20,7 +21,7 @@ import time
 
 from conftest import HOST, UNIT, read_table, register_map
 from master import Map, Master, f32_of, read_samples, u32_words
-from test_config import code, get
+from test_config import code, get, write
 
 ON_DELAY_MS = 4000
 # The alarms that latch, committed with the configuration: warning and sensor fault.
@@ -152,3 +153,16 @@ def test_configuration_and_unacknowledged_events_survive_a_reset(client):
     assert kept == seqs[5:], f"after the reset: {kept}, expected {seqs[5:]}"
     assert after.events == events[5:], "the events' contents changed"
     assert after.missed == 0
+
+    # A reset of the statistics is answered once it is checkpointed: it holds across
+    # a reset at once, before any event or periodic checkpoint.
+    samples = input_address("samples")
+    assert read_table(client, "input", samples, 2) != [0, 0]
+    seq_next = read_table(client, "input", input_address("event_seq_next"), 2)
+    assert not write(client, "unlock", code()).isError()
+    assert not write(client, "command", 4).isError()
+    assert read_table(client, "input", samples, 2) == [0, 0]
+    reset_node()
+    wait_serving(client)
+    assert read_table(client, "input", samples, 2) == [0, 0], "the statistics came back"
+    assert read_table(client, "input", input_address("event_seq_next"), 2) == seq_next
