@@ -1,10 +1,11 @@
 //! The Modbus node's two flash regions (feature `modbus-flash`, `persist.rs`) on the
 //! board the image is built for. On the Cortex-M0 (thumbv6m, told apart as the one
-//! target without compare-and-swap) the micro:bit's flash through its NVMC
+//! target without compare-and-swap) the micro:bit's flash through the nRF51's NVMC
 //! (`examples/common/nvmc_flash.rs`), in the regions its memory layout reserves at the
-//! end of the flash (`harness/boards/microbit.x`). On the MPS2 boards (Cortex-M3, M4F,
-//! M7) RAM in cortex-m-rt's `.uninit`, kept across a system reset
-//! (`examples/common/ram_flash.rs`, shared with the storage node).
+//! end of the flash (`harness/boards/microbit.x`, whose symbols give their bounds);
+//! another Cortex-M0 board needs its own driver here and its layout's regions. On the
+//! MPS2 boards (Cortex-M3, M4F, M7) RAM in cortex-m-rt's `.uninit`, kept across a
+//! system reset (`examples/common/ram_flash.rs`, shared with the storage node).
 
 use crate::persist::{EVENTS_SIZE, STORE_SIZE};
 
