@@ -13,7 +13,8 @@
 //! With the feature `_power-cut` a cut armed at run time (`ram_flash::armed`, shared
 //! with the RAM flash) resets the core at its point, a byte written or a word erased,
 //! as `RamFlash` does: the bytes (words) before it done, that one and the rest not.
-//! Included by `#[path]`; the register access is the only `unsafe` here.
+//! Included by `#[path]`; the accesses to the NVMC's registers and to the flash are
+//! the only `unsafe` here.
 
 use embedded_storage::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash, check_erase, check_read,
@@ -52,8 +53,8 @@ impl NvmcFlash {
     }
 
     /// Whether every word reads 0. QEMU starts its flash with zeros outside the image,
-    /// where a new part's flash comes erased; a region used by sequential-storage never
-    /// reads all zeros (its items carry a CRC over their data).
+    /// where a new part's flash comes erased; a region sequential-storage wrote never
+    /// reads all zeros (a header of zeros fails its length's checksum).
     pub fn reads_all_zeros(&self) -> bool {
         (0..self.len).step_by(4).all(|at| self.word(at) == 0)
     }
