@@ -37,14 +37,16 @@ impl RamFlash {
             cortex_m::peripheral::SCB::sys_reset();
         }
         #[cfg(feature = "_power-cut")]
-        armed::tick();
+        if armed::due() {
+            cortex_m::peripheral::SCB::sys_reset();
+        }
         self.points += 1;
     }
 }
 
-/// A power cut armed at run time, for every `RamFlash` of the image (feature
-/// `_power-cut`, test builds only): [`arm`](armed::arm) before an operation,
-/// [`disarm`](armed::disarm) after it.
+/// A power cut armed at run time, for every flash driver of the image (`RamFlash`,
+/// `NvmcFlash`; feature `_power-cut`, test builds only): [`arm`](armed::arm) before an
+/// operation, [`disarm`](armed::disarm) after it.
 #[cfg(feature = "_power-cut")]
 pub mod armed {
     use core::sync::atomic::{AtomicU32, Ordering::Relaxed};
@@ -61,11 +63,17 @@ pub mod armed {
         LEFT.store(0, Relaxed);
     }
 
-    pub(super) fn tick() {
+    /// One point passed: whether it is the armed cut (the flash driver then resets
+    /// the core, after what a cut there leaves: `RamFlash` nothing, `NvmcFlash` the
+    /// part of a word or a page done).
+    pub fn due() -> bool {
         match LEFT.load(Relaxed) {
-            0 => {}
-            1 => cortex_m::peripheral::SCB::sys_reset(),
-            n => LEFT.store(n - 1, Relaxed),
+            0 => false,
+            1 => true,
+            n => {
+                LEFT.store(n - 1, Relaxed);
+                false
+            }
         }
     }
 }

@@ -51,11 +51,28 @@
 
 #[cfg(all(target_os = "none", feature = "_power-cut"))]
 mod cut;
+#[cfg(all(target_os = "none", feature = "modbus-flash"))]
+mod flash;
 #[cfg(target_os = "none")]
 mod node;
+// The micro:bit's flash on the Cortex-M0 (thumbv6m, the target without
+// compare-and-swap), RAM on the other boards (`flash.rs`).
+#[cfg(all(
+    target_os = "none",
+    feature = "modbus-flash",
+    not(target_has_atomic = "ptr")
+))]
+#[path = "../common/nvmc_flash.rs"]
+mod nvmc_flash;
 #[cfg(all(target_os = "none", feature = "modbus-node", feature = "modbus-flash"))]
 mod persist;
-#[cfg(all(target_os = "none", feature = "modbus-node", feature = "modbus-flash"))]
+// On the Cortex-M0, a test build's power cut only (`ram_flash::armed`).
+#[cfg(all(
+    target_os = "none",
+    feature = "modbus-flash",
+    any(target_has_atomic = "ptr", feature = "_power-cut")
+))]
+#[cfg_attr(not(target_has_atomic = "ptr"), allow(dead_code))]
 #[path = "../common/ram_flash.rs"]
 mod ram_flash;
 #[cfg(target_os = "none")]

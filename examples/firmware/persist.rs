@@ -1,8 +1,8 @@
 //! The Modbus node's flash (feature `modbus-flash`): what a
 //! node keeps through a reset or a power cut, through `misalign::storage` as a
-//! firmware uses it (a blocking flash driver, `block_on`, no executor). In QEMU the
-//! "flash" is RAM in cortex-m-rt's `.uninit` section (`examples/common/ram_flash.rs`,
-//! shared with the storage node), kept across a system reset.
+//! firmware uses it (a blocking flash driver, `block_on`, no executor), on the board's
+//! flash (`flash.rs`): the micro:bit's through its NVMC on the Cortex-M0, RAM kept
+//! across a system reset on the MPS2 boards.
 //!
 //! Two regions: a [`Store`] of 4 KiB holding the monitor's state (checkpointed at each
 //! event and once a minute of monitored time) and the configuration committed over the
@@ -13,10 +13,7 @@
 //! ran), then the state under it (numbering after the newest event stored), the event
 //! window fed from the queue, from its oldest unacknowledged event on.
 
-use core::mem::MaybeUninit;
-use core::ptr::addr_of_mut;
-
-use crate::ram_flash::{RamFlash, SECTOR};
+use crate::flash::{self, Board, SECTOR};
 use misalign::Estimator;
 use misalign::modbus::{BootSource, IMAGE_LEN, Server, StorageStatus, Stored};
 use misalign::monitor::{Event, Monitor, MonitorState};
@@ -43,13 +40,13 @@ fn cut(_: Op) {}
 fn uncut() {}
 
 /// The store's region (the state's and the configuration's records).
-const STORE_SIZE: usize = 4 * SECTOR;
+pub const STORE_SIZE: usize = 4 * SECTOR;
 /// The event queue's region.
-const EVENTS_SIZE: usize = 2 * SECTOR;
+pub const EVENTS_SIZE: usize = 2 * SECTOR;
 /// The periodic checkpoint's interval (s of monitored time).
 const INTERVAL_S: u32 = 60;
 
-type Flash = BlockingFlash<RamFlash>;
+type Flash = BlockingFlash<Board>;
 const STATE_BUF: usize = Store::<Flash, 0>::buffer_len::<MonitorState>();
 const IMAGE_BUF: usize = Store::<Flash, 0>::buffer_len::<ConfigImage<IMAGE_LEN>>();
 /// The store's buffer: the larger of its two records'.
@@ -59,16 +56,6 @@ const BUF: usize = if STATE_BUF > IMAGE_BUF {
     IMAGE_BUF
 };
 const EVENT_BUF: usize = EventQueue::<Flash, Event, 0>::buffer_len();
-
-#[unsafe(link_section = ".uninit.misalign_node_store")]
-static mut STORE: MaybeUninit<[u8; STORE_SIZE]> = MaybeUninit::uninit();
-#[unsafe(link_section = ".uninit.misalign_node_events")]
-static mut EVENTS: MaybeUninit<[u8; EVENTS_SIZE]> = MaybeUninit::uninit();
-/// [`ERASED`] once the two regions were erased at the first power-on: QEMU starts
-/// with RAM of zeros, where a new part's flash comes erased.
-#[unsafe(link_section = ".uninit.misalign_node_erased")]
-static mut FIRST_POWER_ON: MaybeUninit<u32> = MaybeUninit::uninit();
-const ERASED: u32 = 0x4552_4153;
 
 /// The node's storage, and what it last told the server.
 pub struct Persist {
@@ -89,37 +76,9 @@ impl Persist {
     /// The two regions, opened once at boot; the event queue read through. `None` on
     /// a flash error.
     pub fn open() -> Option<Self> {
-        // SAFETY: the only references to the two statics, taken once per boot (`node`
-        // calls this once, before its loop); u8 holds any bit pattern, and the RAM is
-        // initialised memory on the target (what the previous boot left, or the
-        // power-on contents).
-        let (store, events) = unsafe {
-            (
-                &mut *addr_of_mut!(STORE).cast::<[u8; STORE_SIZE]>(),
-                &mut *addr_of_mut!(EVENTS).cast::<[u8; EVENTS_SIZE]>(),
-            )
-        };
-        // SAFETY: a u32 of RAM, kept across a reset, any bit pattern valid; read and
-        // written volatile, as memory the compiler cannot know (what the last boot
-        // left).
-        let marker = addr_of_mut!(FIRST_POWER_ON).cast::<u32>();
-        if unsafe { marker.read_volatile() } != ERASED {
-            store.fill(0xFF);
-            events.fill(0xFF);
-            // SAFETY: as above.
-            unsafe { marker.write_volatile(ERASED) };
-        }
-        let store = Store::new(
-            BlockingFlash(RamFlash::new(store, None)),
-            0..STORE_SIZE as u32,
-            INTERVAL_S,
-        )
-        .ok()?;
-        let mut events = EventQueue::new(
-            BlockingFlash(RamFlash::new(events, None)),
-            0..EVENTS_SIZE as u32,
-        )
-        .ok()?;
+        let (store, events) = flash::regions()?;
+        let store = Store::new(BlockingFlash(store), 0..STORE_SIZE as u32, INTERVAL_S).ok()?;
+        let mut events = EventQueue::new(BlockingFlash(events), 0..EVENTS_SIZE as u32).ok()?;
         let found = block_on(events.open()).ok()?;
         defmt::println!(
             "storage: {=u32} events kept, acknowledged through {=?}, region erased {=bool}",

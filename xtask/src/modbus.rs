@@ -7,12 +7,15 @@
 //!   `tests/modbus/` against it: the node on its own samples (the built-in scenario;
 //!   every register equal, word for word, to this host's replay of the same samples
 //!   through `misalign::modbus::Server`), then the node on a master's samples (every
-//!   event read back across the event window's wrap); and on the Cortex-M4F the node
-//!   with flash (feature `modbus-flash`) across a reset through QEMU's monitor
-//!   (`tests/modbus/test_reset.py`: the committed configuration and the unacknowledged
-//!   events back), and a test build of it through power cuts at points of a commit, an
-//!   event push and an acknowledgement (feature `_power-cut`,
-//!   `tests/modbus/test_power_cut.py`; `MODBUS_POWER_CUT_ALL=1`: at every point). On
+//!   event read back across the event window's wrap); and on both cores the node with
+//!   flash (feature `modbus-flash`: RAM a reset keeps on the Cortex-M4F, the
+//!   micro:bit's flash through its NVMC on the Cortex-M0) across a reset through QEMU's
+//!   monitor (`tests/modbus/test_reset.py`: the committed configuration and the
+//!   unacknowledged events back), and a test build of it through power cuts at points
+//!   of a commit, an event push and an acknowledgement (feature `_power-cut`,
+//!   `tests/modbus/test_power_cut.py`; `MODBUS_POWER_CUT_ALL=1`: at every point), each
+//!   printing the RAM it took (statics, and the deepest stack read through QEMU's
+//!   monitor). On
 //!   the Cortex-M4F, tools/commission.py also commissions the node over a serial line
 //!   (serial0 on a pseudo-terminal, `tests/modbus/test_serial.py`). pymodbus, pyserial
 //!   and pytest, pinned, in a virtual environment under `target/modbus-venv`.
@@ -393,19 +396,19 @@ fn tests(boards: bool) -> Result<(), String> {
         .iter()
         .flat_map(|id| [false, true].map(|external| Node::on(cpu(id), external)))
         .collect();
-    // With flash, across a reset: on the Cortex-M4F (the M0's 16 KiB of RAM do not
-    // hold the node's stack beside the 6 KiB of flash regions: docs/firmware.md).
-    nodes.push(Node {
-        stored: true,
-        ..Node::on(cpu("cortex-m4f"), true)
-    });
-    // The same with power cuts at points of a commit, an event push and an
-    // acknowledgement (a test build).
-    nodes.push(Node {
-        stored: true,
-        cut: true,
-        ..Node::on(cpu("cortex-m4f"), true)
-    });
+    // With flash, across a reset, and a test build of it through power cuts at points
+    // of a commit, an event push and an acknowledgement: on the Cortex-M4F (flash
+    // emulated in RAM a reset keeps) and the Cortex-M0 (the micro:bit's flash, through
+    // its NVMC; examples/firmware/flash.rs).
+    for id in ["cortex-m4f", "cortex-m0"] {
+        for cut in [false, true] {
+            nodes.push(Node {
+                stored: true,
+                cut,
+                ..Node::on(cpu(id), true)
+            });
+        }
+    }
     if boards {
         nodes.extend(OTHER_BOARDS.map(|(id, machine, memory_x)| Node {
             machine,
@@ -517,9 +520,20 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         )
         .status()
         .map_err(|e| format!("pytest: {e}"))?;
+    // The node's RAM once the tests ran, read through the monitor before it stops.
+    let ram = monitor.map(|m| ram_used(&elf, m));
     drop(booted);
     if !status.success() {
         return Err(format!("pytest {}: {status}", tests.join(" ")));
+    }
+    match ram {
+        Some(Ok((statics, stack, board))) => println!(
+            "  RAM: {statics} B of statics + {stack} B of stack (the deepest since the node's \
+             last boot) = {} B of the board's {board} B",
+            statics + stack
+        ),
+        Some(Err(e)) => return Err(format!("the node's RAM not read: {e}")),
+        None => {}
     }
     if node.external && !node.stored {
         let compared = host::compare_events(crate::node::core(fpu)?, &host::scenario(), &file)?;
@@ -529,6 +543,61 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         );
     }
     Ok(())
+}
+
+/// The RAM the node in QEMU takes (bytes): its statics (llvm-size), the deepest stack
+/// it used since its last boot, and the board's RAM. The stack is read through QEMU's
+/// human monitor on 127.0.0.1:`monitor` (`xp`): the self-test paints the stack below
+/// its frame at each boot (`misalign_harness::support::stack`), and the node's frames
+/// reach deeper than the self-test's, so every word written since is counted.
+fn ram_used(elf: &Path, monitor: u16) -> Result<(u64, u64, u64), String> {
+    use std::io::{Read, Write};
+    const PAINT: &str = "0xcccccccc";
+    let sections = cross::Sections::of(&crate::tools::llvm_tool("llvm-size")?, elf)?;
+    let nm = Command::new(crate::tools::llvm_tool("llvm-nm")?)
+        .arg(elf)
+        .output()
+        .map_err(|e| format!("llvm-nm: {e}"))?;
+    let symbol = |name: &str| {
+        String::from_utf8_lossy(&nm.stdout)
+            .lines()
+            .find_map(|l| {
+                let f: Vec<&str> = l.split_whitespace().collect();
+                (f.len() == 3 && f[2] == name).then(|| u64::from_str_radix(f[0], 16).ok())?
+            })
+            .ok_or_else(|| format!("{}: no symbol {name}", elf.display()))
+    };
+    // cortex-m-rt's: the stack's top (the RAM's end) and its lowest address.
+    let (top, bottom) = (symbol("_stack_start")?, symbol("_stack_end")?);
+    // cortex-m-rt links .data at the RAM's origin.
+    let origin = sections.addr(".data").unwrap_or(bottom);
+    let mut conn = std::net::TcpStream::connect(("127.0.0.1", monitor))
+        .map_err(|e| format!("QEMU's monitor: {e}"))?;
+    conn.set_read_timeout(Some(Duration::from_secs(20)))
+        .map_err(|e| e.to_string())?;
+    let words = (top - bottom) / 4;
+    write!(conn, "xp /{words}xw {bottom:#x}\nquit\n").map_err(|e| e.to_string())?;
+    let mut text = String::new();
+    // QEMU closes the connection at `quit`, after the dump.
+    conn.read_to_string(&mut text)
+        .map_err(|e| format!("QEMU's monitor: {e}"))?;
+    let values: Vec<String> = text
+        .lines()
+        .filter_map(|l| l.split_once(": ").map(|(_, rest)| rest.to_string()))
+        .flat_map(|rest| {
+            rest.split_whitespace()
+                .map(str::to_string)
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    if values.len() as u64 != words {
+        return Err(format!(
+            "QEMU's monitor dumped {} words of {words}",
+            values.len()
+        ));
+    }
+    let painted = values.iter().take_while(|w| w.as_str() == PAINT).count() as u64;
+    Ok((sections.ram(), top - bottom - 4 * painted, top - origin))
 }
 
 /// `--serve PORT [--target TRIPLE]`: the node on its own samples until killed.
