@@ -5,13 +5,14 @@
 //! across a system reset on the MPS2 boards.
 //!
 //! Two regions: a [`Store`] of 4 KiB holding the monitor's state (checkpointed at each
-//! event and once a minute of monitored time) and the configuration committed over the
-//! bus (`ConfigImage`, written once per commit or switch of latching or the samples'
-//! source); an [`EventQueue`] of 2 KiB holding every event until a master
-//! acknowledges it (`event_ack`). The answer to a master's write waits until what it
-//! changed is stored (`Server::stored`). At boot: the committed configuration restored (`config_source` says which
-//! ran), then the state under it (numbering after the newest event stored), the event
-//! window fed from the queue, from its oldest unacknowledged event on.
+//! event, when a master reset the statistics, and once a minute of monitored time) and
+//! the configuration committed over the bus (`ConfigImage`, written once per commit or
+//! switch of latching or the samples' source); an [`EventQueue`] of 2 KiB holding every
+//! event until a master acknowledges it (`event_ack`). The answer to a master's write
+//! waits until what it changed is stored (`Server::stored`). At boot: the committed
+//! configuration restored (`config_source` says which ran), then the state under it
+//! (numbering after the newest event stored), the event window fed from the queue, from
+//! its oldest unacknowledged event on.
 
 use crate::flash::{self, Board, SECTOR};
 use misalign::Estimator;
