@@ -48,6 +48,8 @@ pub const IMAGE_VERSION: u8 = 2;
 mod flags {
     pub const SCENE: u8 = 1;
     pub const EXTERNAL: u8 = 2;
+    /// Bits 2-3: 0 in every image.
+    pub const RESERVED: u8 = 0x0C;
     pub const LATCHING_SHIFT: u8 = 4;
 }
 
@@ -814,7 +816,7 @@ impl<E: Estimator> Commissioning<E> {
         let (&[version, flags], rest) = image.split_first_chunk::<2>()?;
         let switches = match version {
             1 if flags <= flags::SCENE => None,
-            IMAGE_VERSION if flags & 0x0C == 0 => Some(Switches {
+            IMAGE_VERSION if flags & flags::RESERVED == 0 => Some(Switches {
                 latching: AlarmSet::from_bits(flags >> flags::LATCHING_SHIFT),
                 external: flags & flags::EXTERNAL != 0,
             }),

@@ -125,6 +125,16 @@ class Feeder:
         return frames
 
 
+def answered(request):
+    """Whether a write planned to be cut was answered without an exception (not lost
+    to the cut)."""
+    try:
+        r = request()
+    except Exception:  # noqa: BLE001 (the answer lost to the cut)
+        return False
+    return r is None or not r.isError()
+
+
 def unlock(client):
     assert not write(client, "unlock", code()).isError()
 
@@ -175,17 +185,13 @@ def test_a_commit_cut_anywhere_leaves_the_old_or_the_new_configuration(client):
         assert new != old
         plan("commit", n)
         frames = frames_now(client)
-        answered = False
-        try:
-            answered = not write(client, "command", 1).isError()
-        except Exception:  # noqa: BLE001 (the answer lost to the cut)
-            pass
+        answer = answered(lambda: write(client, "command", 1))
         cut = settled(client, frames)
         if cut is None:
             return None
         active = view(client, "active")
         assert active in (old, new), f"cut after {n} points: neither configuration"
-        assert not answered or active == new, f"cut after {n} points: answered, yet not in force"
+        assert not answer or active == new, f"cut after {n} points: answered, yet not in force"
         assert get(client, "config_source") == 1
         assert cut or active == new, f"the commit completed before point {n}, yet is not in force"
         return cut
@@ -228,18 +234,13 @@ def test_an_acknowledgement_cut_anywhere_brings_back_no_acknowledged_event(clien
         k = seq(before[0])
         plan("ack", n)
         frames = frames_now(client)
-        answered = False
-        try:
-            Master(client, regmap).write(ack_address(), u32_words(k))
-            answered = True
-        except Exception:  # noqa: BLE001 (the answer lost to the cut)
-            pass
+        answer = answered(lambda: Master(client, regmap).write(ack_address(), u32_words(k)))
         cut = settled(client, frames)
         if cut is None:
             return None
         durable = get_input(client, "event_acked")
         assert durable in (old, k), f"cut after {n} points: acknowledged through {durable}"
-        assert not answered or durable == k, f"cut after {n} points: answered, yet not on flash"
+        assert not answer or durable == k, f"cut after {n} points: answered, yet not on flash"
         after = stored_events(client, regmap)
         kept = before if durable == NONE else [e for e in before if seq(e) > durable]
         assert after == kept, f"cut after {n} points"
