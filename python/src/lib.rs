@@ -817,9 +817,9 @@ fn thresholds(
 /// Where the reference's time goes per row, on one thread, for the demo scene over
 /// the given loads (N) and angles (rad): ns per row of the reference's ellipse shape
 /// (k', m, n from theta, eqs 4-6), its critical angle (phi0 at the load, eqs 18, 30),
-/// its whole elliptic solution; of the fast path the batch takes
-/// (`reference::fast::Prepared::estimate`: d/b, F, phi0, flags); and the batch (the
-/// fast path plus writing the columns).
+/// its whole elliptic solution; of the fast path called row by row
+/// (`reference::fast::Prepared::estimate`: d/b, F, phi0, flags; the batch takes it
+/// eight rows at a time); and the batch (the fast path plus writing the columns).
 #[pyfunction]
 fn reference_cost<'py>(
     py: Python<'py>,

@@ -302,7 +302,15 @@ fn put_reference(
 
 pub(super) fn reference(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) -> usize {
     let details = out.details.is_some();
-    let prepare = |s: &Scene| Ok((*s, reference::fast::Prepared::new(s, inputs.choice)));
+    // With details every row is the reference's: no fast path to prepare.
+    let prepare = |s: &Scene| {
+        let fast = if details {
+            None
+        } else {
+            reference::fast::Prepared::new(s, inputs.choice)
+        };
+        Ok((*s, fast))
+    };
     let mut cache = Cache::new();
     let mut bad = 0;
     let mut start = 0;
@@ -340,9 +348,7 @@ pub(super) fn reference(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) ->
         let (load, phi) = (inputs.load.at(i), inputs.phi.at(i));
         let answer = match cache.get(inputs, i, prepare) {
             Ok((scene, fast)) => {
-                let answer = fast
-                    .filter(|_| !details)
-                    .and_then(|f| f.estimate(load, phi));
+                let answer = fast.and_then(|f| f.estimate(load, phi));
                 reference_row(scene, answer, load, phi, inputs.choice)
             }
             Err(e) => Err(*e),

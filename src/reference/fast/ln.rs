@@ -33,7 +33,7 @@ const fn table() -> [(f64, f64); N] {
         let lo = f64::from_bits(OFF + ((i as u64) << 45));
         let hi = f64::from_bits(OFF + ((i as u64 + 1) << 45));
         let inverse = 2.0 / (lo + hi);
-        t[i] = (inverse, -ln_near_one(inverse));
+        t[i] = (inverse, -ln_by_atanh(inverse));
         i += 1;
     }
     t
@@ -41,7 +41,7 @@ const fn table() -> [(f64, f64); N] {
 
 /// `ln y` for y in [0.7, 1.5] by `2 atanh(u)`, `u = (y - 1)/(y + 1)`, `|u| < 0.21`:
 /// 24 terms (the rest below `u^49 < 1e-33`).
-const fn ln_near_one(y: f64) -> f64 {
+const fn ln_by_atanh(y: f64) -> f64 {
     let u = (y - 1.0) / (y + 1.0);
     let u2 = u * u;
     let mut sum = 0.0;

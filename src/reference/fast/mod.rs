@@ -241,7 +241,10 @@ impl Prepared {
         // p0 = 3 P^(1/3) / (2 pi m n v^2), so p0 / G = |phi| / (2 mu (d/b)) (eq 15):
         // p0 / G > PRESSURE_LIMIT where |phi| > PRESSURE_LIMIT 2 mu (d/b).
         let pressure = self.pressure_per_slip * s;
+        // Within the guard of pi/2 the reference may find no critical angle (phi0 not
+        // an angle between two axes) where this one finds one: the reference answers.
         if !(phi0 <= FRAC_PI_2
+            && clear_of(phi0, FRAC_PI_2)
             && clear_of(s, 1.0)
             && clear_of(phi0, ANGLE_LIMIT)
             && clear_of(abs_phi, pressure)
