@@ -258,7 +258,8 @@ pub fn threshold_plan<E: Estimator>(
     let stop_load = config.stop_load;
     let (load_max, note) = match range {
         PlanRange::UpTo(top) => {
-            if !(top > stop_load) {
+            // NaN is not above it either.
+            if top.partial_cmp(&stop_load) != Some(core::cmp::Ordering::Greater) {
                 return Err(PlanError::NotAboveStop {
                     load_max: top,
                     stop_load,
@@ -276,7 +277,8 @@ pub fn threshold_plan<E: Estimator>(
         PlanRange::Trace(None) => return Err(PlanError::NoLoad),
         PlanRange::Trace(Some(quantile)) => {
             let top = quantile * 1.2;
-            if !(top > stop_load) {
+            // NaN is not above it either.
+            if top.partial_cmp(&stop_load) != Some(core::cmp::Ordering::Greater) {
                 return Err(PlanError::NotAboveStop {
                     load_max: top,
                     stop_load,

@@ -99,11 +99,11 @@ struct Options {
     #[arg(long, value_enum, default_value_t = Counts::Exact)]
     counts: Counts,
     /// With --counts adc: N per load count [default: 0.01].
-    #[arg(long, value_parser = lsb)]
+    #[arg(long, value_parser = lsb, allow_hyphen_values = true)]
     load_lsb: Option<f64>,
     /// With --counts adc: rad per angle count [default: the finest angle the scene's
     /// tables allow, at least 1e-10].
-    #[arg(long, value_parser = lsb)]
+    #[arg(long, value_parser = lsb, allow_hyphen_values = true)]
     angle_lsb: Option<f64>,
 }
 
