@@ -412,8 +412,13 @@ fn replay<E: Estimator + Copy>(
         let _ = writeln!(io.err, "wrote {}", path.display());
     }
     if let (Some(path), Some(plot_path)) = (&args.thresholds, &args.plot) {
-        let top = loads.as_ref().and_then(Quantile::value).unwrap_or(0.0);
-        let table = output::threshold_rows(&core, &config, top * 1.2);
+        let range = output::PlanRange::Trace(loads.as_ref().and_then(Quantile::value));
+        let plan = output::threshold_plan(&core, &config, range)
+            .map_err(|e| format!("--thresholds: {e}"))?;
+        if let Some(note) = &plan.note {
+            let _ = writeln!(io.err, "monitor: --thresholds: {note}");
+        }
+        let table = plan.rows;
         std::fs::write(path, output::thresholds_csv(&table))?;
         let _ = writeln!(io.err, "wrote {}", path.display());
         let svg = plot_path.with_file_name(format!(
