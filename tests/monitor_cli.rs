@@ -438,3 +438,27 @@ fn the_planners_range_is_refused_or_its_change_said() {
     let last = table.lines().last().unwrap();
     assert!(last.starts_with("50000,"), "{last}");
 }
+
+/// `--thresholds` alone writes the planner's table (the web console and the Python
+/// package give the table without a figure too), the same bytes as beside a plot.
+#[test]
+fn the_thresholds_table_needs_no_plot() {
+    let dir = trace_file("alone-dir-marker", b"")
+        .parent()
+        .unwrap()
+        .to_owned();
+    let out = |name: &str| dir.join(name).display().to_string();
+    let alone = out("alone-thresholds.csv");
+    let (code, _, err) = monitor(&["--thresholds", &alone]);
+    assert_eq!(code, 0, "{err}");
+    let with_plot = out("with-plot-thresholds.csv");
+    let (code, _, err) = monitor(&["--plot", &out("with-plot.svg"), "--thresholds", &with_plot]);
+    assert_eq!(code, 0, "{err}");
+    let table = std::fs::read(&alone).unwrap();
+    assert!(
+        table.starts_with(b"P,"),
+        "{}",
+        String::from_utf8_lossy(&table)
+    );
+    assert_eq!(table, std::fs::read(&with_plot).unwrap());
+}
