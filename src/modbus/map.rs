@@ -7,6 +7,7 @@
 //! samples). A 32-bit value takes two registers, the high word first.
 
 use super::config::{ConfigField, Reg};
+use super::div::div_rem;
 use crate::monitor::annunciation::AlarmSet;
 use core::fmt;
 
@@ -1023,27 +1024,6 @@ impl Served {
     }
 }
 
-/// `n / d` and `n % d` (`None` for `d` 0) by shifts and subtractions, 16 steps: no
-/// division routine linked into a node without a divider (the Cortex-M0), for the few
-/// divisions by a block's stride, none of them on a poll's path. Out of line: one
-/// copy for its three callers.
-#[inline(never)]
-pub(crate) fn div_rem(n: u16, d: u16) -> Option<(u16, u16)> {
-    if d == 0 {
-        return None;
-    }
-    let (mut q, mut r) = (0u16, 0u32);
-    for i in (0..16).rev() {
-        r = r << 1 | u32::from(n >> i & 1);
-        q <<= 1;
-        if r >= u32::from(d) {
-            r -= u32::from(d);
-            q |= 1;
-        }
-    }
-    Some((q, r as u16))
-}
-
 /// An address located in the map.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Located {
@@ -1165,31 +1145,6 @@ mod tests {
                 );
                 let slots: std::vec::Vec<Slot> = b.fields.iter().map(Slot::of).collect();
                 assert_eq!(sb.fields, &slots[..], "{}", b.prefix);
-            }
-        }
-    }
-
-    #[test]
-    fn div_rem_is_division() {
-        for n in 0..=u16::MAX {
-            for d in [
-                0,
-                1,
-                2,
-                3,
-                6,
-                7,
-                11,
-                25,
-                255,
-                256,
-                1000,
-                0x7FFF,
-                0x8000,
-                u16::MAX,
-            ] {
-                let expected = n.checked_div(d).zip(n.checked_rem(d));
-                assert_eq!(div_rem(n, d), expected, "{n} {d}");
             }
         }
     }

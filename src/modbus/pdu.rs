@@ -3,10 +3,14 @@
 //! exceptions, broadcasts.
 
 use super::config::{ConfigField, Reg};
+use super::div::div_rem;
 use super::exception::Exception;
-use super::map::{Access, Field, Located, Served, SlotBlock, Table, div_rem};
-use super::{ADU_MAX, Core, crc, ident};
+use super::map::{Access, Field, Located, Served, SlotBlock, Table};
+use super::rtu::ADU_MAX;
+use super::state::Core;
+use super::{crc, ident};
 use crate::Estimator;
+use crate::monitor::annunciation::AlarmSet;
 
 /// Most bits one read returns.
 const READ_BITS_MAX: u16 = 2000;
@@ -571,7 +575,7 @@ impl<E: Estimator> Core<E> {
         // Guarded by the caller (`protected_bit`).
         let latching = self.annunciator.latching();
         match field {
-            Field::Acknowledge if on => self.annunciator.acknowledge(super::AlarmSet::ALL),
+            Field::Acknowledge if on => self.annunciator.acknowledge(AlarmSet::ALL),
             Field::Latching(which) => self.switch(latching.with(which, on), self.external),
             Field::ExternalSamples => self.switch(latching, on),
             _ => {}
@@ -580,7 +584,7 @@ impl<E: Estimator> Core<E> {
 
     /// Latching and the samples' source set (the guard passed); a change is kept as a
     /// commit is (`Server::take_committed`), a write of the same values stores nothing.
-    fn switch(&mut self, latching: super::AlarmSet, external: bool) {
+    fn switch(&mut self, latching: AlarmSet, external: bool) {
         if (latching, external) != (self.annunciator.latching(), self.external) {
             self.annunciator.set_latching(latching);
             self.external = external;
@@ -589,7 +593,7 @@ impl<E: Estimator> Core<E> {
     }
 
     fn write_word(&mut self, field: Field, v: u32) -> Result<(), Exception> {
-        let bits = super::AlarmSet::from_bits(v as u8);
+        let bits = AlarmSet::from_bits(v as u8);
         let c = &mut self.commissioning;
         match field {
             Field::EventFrom => self.events.from = v,
@@ -650,7 +654,7 @@ mod tests {
     fn every_read_of_bits_is_each_bits_value() {
         let config = ServerConfig {
             external_samples: true,
-            latching: super::super::AlarmSet::ALARM,
+            latching: super::AlarmSet::ALARM,
             ..ServerConfig::default()
         };
         let mut server = server(config);
