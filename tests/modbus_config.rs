@@ -1084,7 +1084,14 @@ fn every_configuration_write_needs_the_unlock() {
     coil(&mut s, 0, true).unwrap();
     write1(&mut s, at("acknowledge_alarms"), 15).unwrap();
     write(&mut s, at("event_from"), &[0, 0]).unwrap();
-    write(&mut s, at("event_ack"), &[0xFFFF, 0xFFFF]).unwrap();
+    // An acknowledgement needs a number given (03 before any event), not the code.
+    assert_eq!(write(&mut s, at("event_ack"), &[0, 0]), Err(3));
+    let mut t = 0;
+    while s.monitor().next_event_seq() == 0 {
+        s.process(Sample::new(t, 2e3, 1e-4).with_speed(2.0));
+        t += 1000;
+    }
+    write(&mut s, at("event_ack"), &[0, 0]).unwrap();
     assert!(!s.unlocked());
 
     // Unlocked: taken, each renewing the unlock as a staged write does.

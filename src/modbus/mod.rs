@@ -217,7 +217,8 @@ impl<E: Estimator> Server<E> {
             return Err(ServerConfigError::UnitId);
         }
         let pending = monitor.pending_events() as u32;
-        let from = monitor.next_event_seq().wrapping_sub(pending);
+        let monitor_next = monitor.next_event_seq();
+        let from = monitor_next.wrapping_sub(pending);
         let model_name = if config.ident.model_name.is_empty() {
             core::any::type_name::<E>()
         } else {
@@ -233,7 +234,7 @@ impl<E: Estimator> Server<E> {
                 ident: config.ident,
                 model_name,
                 annunciator: Annunciator::new(config.latching),
-                events: EventWindow::new(from),
+                events: EventWindow::new(from, monitor_next),
                 external: config.external_samples,
                 last_time_ms: 0,
                 counters: Counters::default(),
@@ -439,6 +440,7 @@ impl<E: Estimator> Server<E> {
         let w = &mut self.core.events;
         w.stored = true;
         if let Some(f) = first {
+            w.know(f, next);
             w.from = f;
             w.backlog = Some(f).filter(|&f| f != next);
         }
@@ -469,7 +471,8 @@ impl<E: Estimator> Server<E> {
     /// holds none at or after it, call [`end_backlog`](Self::end_backlog).
     pub fn wanted_event(&self) -> Option<u32> {
         let w = &self.core.events;
-        w.backlog.filter(|_| w.has_room())
+        let next = self.core.monitor.next_event_seq();
+        w.backlog.filter(|_| w.has_room(next))
     }
 
     /// Store-and-forward: an event read from the store, the first at or after

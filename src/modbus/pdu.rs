@@ -547,10 +547,7 @@ impl<E: Estimator> Core<E> {
             Field::EventFrom => true,
             // Only numbers already given: a later one would acknowledge an event not
             // yet raised.
-            Field::EventAck => {
-                let newest = self.monitor.next_event_seq().wrapping_sub(1);
-                super::events::at_or_after(newest, v)
-            }
+            Field::EventAck => self.events.given(v, self.monitor.next_event_seq()),
             Field::Commission(Reg::Unlock | Reg::Command) if !alone => {
                 return Err(Exception::IllegalDataAddress);
             }
@@ -599,9 +596,7 @@ impl<E: Estimator> Core<E> {
             Field::EventFrom => self.events.from = v,
             Field::EventAck => {
                 self.ack = Some(v);
-                if super::events::at_or_after(v, self.events.from) {
-                    self.events.from = v.wrapping_add(1);
-                }
+                self.events.acknowledge(v, self.monitor.next_event_seq());
             }
             Field::AcknowledgeAlarms => self.annunciator.acknowledge(bits),
             Field::LatchingAlarms => self.switch(bits, self.external),

@@ -75,7 +75,7 @@ impl<E: Estimator> Core<E> {
         while !self.events.stored
             && let Some(e) = self.monitor.pop_event()
         {
-            self.events.push(e);
+            self.events.push(e, self.monitor.next_event_seq());
         }
         self.annunciator.update(AlarmSet::of(&self.monitor));
     }

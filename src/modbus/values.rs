@@ -331,7 +331,7 @@ impl<E: Estimator> Core<E> {
             Field::Indicated(w) => bit(a.indicated(), w),
             Field::Unacknowledged(w) => bit(a.unacknowledged(), w),
             Field::Running => u32::from(m.state() != RiskState::Stopped),
-            Field::EventAvailable => u32::from(self.events.slot(0).is_some()),
+            Field::EventAvailable => u32::from(self.events.slot(0, m.next_event_seq()).is_some()),
             Field::Status => self.status(),
             Field::Alarms => {
                 u32::from(a.indicated().bits())
@@ -382,9 +382,15 @@ impl<E: Estimator> Core<E> {
             Field::BusDiscarded => self.bus(|c| c.framing.discarded),
             Field::BusExceptions => self.bus(|c| c.exceptions),
             Field::EventFirst => self.events.first(m.next_event_seq()),
-            Field::EventCount => u32::from(self.events.unread(super::map::EVENT_SLOTS)),
+            Field::EventCount => u32::from(
+                self.events
+                    .count(super::map::EVENT_SLOTS, m.next_event_seq()),
+            ),
             Field::EventsMissed => self.events.missed(m.next_event_seq()),
-            Field::Event(f) => self.events.slot(record).map_or(0, |e| event_value(e, f)),
+            Field::Event(f) => self
+                .events
+                .slot(record, m.next_event_seq())
+                .map_or(0, |e| event_value(e, f)),
             Field::EventFrom => self.events.from,
             Field::UnitId => u32::from(self.unit),
             Field::MapVersion => u32::from(super::map::MAP_VERSION),
