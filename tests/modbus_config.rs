@@ -5,7 +5,7 @@
 //! every word erased of a commit's record.
 
 use misalign::float::Auto;
-use misalign::modbus::map::{Access, SAMPLES_ADDRESS, SCENE_ADDRESS, Table, TableMap};
+use misalign::modbus::map::{Access, Domain, SAMPLES_ADDRESS, SCENE_ADDRESS, Table, TableMap};
 use misalign::modbus::{
     AlarmSet, BootSource, DEFAULT_UNLOCK_CODE, IMAGE_LEN, LOCKOUT_S, Server, ServerConfig, Stored,
     UNLOCK_TIMEOUT_S, WRONG_CODES_MAX, command, crc16, reason, staged,
@@ -1138,4 +1138,58 @@ fn external_samples_need_no_code() {
     write(&mut s, SAMPLES_ADDRESS, &record).unwrap();
     assert_eq!(s.monitor().statistics().samples(), 1);
     assert_eq!(s.commissioning().refused, 0);
+}
+
+/// Every writable holding register refuses what its domain (the map's, the CSV's
+/// `min` and `max`) leaves out: at the write (exception 03) or at the commit (refused,
+/// its reason in `commit_error`), from the default configuration (every option on);
+/// and takes its bounds at the write, but where the value has a meaning of its own:
+/// `event_ack` takes the numbers given only (the event window's tests), `unlock` the
+/// site's code, `command` a commit with something staged.
+#[test]
+fn every_register_refuses_what_its_domain_leaves_out() {
+    let mut checked = 0;
+    for e in TableMap::of(Table::Holding).entries {
+        let (mut outside, mut bounds) = (Vec::new(), Vec::new());
+        match e.domain() {
+            Domain::ReadOnly | Domain::Any => continue,
+            Domain::Whole { min, max } => {
+                let top = if e.ty.words() == 2 { u32::MAX } else { 0xFFFF };
+                outside.extend(min.checked_sub(1));
+                outside.extend((max < top).then(|| max + 1));
+                bounds.extend([min, max]);
+            }
+            Domain::Finite { min, max } => {
+                outside.extend([f32::NAN, f32::INFINITY, f32::NEG_INFINITY].map(f32::to_bits));
+                if min > -f32::MAX {
+                    outside.push((min - 1e-30_f32.max(min.abs() * 1e-6)).to_bits());
+                }
+                bounds.extend([min.to_bits(), max.to_bits()]);
+            }
+        }
+        if matches!(e.name, "event_ack" | "unlock" | "command") {
+            bounds.clear();
+        }
+        for v in outside {
+            let mut s = server();
+            unlock(&mut s);
+            let refused = match put(&mut s, e.name, v) {
+                Err(x) => x == 3,
+                Ok(()) => cmd(&mut s, command::COMMIT) == Err(3),
+            };
+            assert!(refused, "{} = {v:#x} taken", e.name);
+            checked += 1;
+        }
+        for v in bounds {
+            let mut s = server();
+            unlock(&mut s);
+            assert_eq!(
+                put(&mut s, e.name, v),
+                Ok(()),
+                "{} = {v:#x} at the write",
+                e.name
+            );
+        }
+    }
+    assert!(checked > 40, "{checked}");
 }

@@ -336,7 +336,10 @@ fn event_from_at_a_number_never_given_shows_nothing() {
         let first = next.wrapping_sub(4);
         assert_eq!(window_from(&mut s, first), (first, 4, 0, true));
         // The window holds eight of the nine: the first one missed.
-        assert_eq!(window_from(&mut s, start), (start.wrapping_add(1), 4, 1, true));
+        assert_eq!(
+            window_from(&mut s, start),
+            (start.wrapping_add(1), 4, 1, true)
+        );
         assert_eq!(
             window_from(&mut s, next.wrapping_sub(1)),
             (next.wrapping_sub(1), 1, 0, true)
