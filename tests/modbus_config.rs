@@ -695,6 +695,43 @@ fn resetting_the_statistics_needs_the_unlock_and_keeps_state_and_events() {
     assert!(s.monitor().statistics().total_energy() > 0.0);
 }
 
+/// `events_dropped` (the monitor's queue and the event window) is a statistic: it
+/// starts afresh with the others, while the events' numbers go on.
+#[test]
+fn resetting_the_statistics_starts_events_dropped_afresh() {
+    let mut s = server();
+    let dropped = |s: &mut Server<Auto>| {
+        let e = TableMap::of(Table::Input)
+            .entries
+            .iter()
+            .find(|e| e.name == "events_dropped")
+            .unwrap();
+        let pdu = request(s, 4, &words_be(&[e.address, 2]));
+        u32::from_be_bytes([pdu[2], pdu[3], pdu[4], pdu[5]])
+    };
+    // A sensor fault every 40 s, cleared after the off-delay: an event in and one
+    // out, never read.
+    let mut i = 0u32;
+    let mut sample = |s: &mut Server<Auto>| {
+        let noise = (i % 7) as f32;
+        let load = if i % 40 == 39 { f32::NAN } else { 1e3 + noise };
+        s.process(Sample::new(i * 1000, load, 5e-5 + 1e-8 * noise).with_speed(2.0));
+        i += 1;
+    };
+    while s.monitor().next_event_seq() < 20 {
+        sample(&mut s);
+    }
+    assert!(dropped(&mut s) >= 12, "{}", dropped(&mut s));
+    unlock(&mut s);
+    cmd(&mut s, command::RESET_STATISTICS).unwrap();
+    assert_eq!(dropped(&mut s), 0);
+    assert_eq!(s.monitor().next_event_seq(), 20);
+    while s.monitor().next_event_seq() < 22 {
+        sample(&mut s);
+    }
+    assert_eq!(dropped(&mut s), 2, "counted again from 0");
+}
+
 fn at_coil(name: &str) -> u16 {
     TableMap::of(Table::Coil)
         .entries

@@ -604,7 +604,14 @@ impl<E: Estimator> Core<E> {
             Field::Staged(f) => c.write_staged(f, v, self.monitor.config()),
             Field::Commission(Reg::NewCode) => c.write_new_code(v as u16),
             Field::Commission(Reg::Unlock) => c.unlock(v as u16)?,
-            Field::Commission(Reg::Command) => c.command(v as u16, &mut self.monitor)?,
+            Field::Commission(Reg::Command) => {
+                c.command(v as u16, &mut self.monitor)?;
+                // The events lost count with the statistics (`events_dropped`): the
+                // window's share starts afresh with the monitor's.
+                if v == u32::from(super::config::command::RESET_STATISTICS) {
+                    self.events.dropped = 0;
+                }
+            }
             _ => {}
         }
         Ok(())
