@@ -86,7 +86,7 @@ impl EventWindow {
 
     /// `event_from`'s place: [`rank`](Self::rank), or the next number's for a
     /// number never given.
-    fn from_rank(&self, next: u32) -> u32 {
+    fn rank_of_from(&self, next: u32) -> u32 {
         self.rank(self.from, next)
             .unwrap_or_else(|| self.span(next))
     }
@@ -94,7 +94,7 @@ impl EventWindow {
     /// Whether `seq` is at or after `event_from` (to be read).
     fn unread(&self, seq: u32, next: u32) -> bool {
         self.rank(seq, next)
-            .is_some_and(|r| r >= self.from_rank(next))
+            .is_some_and(|r| r >= self.rank_of_from(next))
     }
 
     /// A master acknowledged the events through `seq` (a number given): `event_from`
@@ -193,7 +193,7 @@ impl EventWindow {
     /// `next` is the next event's sequence number.
     pub(crate) fn missed(&self, next: u32) -> u32 {
         let first = self.rank(self.first(next), next).unwrap_or(0);
-        first.saturating_sub(self.from_rank(next))
+        first.saturating_sub(self.rank_of_from(next))
     }
 }
 
