@@ -15,11 +15,11 @@ const SPAN_MAX: u32 = 1 << 31;
 /// The window.
 ///
 /// Sequence numbers count modulo 2^32, so that two numbers alone do not say which
-/// came first. Every comparison here is made through [`rank`](Self::rank): a number's
-/// place among the numbers given so far (from `base`, the oldest the window knows
-/// of, to the monitor's next one). A number never given, ahead of the next one or
-/// older than any given, has no place: as `event_from` it means "after the newest",
-/// and as `event_ack` it is refused.
+/// came first. Every comparison here is made by the distance back from the monitor's
+/// next number, within the numbers given so far ([`span`](Self::span): from `base`,
+/// the oldest the window knows of). A number never given, ahead of the next one or
+/// older than any given, has no place among them: as `event_from` it means "after
+/// the newest", and as `event_ack` it is refused.
 #[derive(Debug, Clone)]
 pub(crate) struct EventWindow {
     events: Deque<Event, EVENT_WINDOW>,
@@ -56,45 +56,59 @@ impl EventWindow {
         w
     }
 
-    /// How many numbers before `next` were given, as far as the window can tell.
+    /// How many numbers before `next` were given, as far as the window can tell (at
+    /// most [`SPAN_MAX`] once `base` followed `next`).
     fn span(&self, next: u32) -> u32 {
-        next.wrapping_sub(self.base).min(SPAN_MAX)
+        next.wrapping_sub(self.base)
     }
 
-    /// The place of `seq` among the numbers given before `next`, oldest first:
-    /// `0..span` for a number given, `span` for `next` itself, `None` for any other.
-    pub(crate) fn rank(&self, seq: u32, next: u32) -> Option<u32> {
-        let span = self.span(next);
-        let place = seq.wrapping_sub(next.wrapping_sub(span));
-        (place <= span).then_some(place)
+    /// `base` follows `next` within [`SPAN_MAX`]: called whenever new events came.
+    pub(crate) fn follow(&mut self, next: u32) {
+        if self.span(next) > SPAN_MAX {
+            self.base = next.wrapping_sub(SPAN_MAX);
+        }
     }
 
-    /// Whether `seq` was given before `next` (an event was numbered so).
+    /// Whether `seq` was given before `next` (an event was numbered so): at most
+    /// [`span`](Self::span) numbers back from `next`.
     pub(crate) fn given(&self, seq: u32, next: u32) -> bool {
-        self.rank(seq, next).is_some_and(|r| r < self.span(next))
+        next.wrapping_sub(seq).wrapping_sub(1) < self.span(next)
     }
 
     /// `seq` was given, or is `next`: the window's numbers reach back to it (a number
     /// from before a wrap, restored at start-up); and `base` follows `next` within
     /// [`SPAN_MAX`]. Called whenever `next` may have moved.
     pub(crate) fn know(&mut self, seq: u32, next: u32) {
-        if self.rank(seq, next).is_none() {
+        if next.wrapping_sub(seq) > self.span(next) {
             self.base = seq;
         }
-        self.base = next.wrapping_sub(self.span(next));
+        self.follow(next);
     }
 
-    /// `event_from`'s place: [`rank`](Self::rank), or the next number's for a
-    /// number never given.
-    fn rank_of_from(&self, next: u32) -> u32 {
-        self.rank(self.from, next)
-            .unwrap_or_else(|| self.span(next))
+    /// Whether `event_from` is a number given, or `next`: a place among the numbers.
+    fn event_from_placed(&self, next: u32) -> bool {
+        next.wrapping_sub(self.from) <= self.span(next)
     }
 
-    /// Whether `seq` is at or after `event_from` (to be read).
+    /// How many numbers from `event_from` up to `next` are to be read: none for an
+    /// `event_from` never given (it means "after the newest").
+    fn unread_span(&self, next: u32) -> u32 {
+        if self.event_from_placed(next) {
+            next.wrapping_sub(self.from)
+        } else {
+            0
+        }
+    }
+
+    /// Whether `seq` is at or after `event_from` and before `next` (to be read), given
+    /// the window's [`unread_span`](Self::unread_span).
+    fn unread_in(&self, seq: u32, unread_span: u32) -> bool {
+        seq.wrapping_sub(self.from) < unread_span
+    }
+
+    /// Whether `seq` is to be read.
     fn unread(&self, seq: u32, next: u32) -> bool {
-        self.rank(seq, next)
-            .is_some_and(|r| r >= self.rank_of_from(next))
+        self.unread_in(seq, self.unread_span(next))
     }
 
     /// A master acknowledged the events through `seq` (a number given): `event_from`
@@ -124,7 +138,8 @@ impl EventWindow {
         self.know(event.seq, next);
         if let Some(b) = self.backlog {
             let wanted = if from_store {
-                self.rank(event.seq, next) >= self.rank(b, next)
+                // As far back from `next` as `b` or less: at or after it.
+                next.wrapping_sub(event.seq) <= next.wrapping_sub(b)
             } else {
                 event.seq == b
             };
@@ -143,9 +158,9 @@ impl EventWindow {
     }
 
     /// Keeps `event`; a full window drops its oldest, counted when the master had
-    /// not read it yet. `next` is the next event's number.
+    /// not read it yet. `next` is the next event's number, which `base` has followed
+    /// ([`follow`](Self::follow)).
     pub(crate) fn push(&mut self, event: Event, next: u32) {
-        self.know(event.seq, next);
         if self.events.is_full()
             && let Some(old) = self.events.pop_front()
             && self.unread(old.seq, next)
@@ -162,10 +177,11 @@ impl EventWindow {
     #[inline(never)]
     pub(crate) fn slot(&self, i: u16, next: u32) -> Option<&Event> {
         let (older, newer) = self.events.as_slices();
+        let unread = self.unread_span(next);
         let mut left = i;
         for part in [older, newer] {
             for e in part {
-                if self.unread(e.seq, next) {
+                if self.unread_in(e.seq, unread) {
                     if left == 0 {
                         return Some(e);
                     }
@@ -192,8 +208,11 @@ impl EventWindow {
     /// Events from `from` to slot 0 that are lost (none from a number never given);
     /// `next` is the next event's sequence number.
     pub(crate) fn missed(&self, next: u32) -> u32 {
-        let first = self.rank(self.first(next), next).unwrap_or(0);
-        first.saturating_sub(self.rank_of_from(next))
+        if self.event_from_placed(next) {
+            self.first(next).wrapping_sub(self.from)
+        } else {
+            0
+        }
     }
 }
 
@@ -247,11 +266,12 @@ mod tests {
             for pushed in 0..3 * window {
                 let next = start.wrapping_add(pushed as u32);
                 let mut w = EventWindow::new(start, start);
+                // As the server does after each sample: `base` follows, then the
+                // new event.
                 for k in 0..pushed {
-                    w.push(
-                        event(start.wrapping_add(k as u32)),
-                        start.wrapping_add(k as u32 + 1),
-                    );
+                    let after = start.wrapping_add(k as u32 + 1);
+                    w.follow(after);
+                    w.push(event(start.wrapping_add(k as u32)), after);
                 }
                 // The window holds the last EVENT_WINDOW, from offset `held`.
                 let held = (pushed - window).max(0);

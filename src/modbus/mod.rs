@@ -420,6 +420,8 @@ impl<E: Estimator> Server<E> {
     /// start the conditioning and the trend afresh.
     pub fn resume(&mut self, state: &MonitorState) {
         self.core.monitor.resume(state);
+        let next = self.core.monitor.next_event_seq();
+        self.core.events.follow(next);
     }
 
     /// The monitor back, the server given up.

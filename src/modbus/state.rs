@@ -72,10 +72,13 @@ impl<E: Estimator> Core<E> {
     /// The monitor's queued events into the window (unless the application takes
     /// them: [`Server::store_events`](super::Server::store_events)); the alarms from its state.
     pub(super) fn drain(&mut self) {
+        // Every queued event is numbered already: `next` is after all of them.
+        let next = self.monitor.next_event_seq();
+        self.events.follow(next);
         while !self.events.stored
             && let Some(e) = self.monitor.pop_event()
         {
-            self.events.push(e, self.monitor.next_event_seq());
+            self.events.push(e, next);
         }
         self.annunciator.update(AlarmSet::of(&self.monitor));
     }
