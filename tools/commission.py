@@ -237,7 +237,9 @@ def commission(node, code, settings, scene, reset_statistics=False):
     # The switches as they were, put back if the run fails.
     switched = {name: node.read(name) for name, _, _ in settings if name in SWITCHES}
     unlock(node, code)
-    committed = False
+    # Once a commit applied the staged copy (and ended the unlock), a failure has
+    # nothing to put back; after it the node is unlocked again only to reset.
+    committed, unlocked = False, True
     try:
         for name, words, text in settings:
             x = node.write(name, words)
@@ -257,7 +259,7 @@ def commission(node, code, settings, scene, reset_statistics=False):
             if x is not None:
                 why = node.read("commit_error")[0]
                 raise Failed(f"commit refused: {REASONS.get(why, why)} (commit_error {why:#x})")
-            committed = True
+            committed, unlocked = True, False
             # What the node runs now.
             for name, words, _ in staged:
                 active = "active_" + name[len("config_"):]
@@ -270,16 +272,20 @@ def commission(node, code, settings, scene, reset_statistics=False):
                 # The commit ended the unlock; the code may be the one it committed.
                 new = [w[0] for n, w, _ in settings if n == "new_code"]
                 unlock(node, new[-1] if new else code)
+                unlocked = True
             x = node.write("command", [RESET_STATISTICS])
             if x is not None:
                 raise Failed(f"reset of the statistics: exception {x}")
-        node.write("command", [LOCK])
+        if unlocked:
+            node.write("command", [LOCK])
     except BaseException as e:
-        if committed:
-            failed = put_back(node, {})[1:]  # the lock only: the commit stands
-            e.add_note("the configuration was committed")
-        else:
+        failed = []
+        if not committed:
             failed = put_back(node, switched)
+        else:
+            e.add_note("the configuration was committed")
+            if unlocked:
+                failed = put_back(node, {})  # nothing staged to revert: the lock
         if failed:
             e.add_note("putting the node back failed (" + "; ".join(failed) + "): it locks "
                        "itself when the unlock times out")

@@ -236,10 +236,12 @@ def test_the_commissioning_tool_takes_what_an_engineer_planned(client, tmp_path)
                              "--config", str(config), "--thresholds", str(plan(other, other_scene)))
     assert status == 1 and "planned for another scene" in err, err
     events = tmp_path / "events.csv"
+    refusals = get(client, "refused_writes")
     status, out = commission(client, "--code", str(code()), "--scene", str(scene), "--core", core,
                              "--config", str(config), "--thresholds", str(table),
                              "--events", str(events))
     assert status == 0, out
+    assert get(client, "refused_writes") == refusals, "the tool wrote nothing the node refused"
     assert "thresholds planned for " in out and "events held" in out, out
     assert get(client, "active_on_delay") == 6000
     assert get(client, "active_warning") == f32(0.8)
@@ -327,8 +329,10 @@ def test_any_failure_after_the_unlock_puts_the_node_back(client):
 def test_a_switch_alone_is_written_without_a_commit(client):
     """`--set latching=N` alone: applied and kept, nothing to commit, the node locked."""
     latching = get(client, "latching")
+    refusals = get(client, "refused_writes")
     status, out = commission(client, "--code", str(code()), "--set", f"latching={latching ^ 5}")
     assert status == 0 and "switched: latching" in out, out
+    assert get(client, "refused_writes") == refusals
     assert get(client, "latching") == latching ^ 5 and get(client, "unlock") == 0
     assert get(client, "config_source") == 1
     status, out = commission(client, "--code", str(code()), "--set", f"latching={latching}")
@@ -357,10 +361,12 @@ def test_the_commissioning_tool_resets_the_statistics(client):
         assert status == 1 and ("config_warning" in err or "commit refused" in err), err
         assert samples_counted(client) == counted, value
         assert get(client, "unlock") == 0 and get(client, "staged") == 0
-    status, out = commission(client, "--code", str(code()), "--reset-statistics")
+    refusals = get(client, "refused_writes")
+    status, out = commission(client, "--code", str(code()), "--reset-statistics",
+                             "--set", "config_on_delay=6500")
     assert status == 0 and "statistics reset" in out, out
-    assert samples_counted(client) == 0
-    assert get(client, "unlock") == 0
+    assert samples_counted(client) == 0 and get(client, "active_on_delay") == 6500
+    assert get(client, "unlock") == 0 and get(client, "refused_writes") == refusals
 
 
 # Last: the lock-out lasts minutes of the node's time.
