@@ -25,7 +25,8 @@ import { Hx711, Ads1115, Tachometer } from './src/sensors.mjs';
 const CYCLE_NS = 8; // 125 MHz, as embassy-rp sets the system clock
 const VTOR = 0x10000100; // the vector table, after the 256-byte second-stage loader
 const PINS = { de: 2, lineOk: 6, pulse: 7, dout: 10, sck: 11 };
-const HX711_PERIOD_NS = 100e6;
+const HX711_PERIOD_NS = 12.5e6; // 80 samples a second (RATE high)
+const PAINT = 0xcccccccc;
 
 function args() {
   const a = { realtime: false };
@@ -228,6 +229,17 @@ class Harness {
       readUint32: (offset) => (offset === 0x08 ? 0b011 : 0),
       writeUint32Atomic: () => {},
     };
+    // The pads' reset value (datasheet 2.19.6.3: 0x56, input enabled, pull-down,
+    // Schmitt trigger); rp2040js starts them at 0x36, input disabled, so that a pin
+    // the firmware does not configure as a GPIO input (the PWM slice's B input) reads
+    // nothing.
+    for (const pin of mcu.gpio) pin.padValue = 0x56;
+    // The stack painted (cortex-m-rt's stack region, `_stack_end` up to
+    // `_stack_start`): `status` reports the deepest stack the node used since.
+    const paint = this.stackBounds();
+    if (paint) {
+      for (let a = paint.bottom; a < paint.top; a += 4) mcu.writeUint32(a, PAINT);
+    }
     mcu.core.VTOR = VTOR;
     mcu.core.reset();
     // The flash the ROM changes, seen through XIP at once (the harness's image is the
@@ -258,6 +270,21 @@ class Harness {
       this.sched.at(this.sched.now() + 1e6, poll);
     };
     poll();
+  }
+
+  stackBounds() {
+    const top = this.elf.symbols.get('_stack_start');
+    const bottom = this.elf.symbols.get('_stack_end');
+    return top && bottom && bottom < top ? { top, bottom } : null;
+  }
+
+  /** The deepest stack the node used since its boot (bytes). */
+  stackUsed() {
+    const b = this.stackBounds();
+    if (!b) return null;
+    let a = b.bottom;
+    while (a < b.top && this.mcu.readUint32(a) === PAINT) a += 4;
+    return b.top - a;
   }
 
   applyStates() {
@@ -384,12 +411,19 @@ class Harness {
       flash_ops: this.flash.ops,
       de_errors: this.deErrors,
       overruns: this.uart.overruns,
+      uart_read: this.uart.received,
+      uart_lcr: this.uart.lcr,
+      uart_ifls: this.uart.ifls,
+      uart_imsc: this.uart.imsc,
+      uart_ris: this.uart.ris,
+      uart_rx: this.uart.rx.length,
       anchored: this.world.anchorNs !== null,
       done: this.world.done(),
       end_ms: this.world.endMs(),
       hx711_conversions: this.hx711.conversions,
       ads1115_conversions: this.ads.conversions,
       pulses: this.tach.pulses,
+      stack: this.stackUsed(),
     };
   }
 
@@ -408,6 +442,19 @@ class Harness {
       case 'cut':
         this.flash.arm(Number(w[1]), Number(w[2] ?? 0));
         return { ok: true, ops: this.flash.ops };
+      case 'pins': {
+        const pin = this.mcu.gpio[PINS.pulse];
+        const ch = this.mcu.pwm.channels[3];
+        return {
+          func: pin.functionSelect,
+          ie: pin.inputEnable,
+          input: pin.inputValue,
+          dir: this.mcu.pwm.gpioDirection >>> 0,
+          csr: ch.csr,
+          ctr: ch.timer.counter,
+          divmode: ch.divMode,
+        };
+      }
       case 'reset':
         this.resetPending = true;
         return { ok: true };

@@ -39,6 +39,8 @@ export class Uart {
     this.fbrd = 0;
     this.rxTimeout = null;
     this.overruns = 0;
+    this.received = 0; // bytes the node read
+    this.sent = 0;
     peripheral.readUint32 = (offset) => this.read(offset);
     peripheral.writeUint32 = (offset, value) => this.write(offset, value);
   }
@@ -118,6 +120,7 @@ export class Uart {
     switch (offset) {
       case DR: {
         const byte = this.rx.length ? this.rx.shift() : 0;
+        this.received += 1;
         if (this.rx.length < this.rxLevel()) this.ris &= ~RXI;
         if (!this.rx.length) this.ris &= ~RTI;
         this.update();

@@ -30,18 +30,25 @@ pub const LINE: Line = Line {
     unit_id: 1,
 };
 
-/// The sampling period (µs of the RP2040's 1 MHz timer): 10 samples a second, the
-/// HX711's rate with its RATE pin low.
+/// The sampling period (µs of the RP2040's 1 MHz timer): 10 samples a second. The
+/// HX711 converts at 80 samples a second (its RATE pin high) and the ADS1115 at 860,
+/// so that each sample takes a conversion at most 12.5 ms old and its reads hold the
+/// Modbus loop up for at most that long plus two of the ADS1115's 1.2 ms.
 pub const SAMPLE_PERIOD_US: u64 = 100_000;
 
 /// The watchdog's timeout (ms): longer than any pass of the node's loop (a sample
-/// whose HX711 never becomes ready waits 500 ms; a sector erase 400 ms at most).
+/// whose HX711 never becomes ready waits 50 ms; a sector erase 400 ms at most).
 pub const WATCHDOG_MS: u64 = 2_000;
 
-/// The HX711's bounded wait at 10 samples/s.
-pub const HX711_TIMEOUT: Timeout = Timeout::HX711_10SPS;
-/// The ADS1115's bounded wait at 128 samples/s.
-pub const ADS1115_TIMEOUT: Timeout = Timeout::ADS1115_128SPS;
+/// The HX711's bounded wait at 80 samples/s.
+pub const HX711_TIMEOUT: Timeout = Timeout::HX711_80SPS;
+/// The ADS1115's data rate (samples/s) and its bounded wait: 1.16 ms a conversion,
+/// checked every 250 µs for 4 ms.
+pub const ADS1115_SPS: u32 = 860;
+pub const ADS1115_TIMEOUT: Timeout = Timeout {
+    polls: 16,
+    interval_us: 250,
+};
 /// The ADS1115's full-scale range (V): +-4.096 V, 8000 codes a volt.
 pub const ADS1115_FULL_SCALE_V: f32 = 4.096;
 

@@ -1,7 +1,8 @@
 //! The monitoring node on a Raspberry Pi Pico (RP2040, Cortex-M0+), the board a user
 //! flashes (docs/pico.md: pins, parts, power, putting the image on a board): the load
 //! cell on an HX711, two displacement probes on an ADS1115, a tachometer's pulses
-//! (`sensors.rs`), sampled on the RP2040's timer every 100 ms and sleeping between
+//! (`sensors.rs`), sampled on the RP2040's timer every 100 ms (the HX711 at 80 samples a second, the
+//! ADS1115 at 860) and sleeping between
 //! samples and requests (`sleep.rs`); Modbus RTU over RS-485 on UART0 with the
 //! transceiver's driver enable (`board.rs`: the pins and the line in one place); its
 //! state, committed configuration and events on its own QSPI flash (`flash.rs`), in
@@ -25,6 +26,7 @@ mod sleep;
 use defmt_rtt as _;
 use embassy_rp::bind_interrupts;
 use embassy_rp::gpio::{Input, Level, Output, Pull};
+use embassy_rp::interrupt::InterruptExt;
 use embassy_rp::peripherals::UART0;
 use embassy_rp::pwm::{self, Pwm};
 use embassy_rp::uart::{BufferedInterruptHandler, BufferedUart, Config};
@@ -57,10 +59,15 @@ bind_interrupts!(struct Irqs {
 /// transceiver's driver-enable pin, raised from the first byte of an answer until its
 /// last stop bit has left. `idle` says whether the UART's transmitter has sent that
 /// (`flush` empties the HAL's buffer; the shift register is the HAL's own business).
+/// `drain` moves bytes still in the UART's own FIFO into the HAL's buffer: the
+/// PL011 raises its RX interrupt only at a FIFO level (embassy-rp sets 28 bytes, 2.4
+/// ms of the line at 115200 baud) or 32 bit times after the last byte, so without it
+/// a frame's end of silence would be judged on bytes the node has not seen.
 pub struct Rs485<U, D> {
     uart: U,
     driver_enable: D,
     idle: fn(&U) -> bool,
+    drain: fn(),
 }
 
 impl<U: ErrorType, D> ErrorType for Rs485<U, D> {
@@ -69,6 +76,9 @@ impl<U: ErrorType, D> ErrorType for Rs485<U, D> {
 
 impl<U: ReadReady, D> ReadReady for Rs485<U, D> {
     fn read_ready(&mut self) -> Result<bool, U::Error> {
+        if !self.uart.read_ready()? {
+            (self.drain)();
+        }
         self.uart.read_ready()
     }
 }
@@ -131,7 +141,8 @@ fn main() -> ! {
     sleep::init();
     let mut config = Config::default();
     config.baudrate = board::LINE.baud;
-    let (mut tx_buffer, mut rx_buffer) = ([0u8; 256], [0u8; 256]);
+    // The RX buffer holds 44 ms of the line: a sample's reads never overflow it.
+    let (mut tx_buffer, mut rx_buffer) = ([0u8; 256], [0u8; 512]);
     let uart = BufferedUart::new(
         p.UART0,
         p.PIN_0,
@@ -145,6 +156,12 @@ fn main() -> ! {
         uart,
         driver_enable: Output::new(p.PIN_2, Level::Low),
         idle: |u: &BufferedUart| !u.busy(),
+        drain: || {
+            if !embassy_rp::pac::UART0.uartfr().read().rxfe() {
+                // The HAL's handler empties the FIFO into its buffer whatever raised it.
+                embassy_rp::interrupt::UART0_IRQ.pend();
+            }
+        },
     };
     let mut i2c_config = embassy_rp::i2c::Config::default();
     i2c_config.frequency = 400_000;

@@ -53,7 +53,7 @@ impl Sensors {
         // Not set here (an unplugged ADS1115): its next one-shot conversion carries the
         // driver's settings all the same (`read` writes the whole configuration).
         let _ = driver.set_full_scale_range(full_scale_range(board::ADS1115_FULL_SCALE_V));
-        let _ = driver.set_data_rate(ads1x1x::DataRate16Bit::Sps128);
+        let _ = driver.set_data_rate(data_rate(board::ADS1115_SPS));
         let adc = Ads1115::new(driver, Sleep, board::ADS1115_TIMEOUT);
         let probes = Misalignment::new(
             adc,
@@ -126,6 +126,21 @@ impl Sensors {
             }));
         }
         self.tachometer.update(self.count, now_us).transpose()
+    }
+}
+
+/// The ADS1115's data rate: the slowest at least `sps`.
+fn data_rate(sps: u32) -> ads1x1x::DataRate16Bit {
+    use ads1x1x::DataRate16Bit as D;
+    match sps {
+        0..=8 => D::Sps8,
+        9..=16 => D::Sps16,
+        17..=32 => D::Sps32,
+        33..=64 => D::Sps64,
+        65..=128 => D::Sps128,
+        129..=250 => D::Sps250,
+        251..=475 => D::Sps475,
+        _ => D::Sps860,
     }
 }
 
