@@ -424,6 +424,7 @@ class Harness {
       ads1115_conversions: this.ads.conversions,
       pulses: this.tach.pulses,
       stack: this.stackUsed(),
+      watchdog: { on: this.mcu.peripherals[0x40058].timer.enable, left: this.mcu.peripherals[0x40058].timer.counter, tick: this.mcu.peripherals[0x40058].tickEnable, alarm: this.mcu.peripherals[0x40058].alarm.enabled },
     };
   }
 

@@ -128,6 +128,14 @@ export class Ads1115 {
     this.written = [];
     this.reading = [];
     this.conversions = 0;
+    // rp2040js flushes the TX FIFO on an abort (a NACK) without raising TX_EMPTY,
+    // which the data sheet's controller raises at an empty FIFO: embassy-rp's
+    // blocking write waits on it for ever.
+    const abort = i2c.abort.bind(i2c);
+    i2c.abort = (reason) => {
+      abort(reason);
+      i2c.setInterrupts(1 << 4);
+    };
     i2c.onStart = () => i2c.completeStart();
     i2c.onConnect = (address, mode) => {
       const ack = address === 0x48 && this.state === 'ok';
