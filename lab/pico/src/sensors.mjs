@@ -4,8 +4,8 @@
 // the node's calibration: codes and volts, lab/xtask/src/pico.rs) and can be
 // unplugged or stuck. Each conversion adds a dither of up to DITHER codes (as real
 // noise would; never the previous code again, so that a steady value is not a stuck
-// sensor), except where the trace itself repeats a value bit for bit: that sensor
-// then repeats its code, as a frozen one would.
+// sensor), except where the drive says the trace held a value bit for bit as long as
+// the monitor's stuck time: that sensor then repeats its code, as a frozen one would.
 
 export const DITHER = 4;
 

@@ -80,7 +80,6 @@ pub fn run(args: &Args) -> std::process::ExitCode {
             Path::new(events),
             args.samples.as_deref().map(Path::new),
         )
-        .map(|_| ())
     } else if let Some(out) = &args.uf2 {
         uf2(Path::new(out))
     } else if args.measure {
@@ -150,10 +149,12 @@ struct Row {
 /// inverse of the node's calibration (`board.rs`), the load as the HX711's code, each
 /// probe's displacement as the volts at the ADS1115's input, the speed as the
 /// tachometer's pulse rate. A value the trace could not read (NaN) puts that sensor at
-/// its rail (the load cell's code, probe 1's input at full scale); a value repeated
-/// bit for bit freezes that sensor's code (flags 1 load, 2 the probes, 4 and 8 the
-/// rails); an empty speed holds the last (the configuration's nominal speed before
-/// one).
+/// its rail (the load cell's code, probe 1's input at full scale); a value the trace
+/// holds bit for bit as long as the monitor's stuck time (the default configuration's
+/// `stuck`) freezes that sensor's code from then on, as a stuck sensor's would (a
+/// shorter repeat is a steady value, read through the sensor's noise) (flags 1 load,
+/// 2 the probes, 4 and 8 the rails); an empty speed holds the last (the
+/// configuration's nominal speed before one).
 fn drive(samples: &[Sample]) -> Result<String, String> {
     let cal = board::calibration().map_err(|e| format!("the node's calibration: {e}"))?;
     let volts_per_code = board::ADS1115_FULL_SCALE_V / 32768.0;
@@ -161,7 +162,11 @@ fn drive(samples: &[Sample]) -> Result<String, String> {
         f64::from(v.max(0.0)) * f64::from(cal.speed.pulses_per_rev)
             / (2.0 * std::f64::consts::PI * f64::from(cal.speed.radius_m))
     };
-    let mut speed = pulse_hz(misalign::monitor::Config::default().nominal_speed);
+    let config = misalign::monitor::Config::default();
+    let mut speed = pulse_hz(config.nominal_speed);
+    let stuck_ms = i64::from(config.stuck_ms);
+    // Since when (ms) the load and the angle hold their value bit for bit.
+    let (mut load_since, mut phi_since) = (0i64, 0i64);
     let mut rows = Vec::with_capacity(samples.len());
     let mut t = 0i64;
     let mut last: Option<&Sample> = None;
@@ -170,10 +175,16 @@ fn drive(samples: &[Sample]) -> Result<String, String> {
             t += i64::from(s.time_ms.wrapping_sub(p.time_ms) as i32);
         }
         let mut flags = 0u8;
-        if last.is_some_and(|p| p.load.to_bits() == s.load.to_bits()) {
+        if !last.is_some_and(|p| p.load.to_bits() == s.load.to_bits()) {
+            load_since = t;
+        }
+        if !last.is_some_and(|p| p.phi.to_bits() == s.phi.to_bits()) {
+            phi_since = t;
+        }
+        if stuck_ms > 0 && t - load_since >= stuck_ms {
             flags |= 1;
         }
-        if last.is_some_and(|p| p.phi.to_bits() == s.phi.to_bits()) {
+        if stuck_ms > 0 && t - phi_since >= stuck_ms {
             flags |= 2;
         }
         let load_code = if s.load.is_finite() {
@@ -357,11 +368,6 @@ pub fn json_num(json: &str, key: &str) -> Option<f64> {
     rest[..end].trim().parse().ok()
 }
 
-/// A boolean field of a JSON answer.
-pub fn json_bool(json: &str, key: &str) -> bool {
-    json.contains(&format!("\"{key}\":true"))
-}
-
 /// `--serve PORT`.
 fn serve(port: u16) -> Result<(), String> {
     let elf = build()?;
@@ -384,19 +390,13 @@ fn serve(port: u16) -> Result<(), String> {
     Err(format!("the harness stopped: {status}"))
 }
 
-/// What a trace run gave: the events' CSV and the delivered samples' trace.
-pub struct TraceRun {
-    pub events: usize,
-    pub samples: usize,
-}
-
 /// `--trace`.
 fn run_trace(
     trace: &Path,
     scene: &Path,
     events_out: &Path,
     samples_out: Option<&Path>,
-) -> Result<TraceRun, String> {
+) -> Result<(), String> {
     let open = |p: &Path| std::fs::File::open(p).map_err(|e| format!("{}: {e}", p.display()));
     let scene_v = misalign_cli::monitor_input::read_scene(open(scene)?)
         .map_err(|e| format!("{}: {e}", scene.display()))?;
@@ -546,10 +546,7 @@ fn run_trace(
         csv.events,
         events_out.display()
     );
-    Ok(TraceRun {
-        events: csv.events,
-        samples: n,
-    })
+    Ok(())
 }
 
 /// `--uf2 OUT`: the image's flash segments in UF2 blocks of 256 bytes (family RP2040).
