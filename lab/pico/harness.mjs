@@ -1,7 +1,7 @@
 // The Pico node in rp2040js (cargo xtask pico runs it; README.md beside this file):
 //
 //   node harness.mjs --elf NODE.elf --flash FLASH.bin --port PORT --drive DRIVE.csv
-//       [--control PORT] [--realtime] [--defmt-print PATH] [--samples OUT]
+//       [--control PORT] [--realtime] [--defmt-print PATH] [--samples OUT] [--parent PID]
 //
 // Boots the node's ELF at its vector table with no ROM binary (src/rom.mjs), its flash
 // a file the harness owns (src/flash.mjs), UART0 as the PL011 behaves (src/uart.mjs)
@@ -131,7 +131,7 @@ class World {
   }
   /** The first monitored sample at the node's `ms` (this boot): row 0 is its row. */
   anchor(ms, bootEpochNs) {
-    if (this.anchorNs !== null || this.rows.length < 2) return;
+    if (this.anchorNs !== null) return;
     this.anchorMs = ms;
     this.anchorNs = bootEpochNs + ms * 1e6;
     this.rearm();
@@ -498,5 +498,15 @@ if (a.control) {
       s.on('error', () => {});
     })
     .listen(Number(a.control), '127.0.0.1', () => say(`control on 127.0.0.1:${a.control}`));
+}
+// Ends with the process that started it (`--parent PID`: xtask, whatever way it ends).
+if (a.parent) {
+  setInterval(() => {
+    try {
+      process.kill(Number(a.parent), 0);
+    } catch {
+      process.exit(0);
+    }
+  }, 500).unref();
 }
 h.loop();

@@ -471,6 +471,8 @@ fn run_trace(
     let mut trace_csv = String::from("t,P,phi,V,fault\n");
     let mut n = 0;
     let mut delivered_max = misalign::monitor::scenario::LOAD_MAX;
+    // Whether the node's log went past the trace's end (every sample of it decoded).
+    let mut complete = false;
     for line in text.lines() {
         let f: Vec<u32> = line
             .split(',')
@@ -484,6 +486,7 @@ fn run_trace(
             return Err(format!("a sample line {line:?}"));
         };
         if t > end_ms {
+            complete = true;
             break;
         }
         // The sensor's own fault, as the monitor example's `fault` column names it.
@@ -521,6 +524,11 @@ fn run_trace(
         )
         .unwrap();
         n += 1;
+    }
+    if !complete {
+        return Err(format!(
+            "the node's log holds no sample after the trace's end ({end_ms} ms)"
+        ));
     }
     // The monitor example prepares its scene for the loads of the trace it reads: the
     // delivered samples' must give the scene the node was commissioned with.
@@ -745,4 +753,88 @@ fn measure() -> Result<(), String> {
         crate::measurements::PAGE
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rows(text: &str) -> Vec<Vec<String>> {
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').map(str::to_string).collect())
+            .collect()
+    }
+
+    #[test]
+    fn the_drive_inverts_the_calibration_and_marks_what_a_sensor_cannot_read() {
+        let cal = board::calibration().unwrap();
+        let mut samples = vec![
+            Sample::new(1000, 2500.0, 2e-4).with_speed(2.0),
+            Sample::new(1100, f32::NAN, 2e-4),
+            Sample::new(1200, 2500.0, f32::NAN).with_speed(1.0),
+        ];
+        let d = rows(&drive(&samples).unwrap());
+        assert_eq!(d.len(), 3);
+        assert_eq!(d[0][0], "0");
+        assert_eq!(d[2][0], "200");
+        // The load's code reads back as the load, to a code.
+        let code: i32 = d[0][1].parse().unwrap();
+        assert!((cal.load.newtons(code) - 2500.0).abs() <= cal.load.newtons_per_count);
+        // Probe 1 sits span * tan(phi) beyond probe 2: the angle back from the volts.
+        let v1: f32 = d[0][2].parse().unwrap();
+        let v2: f32 = d[0][3].parse().unwrap();
+        let counts = |v: f32| (v / (board::ADS1115_FULL_SCALE_V / 32768.0)).round() as i32;
+        let pr = cal.probes;
+        let phi = pr.phi(pr.probe1.metres(counts(v1)), pr.probe2.metres(counts(v2)));
+        assert!((phi - 2e-4).abs() < 3e-7, "{phi}");
+        // The pulse rate of 2 m/s, held where the trace has no speed, then 1 m/s.
+        let hz = |r: &Vec<String>| r[4].parse::<f64>().unwrap();
+        let per_m = f64::from(cal.speed.pulses_per_rev)
+            / (2.0 * std::f64::consts::PI * f64::from(cal.speed.radius_m));
+        assert!((hz(&d[0]) - 2.0 * per_m).abs() < 1e-6);
+        assert_eq!(hz(&d[1]), hz(&d[0]));
+        assert!((hz(&d[2]) - per_m).abs() < 1e-6);
+        // Unreadable values put their sensor at its rail.
+        assert_eq!(d[1][5], "4");
+        assert_eq!(d[2][5], "8");
+        // A value held as long as the stuck time freezes its sensor from then on.
+        let stuck = misalign::monitor::Config::default().stuck_ms;
+        samples = (0..=stuck / 1000 + 1)
+            .map(|s| Sample::new(s * 1000, 2500.0, 2e-4 + s as f32 * 1e-6))
+            .collect();
+        let d = rows(&drive(&samples).unwrap());
+        let frozen: Vec<bool> = d.iter().map(|r| r[5] == "1").collect();
+        let first = frozen.iter().position(|&f| f).unwrap();
+        assert_eq!(d[first][0].parse::<u32>().unwrap(), stuck);
+        assert!(frozen[first..].iter().all(|&f| f) && !frozen[..first].iter().any(|&f| f));
+    }
+
+    #[test]
+    fn the_uf2_pages_hold_the_flash_segments_and_nothing_else() {
+        // A minimal ELF: one PT_LOAD of 300 bytes at 0x10000100, one in RAM.
+        let mut elf = vec![0u8; 52 + 2 * 32];
+        elf[..4].copy_from_slice(b"\x7fELF");
+        elf[28..32].copy_from_slice(&52u32.to_le_bytes());
+        elf[42..44].copy_from_slice(&32u16.to_le_bytes());
+        elf[44..46].copy_from_slice(&2u16.to_le_bytes());
+        let data_at = elf.len() as u32;
+        elf.extend((0..300).map(|i| i as u8));
+        for (k, paddr) in [(0usize, 0x1000_0100u32), (1, 0x2000_0000)] {
+            let at = 52 + 32 * k;
+            elf[at..at + 4].copy_from_slice(&1u32.to_le_bytes());
+            elf[at + 4..at + 8].copy_from_slice(&data_at.to_le_bytes());
+            elf[at + 12..at + 16].copy_from_slice(&paddr.to_le_bytes());
+            elf[at + 16..at + 20].copy_from_slice(&300u32.to_le_bytes());
+        }
+        let pages = flash_image(&elf).unwrap();
+        assert_eq!(
+            pages.iter().map(|p| p.0).collect::<Vec<_>>(),
+            [0x1000_0100, 0x1000_0200]
+        );
+        assert_eq!(pages[0].1[..4], [0, 1, 2, 3]);
+        // The segment's byte 299 (299 mod 256 = 43) at 0x1000022b.
+        assert_eq!(pages[1].1[43], 43);
+        assert_eq!(pages[1].1[44], 0xff);
+    }
 }
