@@ -175,10 +175,10 @@ fn drive(samples: &[Sample]) -> Result<String, String> {
             t += i64::from(s.time_ms.wrapping_sub(p.time_ms) as i32);
         }
         let mut flags = 0u8;
-        if !last.is_some_and(|p| p.load.to_bits() == s.load.to_bits()) {
+        if last.is_none_or(|p| p.load.to_bits() != s.load.to_bits()) {
             load_since = t;
         }
-        if !last.is_some_and(|p| p.phi.to_bits() == s.phi.to_bits()) {
+        if last.is_none_or(|p| p.phi.to_bits() != s.phi.to_bits()) {
             phi_since = t;
         }
         if stuck_ms > 0 && t - load_since >= stuck_ms {
