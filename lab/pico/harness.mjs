@@ -220,8 +220,7 @@ class Harness {
     mcu.flash.set(this.flash.bytes);
     // Writes to flash through XIP are not flash: the ROM's routines are the only way.
     installRom(mcu);
-    const rom = romHandler(mcu, this.flash, say);
-    mcu.onBreak = (n) => { if (process.env.ROM_TRACE) say(`rom ${n} r0=${mcu.core.registers[0].toString(16)} r1=${mcu.core.registers[1].toString(16)} r2=${mcu.core.registers[2].toString(16)}`); rom(n); };
+    mcu.onBreak = romHandler(mcu, this.flash, say);
     // XIP_CTRL (0x14000000), which rp2040js leaves out (its reads answer 0xffffffff:
     // embassy-rp's flash driver waits on STREAM_CTR for ever): no cache to flush, no
     // stream running, the stream FIFO empty.
@@ -412,11 +411,6 @@ class Harness {
       de_errors: this.deErrors,
       overruns: this.uart.overruns,
       uart_read: this.uart.received,
-      uart_lcr: this.uart.lcr,
-      uart_ifls: this.uart.ifls,
-      uart_imsc: this.uart.imsc,
-      uart_ris: this.uart.ris,
-      uart_rx: this.uart.rx.length,
       anchored: this.world.anchorNs !== null,
       done: this.world.done(),
       end_ms: this.world.endMs(),
@@ -424,7 +418,6 @@ class Harness {
       ads1115_conversions: this.ads.conversions,
       pulses: this.tach.pulses,
       stack: this.stackUsed(),
-      watchdog: { on: this.mcu.peripherals[0x40058].timer.enable, left: this.mcu.peripherals[0x40058].timer.counter, tick: this.mcu.peripherals[0x40058].tickEnable, alarm: this.mcu.peripherals[0x40058].alarm.enabled },
     };
   }
 
@@ -443,19 +436,6 @@ class Harness {
       case 'cut':
         this.flash.arm(Number(w[1]), Number(w[2] ?? 0));
         return { ok: true, ops: this.flash.ops };
-      case 'pins': {
-        const pin = this.mcu.gpio[PINS.pulse];
-        const ch = this.mcu.pwm.channels[3];
-        return {
-          func: pin.functionSelect,
-          ie: pin.inputEnable,
-          input: pin.inputValue,
-          dir: this.mcu.pwm.gpioDirection >>> 0,
-          csr: ch.csr,
-          ctr: ch.timer.counter,
-          divmode: ch.divMode,
-        };
-      }
       case 'reset':
         this.resetPending = true;
         return { ok: true };
