@@ -1,11 +1,11 @@
 //! `cargo xtask pico`: the Raspberry Pi Pico node (`nodes/pico`) in an emulator of its
 //! chip (rp2040js under Node, `lab/pico`), its sensors simulated at the pins.
 //!
-//! - no option: the checks of `lab/pico/tests` (pytest): commissioning over the bus
-//!   surviving a reset, power cuts in a checkpoint, a commit and an acknowledgement,
-//!   each sensor unplugged and stuck, the driver-enable pin; then a trace through the
-//!   node compared bit for bit with the monitor example's replay of what its sensors
-//!   delivered (as `--trace` does).
+//! - no option: the checks of `tests/modbus/test_pico.py` (pytest, pymodbus in the
+//!   venv of `cargo xtask modbus`): commissioning over the bus surviving a reset,
+//!   power cuts in a checkpoint, a commit and an acknowledgement, each sensor
+//!   unplugged and stuck, the driver-enable pin; then the harness restarted on the
+//!   same flash image, the node still commissioned.
 //! - `--serve PORT`: the node on 127.0.0.1:PORT (its UART0 bridged) until killed, in
 //!   real time, its sensors on a steady process.
 //! - `--trace T.csv --scene S.csv --events OUT.csv [--samples SAMPLES.csv]`: commissions
@@ -661,7 +661,8 @@ fn check_files() -> Result<(PathBuf, PathBuf, PathBuf, PathBuf), String> {
     Ok((python, registers, scene, config))
 }
 
-/// The checks: tests/modbus/test_pico.py (pytest) against a fresh node.
+/// The checks: tests/modbus/test_pico.py (pytest) against a fresh node, then a new
+/// harness on its flash image.
 fn tests() -> Result<(), String> {
     let start = Instant::now();
     let elf = build()?;
@@ -694,13 +695,73 @@ fn tests() -> Result<(), String> {
     if !status.success() {
         return Err(format!("pytest tests/modbus/test_pico.py: {status}"));
     }
+    // The flash image outlives the harness: a new one on the same file boots into the
+    // commissioned node.
+    let h = Harness::start(
+        &elf,
+        &Options {
+            flash: &dir()?.join("checks-flash.bin"),
+            drive: &dir()?.join("steady-drive.csv"),
+            samples: None,
+            realtime: false,
+            port: None,
+        },
+    )?;
+    let source = read_holding(h.port, holding_address("config_source")?)?;
+    drop(h);
+    if source != 1 {
+        return Err(format!(
+            "after a restart of the harness the node's config_source is {source}, not 1 \
+             (committed): its flash image was not kept"
+        ));
+    }
     println!(
-        "pico: every check passed in {} s ({} s of the node's time, {} boots)",
+        "pico: every check passed in {} s ({} s of the node's time, {} boots); a new \
+         harness on the flash image booted the commissioned node",
         start.elapsed().as_secs(),
         json_num(&st, "ns").unwrap_or(0.0) as u64 / 1_000_000_000,
         json_num(&st, "boots").unwrap_or(0.0)
     );
     Ok(())
+}
+
+/// The address of the holding register `name` (the library's register map).
+fn holding_address(name: &str) -> Result<u16, String> {
+    let map = crate::modbus::registers_text()?;
+    map.lines()
+        .find_map(|l| {
+            let c: Vec<&str> = l.splitn(4, ',').collect();
+            (c.len() > 2 && c[0] == "holding" && c[2] == name).then(|| c[1].parse().ok())?
+        })
+        .ok_or_else(|| format!("no holding register {name}"))
+}
+
+/// One holding register of unit 1 on 127.0.0.1:`port` (function 3, an RTU frame on
+/// the bridge), asked up to five times.
+fn read_holding(port: u16, address: u16) -> Result<u16, String> {
+    let mut frame = vec![1, 3];
+    frame.extend_from_slice(&address.to_be_bytes());
+    frame.extend_from_slice(&1u16.to_be_bytes());
+    frame.extend_from_slice(&misalign::modbus::crc16(&frame).to_le_bytes());
+    let mut last = String::new();
+    for _ in 0..5 {
+        let mut s = TcpStream::connect(("127.0.0.1", port)).map_err(|e| e.to_string())?;
+        s.set_read_timeout(Some(Duration::from_secs(5)))
+            .map_err(|e| e.to_string())?;
+        s.write_all(&frame).map_err(|e| e.to_string())?;
+        let mut answer = [0u8; 7];
+        match s.read_exact(&mut answer) {
+            Ok(())
+                if answer[..3] == [1, 3, 2]
+                    && misalign::modbus::crc16(&answer[..5]).to_le_bytes() == answer[5..] =>
+            {
+                return Ok(u16::from_be_bytes([answer[3], answer[4]]));
+            }
+            Ok(()) => last = format!("the answer {answer:02x?}"),
+            Err(e) => last = e.to_string(),
+        }
+    }
+    Err(format!("reading holding register {address}: {last}"))
 }
 
 /// `--measure`: the image's flash and statics (llvm-size), the deepest stack of a
