@@ -2,6 +2,15 @@
 //! irregular time steps, of load and angle, for a sample that passed the checks and
 //! runs; the load clamped at zero. Its state: the two windows, the smoothed values and
 //! the last time step's values.
+//!
+//! **Settling.** After a start afresh (a new monitor, a fault, a stop, a new
+//! configuration or scene) the windows are empty and a value has nothing to be tested
+//! against: the first `window` valid running samples only fill the windows and
+//! condition nothing; the last of them gives the windows' medians, from which the
+//! smoothing starts, and the spike test runs from the next one. So no single sample,
+//! whatever its value, decides what follows a restart (a median of three or more
+//! values is one of the others when one is an outlier). Without spike rejection there
+//! is no window and nothing settles.
 
 use super::config::{Config, SPIKE_WINDOW_CAPACITY, SpikeFilter};
 use super::order::{ge, key, positive, value};
@@ -60,6 +69,12 @@ impl Window {
 
     fn len(&self) -> usize {
         usize::from(self.len).min(CAP)
+    }
+
+    /// The median of the values held (0 for none).
+    fn median(&self) -> f32 {
+        let (sorted, n) = self.sorted();
+        median(sorted.get(..n).unwrap_or(&[]))
     }
 
     pub(crate) fn clear(&mut self) {
@@ -351,7 +366,8 @@ impl Conditioning {
 
     /// Conditions a running sample's load `load` (N) and angle `phi` (rad) after a
     /// step of `dt_ms`: spikes replaced by their window's median (counted in `stats`),
-    /// then smoothed with the weight of the step, the load clamped at zero.
+    /// then smoothed with the weight of the step, the load clamped at zero. `None`
+    /// while the conditioning settles (see the module's documentation).
     #[inline(always)]
     pub(crate) fn condition(
         &mut self,
@@ -360,16 +376,22 @@ impl Conditioning {
         phi: f32,
         dt_ms: u32,
         stats: &mut Statistics,
-    ) -> Conditioned {
+    ) -> Option<Conditioned> {
         let (mut load, mut phi) = (load, phi);
         if let Some(filter) = &config.spikes {
-            // One loop over both channels: one copy of the window's code in the image.
             let mut values = [load, phi];
-            let floors = [filter.load_floor, filter.angle_floor];
-            for ((w, x), floor) in self.windows.iter_mut().zip(&mut values).zip(floors) {
-                if let Some(m) = w.hampel(*x, filter, floor) {
-                    *x = m;
-                    stats.count_spike();
+            let n = usize::from(filter.window);
+            if self.settling(n) {
+                values = self.settle(n, values)?;
+            } else {
+                // One loop over both channels: one copy of the window's code in the
+                // image.
+                let floors = [filter.load_floor, filter.angle_floor];
+                for ((w, x), floor) in self.windows.iter_mut().zip(&mut values).zip(floors) {
+                    if let Some(m) = w.hampel(*x, filter, floor) {
+                        *x = m;
+                        stats.count_spike();
+                    }
                 }
             }
             [load, phi] = values;
@@ -384,15 +406,44 @@ impl Conditioning {
         }
         // A load cell reads a little below zero at rest; the contact has none.
         let load = if ge(load, 0.0) { load } else { 0.0 };
-        Conditioned {
+        Some(Conditioned {
             load,
             phi,
             dt_s: step.dt_s,
+        })
+    }
+
+    /// Whether a window holds fewer than `n` values (the spike window's length): the
+    /// conditioning settles.
+    #[inline(always)]
+    pub(crate) fn settling(&self, n: usize) -> bool {
+        self.windows.iter().any(|w| w.len() < n)
+    }
+
+    /// Whether a window holds a value: samples have come since the last restart.
+    pub(crate) fn started(&self) -> bool {
+        self.windows.iter().any(|w| w.len() > 0)
+    }
+
+    /// A settling sample's load and angle `values` into the windows of `n` values;
+    /// once both are full, the windows' medians, from which the smoothing starts.
+    #[cold]
+    #[inline(never)]
+    fn settle(&mut self, n: usize, values: [f32; 2]) -> Option<[f32; 2]> {
+        for (w, x) in self.windows.iter_mut().zip(values) {
+            w.push_back(x, n);
         }
+        if self.settling(n) {
+            return None;
+        }
+        self.smoothed = None;
+        let [load, angle] = &self.windows;
+        Some([load.median(), angle.median()])
     }
 
     /// Starts afresh after a sample that was not conditioned (a fault, a stop): the
-    /// values before it say nothing about the ones after.
+    /// values before it say nothing about the ones after. The next valid running
+    /// samples settle it again.
     pub(crate) fn restart(&mut self) {
         for w in &mut self.windows {
             w.clear();

@@ -10,6 +10,7 @@
 //!    range values, stuck values, gaps; whether the machine runs;
 //! 3. **conditioning** (`conditioning.rs`): spikes replaced by the Hampel window's
 //!    median, load and angle smoothed with a weight that follows the real time step;
+//!    after a restart it settles first ([`Monitor::settling`]);
 //! 4. **estimate** (`estimate.rs`): the [`Estimator`]'s d/b, F, phi0 and margin, the
 //!    [`Reading`];
 //! 5. **energy** (`energy.rs`): the dissipated power F phi V (section 7) over the step;
@@ -24,6 +25,13 @@
 //!    ([`Monitor::pop_event`]);
 //! 10. **statistics** (`statistics.rs`): the step's energy added to the state
 //!     reported after it.
+//!
+//! **Settling.** No single sample decides a state after the conditioning starts
+//! afresh (at the first sample, after a fault, a stop, a new configuration or scene,
+//! a restored state it cannot take): the first valid running samples, as many as the
+//! spike window holds, only fill its windows and ask for no change (the state is
+//! held, and any change pending ends: they are valid and running); the last of them
+//! decides, from the windows' medians. A start and its start-up inhibit wait for it.
 //!
 //! Conditioning, estimate, energy and trend see only a valid running sample. The
 //! stages count what they see into the [`Statistics`] (time per state, spikes,
@@ -179,6 +187,9 @@ enum Asked {
     Fault(FaultCause),
     /// `Stopped`: the load or the speed is below its stop threshold.
     Stopped,
+    /// No change: a valid running sample while the conditioning settles (it breaks
+    /// every pending run, the sample being valid and running, and decides no level).
+    Settling,
     /// The risk level of a valid running sample's reading, conditioned as `at`.
     Level {
         level: RiskState,
@@ -237,7 +248,8 @@ impl<E: Estimator> Monitor<E> {
 
     /// Replaces the configuration between two samples, checked first: on an error
     /// nothing changes. State, statistics and events go on; the conditioning and the
-    /// trend start afresh, their windows being formed under the old configuration.
+    /// trend start afresh, their windows being formed under the old configuration
+    /// (the conditioning settles again: [`settling`](Self::settling)).
     ///
     /// # Errors
     /// The [`ConfigError`] of an inconsistent configuration.
@@ -253,7 +265,7 @@ impl<E: Estimator> Monitor<E> {
 
     /// Replaces the scene between two samples. State, statistics and events go on; the
     /// conditioning and the trend start afresh (the trend's margins are the old
-    /// scene's).
+    /// scene's; the conditioning settles again: [`settling`](Self::settling)).
     pub fn set_estimator(&mut self, estimator: E) {
         self.estimator = estimator;
         self.conditioning.restart();
@@ -294,6 +306,18 @@ impl<E: Estimator> Monitor<E> {
     /// has not since risen above 1.5 horizons or gone.
     pub fn approaching(&self) -> bool {
         !self.events.approaching_armed
+    }
+
+    /// Whether the conditioning is settling: since it started afresh (a new monitor, a
+    /// fault, a stop, a new configuration or scene, a restored state it could not
+    /// take) valid running samples have come, but fewer than the spike window's
+    /// length (7 by default). Meanwhile no sample decides a state: the reported state
+    /// is held, and the last of them decides from the windows' medians. Never with
+    /// spike rejection off.
+    pub fn settling(&self) -> bool {
+        let c = &self.conditioning;
+        let window = self.config.spikes.map_or(0, |s| usize::from(s.window));
+        c.started() && c.settling(window)
     }
 
     /// Monotonic time since the first sample (ms).
@@ -418,14 +442,18 @@ impl<E: Estimator> Monitor<E> {
 
     /// Conditioning, estimate, energy and trend of a valid running sample after a step
     /// of `dt_ms` at speed `speed` (m/s), and the risk level its reading asks for (a
-    /// fault when the estimator refuses it).
+    /// fault when the estimator refuses it; no change while the conditioning settles:
+    /// the machine's start and its start-up inhibit wait for the settled sample).
     #[inline(always)]
     fn running(&mut self, sample: &Sample, speed: f32, dt_ms: u32, now: u64) -> Asked {
-        self.alarm.note_running(now);
         let (config, stats) = (&self.config, &mut self.stats);
-        let at = self
+        let Some(at) = self
             .conditioning
-            .condition(config, sample.load, sample.phi, dt_ms, stats);
+            .condition(config, sample.load, sample.phi, dt_ms, stats)
+        else {
+            return Asked::Settling;
+        };
+        self.alarm.note_running(now);
         let r = match estimate::estimate(&self.estimator, &at, sample.axial_force) {
             Ok(r) => r,
             Err(f) => return Asked::Fault(f),
@@ -458,6 +486,7 @@ impl<E: Estimator> Monitor<E> {
                 self.conditioning.restart();
                 RiskState::Stopped
             }
+            Asked::Settling => self.alarm.state,
             Asked::Level { level, .. } => level,
         };
         self.alarm.offer(&self.config, candidate, now)
@@ -597,7 +626,8 @@ impl<E: Estimator> Monitor<E> {
     /// The conditioning holds only values this configuration accepts: a smoothed
     /// value, or a spike window holding a value, outside its load and angle ranges (a
     /// state of another configuration, or no monitor's) is left out, and the
-    /// conditioning starts afresh there, as after a fault.
+    /// conditioning starts afresh there, as after a fault (and settles again). A state
+    /// taken while the conditioning settled goes on settling.
     pub fn resume(&mut self, state: &MonitorState) {
         self.clock = state.clock;
         self.alarm = state.alarm;
