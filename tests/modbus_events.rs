@@ -31,7 +31,7 @@ fn monitor(state: Option<&MonitorState>) -> Monitor<Auto> {
 }
 
 /// Sample `i`: running, a sensor fault every ten samples (an event in, and one out
-/// once the conditioning has settled again on the spike window's 7 samples).
+/// once 7 samples have filled the spike window again and the 8th decides).
 fn sample(i: u32) -> Sample {
     // Noise enough that no sensor reads as stuck.
     let noise = (i % 7) as f32;

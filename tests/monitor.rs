@@ -700,8 +700,8 @@ fn the_model_is_chosen_once_for_the_operating_range() {
 /// it: with a fault delay longer than the dropout, 120 s at 2 kN and 0.1 mrad (with
 /// some noise: a constant value is a stuck sensor), 10 s of `P = NaN` and then one
 /// sample at 3 mrad leave the state `Normal`; gross slip that lasts is entered after
-/// the conditioning settled (7 samples, the spike window) and the on-delay from the
-/// first sample that decided it.
+/// the conditioning settled (7 samples fill the spike window) and the on-delay from
+/// the first sample that decided it.
 #[test]
 fn a_pending_fault_hands_no_time_to_a_slip_candidate() {
     let config = Config {
@@ -720,8 +720,9 @@ fn a_pending_fault_hands_no_time_to_a_slip_candidate() {
     }
     let states: Vec<RiskState> = (130..150u32).map(|t| m.process(noisy(t, 3e-3))).collect();
     let entered = states.iter().position(|&s| s == RiskState::GrossSlip);
-    // Settled at 136 s, the first sample that decides: entered at 141 s, not before.
-    assert_eq!(entered, Some(11), "{states:?}");
+    // The window filled by 136 s, the first sample that decides at 137 s: entered at
+    // 142 s, not before.
+    assert_eq!(entered, Some(12), "{states:?}");
 }
 
 /// The fit's slope over its standard error (f64), from the trend's points.
@@ -887,7 +888,7 @@ fn one_glitch_after_a_dropout_raises_nothing() {
     let changes = changes(&mut m);
     assert_eq!(
         changes,
-        [(6_000, RiskState::Stopped, RiskState::Normal)],
+        [(7_000, RiskState::Stopped, RiskState::Normal)],
         "only the start"
     );
 }
@@ -900,8 +901,9 @@ type Restart = fn(&mut Demo, u32) -> u32;
 /// again: after a dropout, a stop, a new configuration or scene, and a checkpoint
 /// restored mid-settling or taken under other accepted ranges, one sample at 3 mrad
 /// (gross slip) and then normal ones raise nothing. The state is held, and
-/// `settling()` says so, until the 7th valid running sample (the spike window)
-/// decides; a reset of the statistics leaves the conditioning as it is.
+/// `settling()` says so, while 7 valid running samples fill the spike window; the 8th,
+/// the first tested, decides. A reset of the statistics leaves the conditioning as it
+/// is.
 #[test]
 fn every_restart_settles_before_a_sample_decides() {
     let config = Config {
@@ -961,13 +963,13 @@ fn every_restart_settles_before_a_sample_decides() {
         assert_eq!(m.state(), held, "{restart}");
         assert!(m.settling(), "{restart}");
         // The glitch is the first fresh sample (the second after the checkpoint taken
-        // while settling); the 7th decides.
+        // while settling); the 8th decides.
         let fresh = if restart.contains("while settling") {
             2
         } else {
             1
         };
-        let deciding = 7 - fresh - 1;
+        let deciding = 8 - fresh - 1;
         let mut states = Vec::new();
         for t in t + 1..t + 61 {
             states.push(normal_run(&mut m, t, 1)[0]);

@@ -51,9 +51,9 @@ fn sample(t_s: u32, mu: f64, noise: f32, rng: &mut Noise) -> Sample {
 
 /// The friction events of a monitor, as (time s, mu, changed).
 /// Samples the conditioning settles on after a start afresh, which estimate nothing:
-/// all but the last of the spike window's.
+/// those that fill the spike window.
 fn settling() -> u32 {
-    u32::from(Config::default().spikes.unwrap().window) - 1
+    u32::from(Config::default().spikes.unwrap().window)
 }
 
 fn friction_events<E: Estimator>(m: &mut Monitor<E>, out: &mut Vec<(f64, f32, bool)>) {

@@ -6,11 +6,12 @@
 //! **Settling.** After a start afresh (a new monitor, a fault, a stop, a new
 //! configuration or scene) the windows are empty and a value has nothing to be tested
 //! against: the first `window` valid running samples only fill the windows and
-//! condition nothing; the last of them gives the windows' medians, from which the
-//! smoothing starts, and the spike test runs from the next one. So no single sample,
-//! whatever its value, decides what follows a restart (a median of three or more
-//! values is one of the others when one is an outlier). Without spike rejection there
-//! is no window and nothing settles.
+//! condition nothing. The next one is the first the spike test can test, against all
+//! of them, and the first conditioned; the smoothing starts from it. So no single
+//! sample, whatever its value, decides what follows a restart: an outlier among the
+//! filling samples is one of three or more values, which moves neither the window's
+//! median nor its MAD far, and an outlier first tested is a spike. Without spike
+//! rejection there is no window and nothing settles.
 
 use super::config::{Config, SPIKE_WINDOW_CAPACITY, SpikeFilter};
 use super::order::{ge, key, positive, value};
@@ -69,12 +70,6 @@ impl Window {
 
     fn len(&self) -> usize {
         usize::from(self.len).min(CAP)
-    }
-
-    /// The median of the values held (0 for none).
-    fn median(&self) -> f32 {
-        let (sorted, n) = self.sorted();
-        median(sorted.get(..n).unwrap_or(&[]))
     }
 
     pub(crate) fn clear(&mut self) {
@@ -341,13 +336,18 @@ pub(crate) struct Conditioned {
 }
 
 /// The stage's state: the spike windows of load and angle, the smoothed values, the
-/// last time step's values; and whether the configuration smooths at all.
+/// last time step's values, whether the last sample only filled the windows; and
+/// whether the configuration smooths at all.
 #[derive(Debug, Clone)]
 pub(crate) struct Conditioning {
     /// The spike windows of load (N) and angle (rad).
     pub(crate) windows: [Window; 2],
     /// Smoothed load (N) and angle (rad), `None` after a restart.
     pub(crate) smoothed: Option<[f32; 2]>,
+    /// Whether the last sample conditioned was settling (it only filled the windows).
+    /// Not part of the monitor's state: it follows from the windows but for the one
+    /// sample that fills them (see [`Conditioning::resumed`]).
+    pub(crate) settling: bool,
     step_cache: StepCache,
     /// Whether the smoothing is on (its time constant above zero).
     smoothing: bool,
@@ -358,6 +358,7 @@ impl Conditioning {
         Conditioning {
             windows: [Window::new(), Window::new()],
             smoothed: None,
+            settling: false,
             step_cache: StepCache::new(),
             // Above zero, by the bits (validated finite and not negative).
             smoothing: positive(config.smoothing_tau_s),
@@ -379,20 +380,22 @@ impl Conditioning {
     ) -> Option<Conditioned> {
         let (mut load, mut phi) = (load, phi);
         if let Some(filter) = &config.spikes {
+            // Settling: a window is not yet full, and takes the value untested.
+            let settling = self.filling(usize::from(filter.window));
+            self.settling = settling;
+            // One loop over both channels: one copy of the window's code in the image.
             let mut values = [load, phi];
-            let n = usize::from(filter.window);
-            if self.settling(n) {
-                values = self.settle(n, values)?;
-            } else {
-                // One loop over both channels: one copy of the window's code in the
-                // image.
-                let floors = [filter.load_floor, filter.angle_floor];
-                for ((w, x), floor) in self.windows.iter_mut().zip(&mut values).zip(floors) {
-                    if let Some(m) = w.hampel(*x, filter, floor) {
-                        *x = m;
-                        stats.count_spike();
-                    }
+            let floors = [filter.load_floor, filter.angle_floor];
+            for ((w, x), floor) in self.windows.iter_mut().zip(&mut values).zip(floors) {
+                if let Some(m) = w.hampel(*x, filter, floor) {
+                    *x = m;
+                    stats.count_spike();
                 }
+            }
+            if settling {
+                // Nothing decided; the smoothing starts from the first tested value.
+                self.smoothed = None;
+                return None;
             }
             [load, phi] = values;
         }
@@ -414,31 +417,20 @@ impl Conditioning {
     }
 
     /// Whether a window holds fewer than `n` values (the spike window's length): the
-    /// conditioning settles.
+    /// next sample settles.
     #[inline(always)]
-    pub(crate) fn settling(&self, n: usize) -> bool {
-        self.windows.iter().any(|w| w.len() < n)
-    }
-
-    /// Whether a window holds a value: samples have come since the last restart.
-    pub(crate) fn started(&self) -> bool {
-        self.windows.iter().any(|w| w.len() > 0)
-    }
-
-    /// A settling sample's load and angle `values` into the windows of `n` values;
-    /// once both are full, the windows' medians, from which the smoothing starts.
-    #[cold]
-    #[inline(never)]
-    fn settle(&mut self, n: usize, values: [f32; 2]) -> Option<[f32; 2]> {
-        for (w, x) in self.windows.iter_mut().zip(values) {
-            w.push_back(x, n);
-        }
-        if self.settling(n) {
-            return None;
-        }
-        self.smoothed = None;
+    fn filling(&self, n: usize) -> bool {
         let [load, angle] = &self.windows;
-        Some([load.median(), angle.median()])
+        usize::from(load.len.min(angle.len)) < n
+    }
+
+    /// After the windows were restored, with a spike window of `window` values (none:
+    /// spike rejection off): whether the last sample was settling, as far as the
+    /// windows tell (partly filled; a state taken just after the sample that filled
+    /// them reads as settled, and the next sample decides either way).
+    pub(crate) fn resumed(&mut self, window: Option<usize>) {
+        let started = self.windows.iter().any(|w| w.len() > 0);
+        self.settling = started && window.is_some_and(|n| self.filling(n));
     }
 
     /// Starts afresh after a sample that was not conditioned (a fault, a stop): the
@@ -449,6 +441,7 @@ impl Conditioning {
             w.clear();
         }
         self.smoothed = None;
+        self.settling = false;
     }
 }
 

@@ -30,8 +30,9 @@
 //! afresh (at the first sample, after a fault, a stop, a new configuration or scene,
 //! a restored state it cannot take): the first valid running samples, as many as the
 //! spike window holds, only fill its windows and ask for no change (the state is
-//! held, and any change pending ends: they are valid and running); the last of them
-//! decides, from the windows' medians. A start and its start-up inhibit wait for it.
+//! held, and any change pending ends: they are valid and running); the next, the
+//! first the spike test can test against them, decides. A start and its start-up
+//! inhibit wait for it.
 //!
 //! Conditioning, estimate, energy and trend see only a valid running sample. The
 //! stages count what they see into the [`Statistics`] (time per state, spikes,
@@ -310,14 +311,12 @@ impl<E: Estimator> Monitor<E> {
 
     /// Whether the conditioning is settling: since it started afresh (a new monitor, a
     /// fault, a stop, a new configuration or scene, a restored state it could not
-    /// take) valid running samples have come, but fewer than the spike window's
-    /// length (7 by default). Meanwhile no sample decides a state: the reported state
-    /// is held, and the last of them decides from the windows' medians. Never with
-    /// spike rejection off.
+    /// take) valid running samples have come, and the last of them was still filling
+    /// the spike window (7 samples by default). Meanwhile no sample decides a state:
+    /// the reported state is held; the next sample after the window is full decides.
+    /// Never with spike rejection off.
     pub fn settling(&self) -> bool {
-        let c = &self.conditioning;
-        let window = self.config.spikes.map_or(0, |s| usize::from(s.window));
-        c.started() && c.settling(window)
+        self.conditioning.settling
     }
 
     /// Monotonic time since the first sample (ms).
@@ -627,7 +626,9 @@ impl<E: Estimator> Monitor<E> {
     /// value, or a spike window holding a value, outside its load and angle ranges (a
     /// state of another configuration, or no monitor's) is left out, and the
     /// conditioning starts afresh there, as after a fault (and settles again). A state
-    /// taken while the conditioning settled goes on settling.
+    /// taken while the conditioning settled goes on settling (read from its windows:
+    /// taken just after the sample that filled them, `settling` reads false, and the
+    /// next sample decides either way).
     pub fn resume(&mut self, state: &MonitorState) {
         self.clock = state.clock;
         self.alarm = state.alarm;
@@ -655,6 +656,8 @@ impl<E: Estimator> Monitor<E> {
                 window.push_back(x, n);
             }
         }
+        let window = self.config.spikes.map(|s| usize::from(s.window));
+        self.conditioning.resumed(window);
         self.trend.points.clear();
         for p in state.trend.iter() {
             let _ = self.trend.points.push_back(p);
