@@ -34,6 +34,24 @@ pub fn log2_u32(x: u32) -> i32 {
     ((31 - lz as i32) << 24).wrapping_add(mantissa)
 }
 
+/// [`log2_u32`] for `x >= 1`, without its test for 0 (`x = 0` gives an unspecified
+/// value, never a panic): for counts that a scene's range already holds at 1 or above.
+#[inline(always)]
+pub(crate) fn log2_positive(x: u32) -> i32 {
+    // As `normalize`, with the shift wrapping: 0 shifts by 32 where `CLZ` gives it.
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    let (lz, normalized) = normalize_by_search(x);
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    let (lz, normalized) = {
+        let lz = x.leading_zeros();
+        (lz, x.wrapping_shl(lz))
+    };
+    let fraction = (normalized << 1) >> 8;
+    let mantissa = LOG2_MANTISSA.eval(fraction as i32).unwrap_or_default();
+    // lz <= 32 (32 for x = 0 only): the subtraction cannot wrap.
+    (31 - lz as i32).wrapping_shl(24).wrapping_add(mantissa)
+}
+
 /// `x / 3` for non-negative x, exactly, by shifts (a Cortex-M0 has no divider).
 /// `(lz, x << lz)` for x > 0, lz its leading zeros: one `CLZ` where the core has
 /// it; on ARMv6-M (the Cortex-M0; the Arm target without compare-and-swap atomics)
@@ -148,6 +166,27 @@ mod tests {
         assert_eq!(log2_u32(0), i32::MIN);
         assert_eq!(log2_u32(1), 0);
         assert_eq!(log2_u32(1 << 20), 20 << 24);
+    }
+
+    /// log2_u32 never decreases: over every fraction the table sees (the octave
+    /// [2^24, 2^25), where x and its fraction are one to one), and from one octave to
+    /// the next (the octave's top stays below the next octave's start). Larger x drop
+    /// bits below the fraction (floor, which keeps the order), smaller x are fractions
+    /// with trailing zeros: monotone over every u32. The fixed-point elliptic scene
+    /// relies on it to turn the critical angle's bound on log2 g0 into a bound on the
+    /// load (`FixedEllipticScene`'s heaviest load with a critical angle).
+    #[test]
+    fn log2_never_decreases() {
+        let mut last = log2_u32((1 << 24) - 1);
+        for x in (1u32 << 24)..(1u32 << 25) {
+            let l = log2_u32(x);
+            assert!(l >= last, "{x}: {l} < {last}");
+            last = l;
+        }
+        assert!(last <= log2_u32(1 << 25), "{last}");
+        for x in (1u32..=u32::MAX).step_by(7919).chain([u32::MAX]) {
+            assert!(log2_u32(x) <= log2_u32(x.saturating_add(1)), "{x}");
+        }
     }
 
     #[test]
