@@ -850,7 +850,7 @@ mod power_loss {
 
     use misalign::monitor::MonitorState;
 
-    /// The node's store (examples/firmware/persist.rs): the committed image beside the
+    /// The node's store (nodes/firmware/persist.rs): the committed image beside the
     /// monitor's state checkpoints, one map, one buffer for the larger record.
     const BOTH_BUF: usize = {
         let state = Store::<BlockingFlash<Flash>, 0>::buffer_len::<MonitorState>();

@@ -376,3 +376,65 @@ fn replay_child() {
             .trim()
     );
 }
+
+/// `--thresholds` over a trace whose loads never reach above the stop load (100 N) is
+/// refused with a message, not a table for a range the trace never saw; a trace whose
+/// loads pass the configuration's `load_max` gets a table up to it, and says so.
+#[test]
+fn the_planners_range_is_refused_or_its_change_said() {
+    let rows = |p: f64| {
+        let mut csv = String::from("t,P,phi\n");
+        for i in 0..200 {
+            csv += &format!("{i},{p},2e-4\n");
+        }
+        csv
+    };
+    let dir = trace_file("plan-dir-marker", b"")
+        .parent()
+        .unwrap()
+        .to_owned();
+    let out = |name: &str| dir.join(name).display().to_string();
+    for (name, p) in [
+        ("plan-50.csv", 50.0),
+        ("plan-neg.csv", -100.0),
+        ("plan-nan.csv", f64::NAN),
+    ] {
+        let trace = trace_file(name, rows(p).as_bytes());
+        let thresholds = out(&format!("{name}-thresholds.csv"));
+        let _ = std::fs::remove_file(&thresholds);
+        let (code, _, err) = monitor(&[
+            "--trace",
+            trace.to_str().unwrap(),
+            "--plot",
+            &out(&format!("{name}.svg")),
+            "--thresholds",
+            &thresholds,
+        ]);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(err.contains("--thresholds:"), "{name}: {err}");
+        assert!(
+            err.contains("stop load") || err.contains("no finite load"),
+            "{name}: {err}"
+        );
+        assert!(!std::path::Path::new(&thresholds).exists(), "{name}");
+    }
+    // Above the configuration's maximum load (50 kN): the table ends there, said.
+    let trace = trace_file("plan-high.csv", rows(49_000.0).as_bytes());
+    let thresholds = out("plan-high-thresholds.csv");
+    let (code, _, err) = monitor(&[
+        "--trace",
+        trace.to_str().unwrap(),
+        "--plot",
+        &out("plan-high.svg"),
+        "--thresholds",
+        &thresholds,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("ends at the configuration's load_max, 50000 N"),
+        "{err}"
+    );
+    let table = std::fs::read_to_string(&thresholds).unwrap();
+    let last = table.lines().last().unwrap();
+    assert!(last.starts_with("50000,"), "{last}");
+}

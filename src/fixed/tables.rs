@@ -1,5 +1,5 @@
 //! Tables of the fixed-point core (Q8.24, uniform spacing, quadratic interpolation),
-//! generated from the f64 reference by `cargo xtask tables` (xtask/src/fixed_tables.rs).
+//! generated from the f64 reference by `cargo xtask tables` (lab/xtask/src/fixed_tables.rs).
 //! Do not edit: a test regenerates this file and fails on any drift.
 
 use super::uniform::UniformTable;

@@ -1,5 +1,5 @@
 //! Tables of the f32 core (octave polynomials; the axial force's two pieces),
-//! generated from the f64 reference by `cargo xtask tables` (xtask/src/tables.rs).
+//! generated from the f64 reference by `cargo xtask tables` (lab/xtask/src/tables.rs).
 //! Do not edit: a test regenerates this file and fails on any drift.
 
 use super::octave::{OctaveTable, Row, Segment};

@@ -1,6 +1,6 @@
 //! What one estimate of the reference costs, counted (test builds only): calls of
 //! Carlson's R_D and evaluations of the function being solved, per estimate over the
-//! host benchmark's samples (workload/src/samples.rs: the demo scene, theta from
+//! host benchmark's samples (lab/workload/src/samples.rs: the demo scene, theta from
 //! 1e-5 to 1e-2, loads from 50 N to 5 kN). `cargo test --lib cost -- --nocapture`.
 
 use core::cell::Cell;
@@ -46,7 +46,7 @@ mod tests {
     use crate::Scene;
     use crate::reference::{elliptic, normal};
 
-    /// The host benchmark's samples (workload/src/samples.rs, `practical`).
+    /// The host benchmark's samples (lab/workload/src/samples.rs, `practical`).
     fn practical(n: usize) -> impl Iterator<Item = (f64, f64)> {
         (0..n).map(move |i| {
             let u = (i as f64 + 0.5) / n as f64;

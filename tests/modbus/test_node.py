@@ -60,7 +60,7 @@ def test_identification_basic_and_regular(client):
 def test_exceptions(client, raw):
     # 01: a function the node does not implement (8, diagnostics). Its length is
     # unknown, so the node answers at the silence after it (in QEMU a second of
-    # virtual time, `examples/firmware/uart.rs`): wait longer than for the others.
+    # virtual time, `nodes/firmware/uart.rs`): wait longer than for the others.
     raw.send(frame([0x08, 0x00, 0x00, 0x12, 0x34]))
     assert raw.answer(5.0) == frame([0x88, 0x01])
     # 02: registers beyond the map.

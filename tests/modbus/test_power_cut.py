@@ -1,6 +1,6 @@
 """Power cuts of the node with flash in QEMU, at points of a commit, of an event push
 and of an acknowledgement. The node is a test build (feature `_power-cut`,
-examples/firmware/cut.rs): the test writes a plan (`commit N`, `push N` or `ack N`)
+nodes/firmware/cut.rs): the test writes a plan (`commit N`, `push N` or `ack N`)
 to MODBUS_POWER_CUT_PLAN, and the node resets itself after N points (bytes written,
 words erased) of its next such operation, as a power cut there would. The master
 then reconnects and checks: the old configuration or the new one, whole; no event

@@ -1,5 +1,5 @@
 """The commissioning tool over a serial line, for real: a second QEMU of the same node
-image with its serial0 on a pseudo-terminal (`-serial pty`: tools/qemu-run with
+image with its serial0 on a pseudo-terminal (`-serial pty`: lab/qemu-run with
 MISALIGN_QEMU_SERIAL=pty; QEMU's monitor names the terminal, `info chardev`), and
 `tools/commission.py --serial /dev/pts/N` (pymodbus's serial client over pyserial)
 unlocking, writing, committing and reading back; then pymodbus's serial client reads
@@ -60,7 +60,7 @@ def pty():
                MISALIGN_QEMU_MACHINE=os.environ["MODBUS_MACHINE"],
                MISALIGN_QEMU_MONITOR_PORT=str(monitor), MISALIGN_QEMU_PARENT=str(os.getpid()))
     env.pop("MISALIGN_QEMU_SERIAL_PORT", None)
-    node = subprocess.Popen(["tools/qemu-run", os.environ["MODBUS_MACHINE"], os.environ["MODBUS_ELF"]],
+    node = subprocess.Popen(["lab/qemu-run", os.environ["MODBUS_MACHINE"], os.environ["MODBUS_ELF"]],
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
                             errors="replace", start_new_session=True)
     serving = threading.Event()

@@ -1,5 +1,5 @@
 //! Seed tables of the reference's fast path (src/reference/fast/table.rs), generated
-//! from the f64 reference by `cargo xtask tables` (xtask/src/seeds.rs).
+//! from the f64 reference by `cargo xtask tables` (lab/xtask/src/seeds.rs).
 //! Do not edit: a test regenerates this file and fails on any drift.
 
 use super::table::{Segment, Table};

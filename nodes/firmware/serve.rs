@@ -1,0 +1,169 @@
+//! The Modbus node, written once for every board: `misalign::modbus::Server` over the
+//! monitor (framing, CRC, the register map, the event window), polled over any UART
+//! implementing the `embedded-io` 0.7 traits: the QEMU images' register-level drivers
+//! (`uart.rs`) and a real board's HAL (`nodes/pico`) alike.
+
+use embedded_io::{ErrorType, Read, ReadReady, Write};
+use misalign::Estimator;
+use misalign::modbus::{Identification, PreparedScene, Server, ServerConfig};
+use misalign::monitor::scenario::Scenario;
+use misalign::monitor::{Config, Monitor};
+
+/// The node's model names (function 43/14): the core and the scene.
+pub const MODEL_F32: &str = "f32 core (float::Auto), the built-in scenario's scene";
+pub const MODEL_FIXED: &str = "fixed-point core (fixed::FixedAuto), the built-in scenario's scene";
+
+/// Whether this image takes its samples from a Modbus master (written to the server's
+/// sample block) instead of monitoring the built-in scenario: chosen at build time,
+/// `MISALIGN_MODBUS_EXTERNAL=1` (any value) in the environment of the build.
+pub const EXTERNAL_SAMPLES: bool = option_env!("MISALIGN_MODBUS_EXTERNAL").is_some();
+
+/// The line's clock: `ticks` a free-running count (wrapping), `silence` how many of its
+/// ticks without a byte end a frame (3.5 character times on a real line,
+/// `misalign::modbus::silence_us`).
+pub struct LineClock<T: FnMut() -> u32> {
+    pub ticks: T,
+    pub silence: u32,
+    /// Ticks in a millisecond: the commissioning's clock (`Server::tick`).
+    pub per_ms: u32,
+}
+
+/// The Modbus node: a `misalign::modbus::Server` over the monitor of `core`
+/// (`model`: its name and the scene's, function 43/14's model name), answering on
+/// `uart` forever, told of the line's silences by `clock`. With its own samples
+/// (the default) it first monitors the whole built-in scenario, so that every register
+/// holds the end of the shift, the state a host replay of the same samples reaches;
+/// with external samples it starts fresh and monitors what a master writes. `None` if
+/// the monitor refuses its configuration.
+pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut() -> u32>(
+    core: E,
+    model: &'static str,
+    uart: &mut U,
+    mut clock: LineClock<T>,
+) -> Option<core::convert::Infallible> {
+    let monitor = match Monitor::new(core, Config::default()) {
+        Ok(m) => m,
+        Err(e) => {
+            defmt::error!("node: configuration refused: {}", e);
+            return None;
+        }
+    };
+    #[cfg(feature = "modbus-flash")]
+    let Some(mut persist) = crate::persist::Persist::open() else {
+        defmt::error!("node: the flash cannot be opened");
+        return None;
+    };
+    let config = ServerConfig {
+        external_samples: EXTERNAL_SAMPLES,
+        ident: Identification {
+            model_name: model,
+            ..Identification::default()
+        },
+        ..ServerConfig::default()
+    };
+    let mut server = match Server::new(monitor, config) {
+        Ok(s) => s,
+        Err(e) => {
+            defmt::error!("node: server configuration refused: {}", e);
+            return None;
+        }
+    };
+    // Commissioning takes scenes of the node's core type over the bus.
+    server.accept_scenes();
+    // With flash (`modbus-flash`): the committed configuration, then the monitor's
+    // last checkpoint under it.
+    #[cfg(feature = "modbus-flash")]
+    {
+        let (source, restored) = persist.start(&mut server);
+        defmt::println!(
+            "storage: configuration from {}, state restored {=bool}, {=u64} samples monitored",
+            source,
+            restored,
+            server.monitor().statistics().samples()
+        );
+    }
+    if !EXTERNAL_SAMPLES {
+        // The scenario's samples not yet monitored (after a restored checkpoint, those
+        // after it).
+        let done = server.monitor().statistics().samples() as usize;
+        for sample in Scenario::new().skip(done) {
+            server.process(sample);
+            #[cfg(feature = "modbus-flash")]
+            persist.service(&mut server);
+        }
+    }
+    defmt::println!(
+        "modbus: serving, {=str}, samples from {=str}, {=u64} processed",
+        model,
+        if EXTERNAL_SAMPLES {
+            "the master"
+        } else {
+            "the built-in scenario"
+        },
+        server.monitor().statistics().samples()
+    );
+    // When the last byte came, and whether a frame may be waiting for the silence that
+    // ends it (garbage, a truncated frame, a function the server does not know: the
+    // server drops or answers it then).
+    let (mut last_byte, mut waiting) = ((clock.ticks)(), false);
+    let mut uart = Watched { uart, seen: false };
+    // The commissioning's milliseconds, from the line's ticks.
+    let (mut ms, mut ticked) = (0u32, last_byte);
+    let per_ms = clock.per_ms.max(1);
+    loop {
+        if server.poll(&mut uart).is_err() {
+            // A framing, parity or overrun error: bytes lost, which the framer's CRC
+            // and resynchronisation deal with; the master retries.
+            defmt::warn!("modbus: a UART error");
+        }
+        #[cfg(feature = "modbus-flash")]
+        persist.service(&mut server);
+        let now = (clock.ticks)();
+        let step = now.wrapping_sub(ticked);
+        if step >= per_ms {
+            ms = ms.wrapping_add(step / per_ms);
+            ticked = ticked.wrapping_add(step - step % per_ms);
+            server.tick(ms);
+        }
+        if core::mem::take(&mut uart.seen) {
+            (last_byte, waiting) = (now, true);
+        } else if waiting && now.wrapping_sub(last_byte) >= clock.silence {
+            server.idle();
+            waiting = false;
+        }
+    }
+}
+
+/// A UART that notes whether a read took a byte.
+struct Watched<'a, U> {
+    uart: &'a mut U,
+    seen: bool,
+}
+
+impl<U: ErrorType> ErrorType for Watched<'_, U> {
+    type Error = U::Error;
+}
+
+impl<U: ReadReady> ReadReady for Watched<'_, U> {
+    fn read_ready(&mut self) -> Result<bool, U::Error> {
+        self.uart.read_ready()
+    }
+}
+
+impl<U: Read> Read for Watched<'_, U> {
+    fn read(&mut self, buf: &mut [u8]) -> Result<usize, U::Error> {
+        let n = self.uart.read(buf)?;
+        self.seen |= n > 0;
+        Ok(n)
+    }
+}
+
+impl<U: Write> Write for Watched<'_, U> {
+    fn write(&mut self, buf: &[u8]) -> Result<usize, U::Error> {
+        self.uart.write(buf)
+    }
+
+    fn flush(&mut self) -> Result<(), U::Error> {
+        self.uart.flush()
+    }
+}
