@@ -35,12 +35,11 @@ pub struct FixedEllipticScene {
     log_hertz: i32,
     /// log2(3 x load LSB / (2 pi)): log2 p0 = this + log2(counts) - log2 a - log2 b (eq 7).
     log_pressure: i32,
-    /// How many loads from `range.load_min` up have a critical angle: phi0 = theta0 / c
-    /// at most pi/2 (and g0 at most pi/2), which depends on the scene (c, eq 4) and on
-    /// the load alone (g0 grows with it, eq 18). Derived when the scene is prepared or
-    /// loaded (not in its bytes): the per-sample path then tests the load's range once,
-    /// with no bound on log2 g0 of its own.
-    critical_loads: u32,
+    /// The largest log2 g0 (Q8.24) with a critical angle: phi0 = theta0 / c at most
+    /// pi/2 (and g0 at most pi/2). Derived from `log_radius_factor` and the theta(g)
+    /// table when the scene is prepared or loaded (not in its bytes), so that the
+    /// per-sample path tests one bound.
+    log_g0_max: i32,
     /// `load_min >= 1`: `estimate` tests zero load only below it.
     range: InputRange,
     /// What one count stands for (the estimator contract).
@@ -94,17 +93,16 @@ impl FixedEllipticScene {
         } else {
             load_min as u32
         };
-        let log_radius_factor = constant(c)?;
         let scene = FixedEllipticScene {
             log_theta_lsb,
             log_slip: constant(slip_gain / cbrt_lsb)?,
             log_critical,
-            log_radius_factor,
+            log_radius_factor: constant(c)?,
             log_force: constant_below(scene.friction() * load_lsb)?,
             log_risk: constant(DEFAULT_RISK_SLIP_RATIO as f64)?,
             log_hertz: constant(v * cbrt_lsb)?,
             log_pressure: constant(3.0 * load_lsb / (2.0 * PI))?,
-            critical_loads: critical_loads(log_critical, log_radius_factor, load_min),
+            log_g0_max: log_g0_max(constant(c)?),
             units: Units::new(load_lsb, angle_lsb)?,
             range: InputRange {
                 load_min,
@@ -182,70 +180,58 @@ impl FixedEllipticScene {
     #[inline(always)]
     pub fn estimate(&self, load: u32, angle: i32) -> Result<FixedEstimate, Error> {
         let a = angle.unsigned_abs();
-        // The common sample in two unsigned compares: 1 <= |angle| <= angle_max and a
-        // load from load_min (>= 1) with a critical angle. The scene's own bounds
-        // (the tables' start, phi0 within pi/2) were turned into these ranges when it
-        // was prepared; everything else takes `estimate_edge`, which answers the same.
-        if a.wrapping_sub(1) >= self.range.angle_max
-            || load.wrapping_sub(self.range.load_min) >= self.critical_loads
-        {
-            return self.estimate_edge(load, angle);
-        }
-        let lp = log2_positive(load);
-        let lp3 = div3(lp);
-        let (phi0, margin) = self.critical_angle(lp3, a)?;
-        self.misaligned(a, angle < 0, (lp, lp3), Some(phi0), Some(margin))
-    }
-
-    /// [`FixedEllipticScene::estimate`] off its common range: the refusals, zero load,
-    /// zero angle, and loads without a critical angle.
-    #[cold]
-    #[inline(never)]
-    fn estimate_edge(&self, load: u32, angle: i32) -> Result<FixedEstimate, Error> {
-        let a = angle.unsigned_abs();
-        if a > self.range.angle_max {
-            return Err(Error::Angle);
-        }
-        // load_min >= 1: zero load lies below it.
+        // The angle's range is tested once, below, at both ends; where a sample is
+        // refused before that, its angle is tested first.
+        let refusal = |load_error| {
+            if a > self.range.angle_max {
+                Error::Angle
+            } else {
+                load_error
+            }
+        };
+        // load_min >= 1: one compare on the common path, zero load inside it.
         if load < self.range.load_min {
-            return if load == 0 {
+            return if load == 0 && a <= self.range.angle_max {
                 Ok(zero_load(a, self.log_risk))
             } else {
-                Err(Error::OutOfRange)
+                Err(refusal(Error::OutOfRange))
             };
         }
+        // load >= 1: log2 without its test for 0. Wrapping adds below never wrap: `new`
+        // bounded the constants (|log2| < 100) and every sum over the declared range
+        // (`check_sums`); counts add < 32, tables < 42.
         let lp = log2_positive(load);
         let lp3 = div3(lp);
-        let (critical, margin) = if load.wrapping_sub(self.range.load_min) < self.critical_loads {
-            let (phi0, margin) = self.critical_angle(lp3, a)?;
-            (Some(phi0), Some(margin))
-        } else {
+        // Critical angle: g(theta0) = g0 (eq 18 at d/b = 1), phi0 = theta0 / c.
+        let z = self.log_critical.wrapping_add(lp3);
+        // No critical angle above g0 = pi/2 (eq 18), nor where phi0 = theta0 / c would
+        // pass pi/2 (unequal radii): `log_g0_max` bounds both.
+        let (critical, margin) = if z > self.log_g0_max {
             (None, None)
+        } else {
+            let log_theta0 = lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z).map_err(refusal)?;
+            // Both within the tables' theta range, 2^-42 .. pi/2.
+            let counts = margin_counts(log_theta0.wrapping_sub(self.log_theta_lsb), a);
+            (
+                Some(Log2(log_theta0.wrapping_sub(self.log_radius_factor))),
+                Some(counts),
+            )
         };
-        if a == 0 {
-            return Ok(zero_angle(critical, margin));
+        // Both ends of the angle's range in one unsigned compare (0 wraps above it):
+        // zero angle answers with the critical angle, above the range is refused.
+        if a.wrapping_sub(1) >= self.range.angle_max {
+            return if a == 0 {
+                Ok(zero_angle(critical, margin))
+            } else {
+                Err(Error::Angle)
+            };
         }
         self.misaligned(a, angle < 0, (lp, lp3), critical, margin)
     }
 
-    /// phi0 (eq 18 at d/b = 1: g(theta0) = g0, phi0 = theta0 / c) and the margin in
-    /// counts, for a load with a critical angle (`lp3` = log2(load counts) / 3).
-    #[inline(always)]
-    fn critical_angle(&self, lp3: i32, a: u32) -> Result<(Log2, i32), Error> {
-        // Wrapping adds below never wrap: `new` bounded the constants (|log2| < 100) and
-        // every sum over the declared range (`check_sums`); counts add < 32, tables < 42.
-        let z = self.log_critical.wrapping_add(lp3); // log2 g0
-        let log_theta0 = lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z)?;
-        // Both within the tables' theta range, 2^-42 .. pi/2.
-        let margin = margin_counts(log_theta0.wrapping_sub(self.log_theta_lsb), a);
-        Ok((
-            Log2(log_theta0.wrapping_sub(self.log_radius_factor)),
-            margin,
-        ))
-    }
-
     /// The estimate of a misaligned (`a` >= 1 counts), loaded (`load` >= load_min)
-    /// sample, with log2 of its load counts and their third, and its critical angle.
+    /// sample, with log2 of its load counts and their third, and its critical angle;
+    /// its wrapping adds are bounded as in `estimate`.
     #[inline(always)]
     fn misaligned(
         &self,
@@ -385,54 +371,26 @@ pub struct FixedDetails {
     pub p0: Log2,
 }
 
-/// How many loads from `load_min` up have a critical angle, for a scene of these
-/// constants: g0 = 2^log_critical P^(1/3) (eq 18) at most pi/2, and phi0 = theta0 / c
-/// from the table at most pi/2 (`log_c` = log2 c). Integers only, so that a scene
-/// loaded from bytes derives it alike. log2 g0 as `estimate` forms it never
-/// decreases with the load ([`log2_u32`] never does, nor the division by 3), so the
-/// loads with one are those up to the heaviest, found by bisection: no load's answer
-/// differs from a test of log2 g0 against its bound.
-fn critical_loads(log_critical: i32, log_c: i32, load_min: u32) -> u32 {
-    let g0_max = log_g0_max(log_c) as i64;
-    let has = |load: u32| log_critical as i64 + div3(log2_u32(load)) as i64 <= g0_max;
-    if load_min == 0 || !has(load_min) {
-        return 0;
-    }
-    let heaviest = if has(u32::MAX) {
-        u32::MAX
-    } else {
-        last_within(load_min.into(), u32::MAX.into(), |l| has(l as u32)) as u32
-    };
-    // load_min >= 1 and heaviest >= load_min: no wrap (wrapping only where the no-panic
-    // proof cannot see it).
-    heaviest.wrapping_sub(load_min).wrapping_add(1)
-}
-
 /// The largest log2 g0 (Q8.24, at most log2(pi/2)) whose theta0 from the table gives
-/// phi0 = theta0 / c at most pi/2, for `log_c` = log2 c (theta(g) increases),
-/// integers only. Below the table's start: the start less one (no critical angle at
-/// all).
+/// phi0 = theta0 / c at most pi/2, for `log_c` = log2 c: a bisection on the table
+/// (theta(g) increases), integers only, so that a scene loaded from bytes derives it
+/// alike. Below the table's start: the start less one (no critical angle at all).
 fn log_g0_max(log_c: i32) -> i32 {
     let within = |z: i32| {
         lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z)
             .is_ok_and(|t| t as i64 - log_c as i64 <= LOG2_HALF_PI as i64)
     };
-    let (lo, hi) = (LOG_THETA_LOW.start, LOG2_HALF_PI);
+    let (mut lo, mut hi) = (LOG_THETA_LOW.start, LOG2_HALF_PI);
     if within(hi) {
         return hi;
     }
     if !within(lo) {
         return lo.saturating_sub(1);
     }
-    last_within(lo.into(), hi.into(), |z| within(z as i32)) as i32
-}
-
-/// The last x of `lo..hi` where `within` holds, for a `within` that holds at `lo`,
-/// not at `hi`, and changes once between them: a bisection, 33 halvings at most for
-/// bounds of 32 bits (whose differences cannot wrap an i64).
-fn last_within(mut lo: i64, mut hi: i64, within: impl Fn(i64) -> bool) -> i64 {
+    // within(lo) and not within(hi), lo < hi, both within +-2^31 / 2 (table and
+    // log2(pi/2)): the differences cannot wrap; 32 halvings at most.
     while hi.wrapping_sub(lo) > 1 {
-        let mid = lo.wrapping_add(hi.wrapping_sub(lo) >> 1);
+        let mid = lo.wrapping_add(hi.wrapping_sub(lo) / 2);
         if within(mid) {
             lo = mid;
         } else {
@@ -530,7 +488,6 @@ impl FixedEllipticScene {
         for x in &mut c {
             *x = read_constant(r)?;
         }
-        let (load_min, angle_max) = (r.u32()?, r.u32()?);
         let scene = FixedEllipticScene {
             log_theta_lsb: c[0],
             log_slip: c[1],
@@ -540,10 +497,10 @@ impl FixedEllipticScene {
             log_risk: c[5],
             log_hertz: c[6],
             log_pressure: c[7],
-            critical_loads: critical_loads(c[2], c[3], load_min),
+            log_g0_max: log_g0_max(c[3]),
             range: InputRange {
-                load_min,
-                angle_max,
+                load_min: r.u32()?,
+                angle_max: r.u32()?,
             },
             units: Units::read(r)?,
         };
@@ -558,112 +515,91 @@ impl FixedEllipticScene {
 }
 
 #[cfg(test)]
-mod common_path_tests {
-    use super::{FixedEllipticScene, div3, log_g0_max, log2_u32};
-    use crate::Scene;
-    use std::{vec, vec::Vec};
+mod order_tests {
+    use super::*;
+    use std::vec;
 
-    /// Equal radii, and radii 25 and 1000 times apart, whose phi0 = theta0 / c passes
-    /// pi/2 at heavy loads; load LSBs that put that load inside the counts or beyond.
-    fn scenes() -> impl Iterator<Item = FixedEllipticScene> {
-        let scenes = [
-            Scene::DEMO,
-            Scene::new(0.02, 0.5, 79.3e9, 0.3, 0.15).unwrap(),
-            Scene::new(1e-3, 1.0, 200e9, 0.29, 0.4).unwrap(),
-            Scene::new(2.0, 3.0, 80e9, 0.28, 0.05).unwrap(),
-        ];
-        scenes.into_iter().flat_map(|scene| {
-            [(1e-2, 1e-8), (1.0, 1e-6), (1e3, 1e-4), (1e6, 1e-3)]
-                .into_iter()
-                .filter_map(move |(load_lsb, angle_lsb)| {
-                    let angle_lsb = f64::max(angle_lsb, FixedEllipticScene::min_angle_lsb(&scene));
-                    FixedEllipticScene::new(&scene, load_lsb, angle_lsb).ok()
-                })
-        })
-    }
-
-    /// The loads with a critical angle are those whose log2 g0, as the estimate forms
-    /// it, is within the bound on it: at every load of a sweep and on both sides of
-    /// the heaviest one, where the derived count ends.
-    #[test]
-    fn critical_loads_are_those_within_the_bound_on_g0() {
-        let mut inside = 0;
-        for core in scenes() {
-            let g0_max = log_g0_max(core.log_radius_factor);
-            let has = |load: u32| core.log_critical + div3(log2_u32(load)) <= g0_max;
-            let (min, n) = (core.range.load_min, core.critical_loads);
-            let heaviest = min.wrapping_add(n).wrapping_sub(1);
-            let mut loads: Vec<u32> = (0..4000u32)
-                .map(|i| (i as f64 * 1.0e6 + 0.5) as u32)
-                .collect();
-            loads.extend((0..33).map(|k| (1u64 << k).min(u32::MAX as u64) as u32));
-            loads.extend([
-                min,
-                heaviest.saturating_sub(1),
-                heaviest,
-                heaviest.saturating_add(1),
-            ]);
-            for load in loads.into_iter().filter(|&l| l >= min) {
-                assert_eq!(load.wrapping_sub(min) < n, has(load), "{load} {min} {n}");
+    impl FixedEllipticScene {
+        /// The estimate with its tests in their plain order (the angle's range, the
+        /// load's, the critical angle's bound, zero angle), as it was written before the
+        /// per-sample path merged them.
+        fn estimate_plain(&self, load: u32, angle: i32) -> Result<FixedEstimate, Error> {
+            let a = angle.unsigned_abs();
+            if a > self.range.angle_max {
+                return Err(Error::Angle);
             }
-            if n > 0 && heaviest < u32::MAX {
-                inside += 1;
-                assert!(has(heaviest) && !has(heaviest + 1));
+            if load < self.range.load_min {
+                return if load == 0 {
+                    Ok(zero_load(a, self.log_risk))
+                } else {
+                    Err(Error::OutOfRange)
+                };
             }
+            let lp = log2_u32(load);
+            let lp3 = div3(lp);
+            let z = self.log_critical.wrapping_add(lp3);
+            let (critical, margin) = if z > self.log_g0_max {
+                (None, None)
+            } else {
+                let log_theta0 = lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z)?;
+                let counts = margin_counts(log_theta0.wrapping_sub(self.log_theta_lsb), a);
+                (
+                    Some(Log2(log_theta0.wrapping_sub(self.log_radius_factor))),
+                    Some(counts),
+                )
+            };
+            if a == 0 {
+                return Ok(zero_angle(critical, margin));
+            }
+            self.misaligned(a, angle < 0, (lp, lp3), critical, margin)
         }
-        assert!(
-            inside >= 3,
-            "{inside} scenes with the heaviest load inside the counts"
-        );
     }
 
-    /// Wherever the common path answers, `estimate_edge` answers the same, and it
-    /// answers alike at every edge: zero and one count of angle and load, the range's
-    /// ends, the heaviest load with a critical angle and the next.
+    /// `estimate` answers as the plain order of tests, answers and refusals alike: over
+    /// scenes of equal and very unequal radii (phi0 beyond pi/2 at heavy loads), soft
+    /// and stiff, frictions and LSBs over many decades (light loads whose critical
+    /// angle falls off the table among them), at every edge of the angle and the load.
     #[test]
-    fn the_common_path_is_the_edge_path_to_the_bit() {
-        let (mut common, mut total) = (0, 0);
-        for core in scenes() {
-            let (min, max) = (core.range.load_min, core.range.angle_max);
-            let heaviest = min.wrapping_add(core.critical_loads).wrapping_sub(1);
-            let mut loads = vec![
-                0,
-                1,
-                min - 1,
-                min,
-                min + 1,
-                heaviest,
-                heaviest.wrapping_add(1),
-            ];
-            loads.extend((0..200u32).map(|i| libm::exp2(i as f64 * 0.16) as u32));
-            let mut angles = vec![
-                0,
-                1,
-                -1,
-                max as i32,
-                -(max as i32),
-                max.wrapping_add(1) as i32,
-            ];
-            angles.extend(
-                (0..60).map(|i| (libm::exp2(i as f64 * 0.52) as i64).min(i32::MAX as i64) as i32),
-            );
-            for &load in &loads {
-                for &angle in &angles {
-                    for angle in [angle, angle.wrapping_neg()] {
-                        total += 1;
-                        let a = angle.unsigned_abs();
-                        if a.wrapping_sub(1) < max && load.wrapping_sub(min) < core.critical_loads {
-                            common += 1;
-                        }
-                        assert_eq!(
-                            core.estimate(load, angle),
-                            core.estimate_edge(load, angle),
-                            "{load} {angle}"
+    fn merged_tests_answer_as_the_plain_order() {
+        let (mut answers, mut refusals) = (0, 0);
+        for (r1, r2) in [(0.05, 0.05), (0.02, 0.5), (1e-3, 1.0), (1e-6, 1e3)] {
+            for (g, mu) in [(79.3e9, 0.3), (1e6, 1e-6), (1e15, 30.0)] {
+                let scene = Scene::new(r1, r2, g, 0.3, mu).unwrap();
+                for lp in (-60..=40).step_by(10) {
+                    for la in [-40, -20, -1] {
+                        let angle_lsb = f64::max(
+                            libm::exp2(la as f64),
+                            FixedEllipticScene::min_angle_lsb(&scene),
                         );
+                        let Ok(core) =
+                            FixedEllipticScene::new(&scene, libm::exp2(lp as f64), angle_lsb)
+                        else {
+                            continue;
+                        };
+                        let (min, max) = (core.range.load_min, core.range.angle_max);
+                        let mut loads = vec![0, 1, 2, u32::MAX, min.saturating_sub(1)];
+                        loads.extend((0..64).map(|k| min.saturating_add(k * k * k)));
+                        loads.extend((0..32).map(|k| 1u32 << k));
+                        let mut angles = vec![0, 1, 2, i32::MAX, i32::MIN, i32::MIN + 1];
+                        angles.extend([max, max.wrapping_add(1), max / 2].map(|x| x as i32));
+                        angles.extend((0..31).map(|k| 1i32 << k));
+                        for &load in &loads {
+                            for &angle in &angles {
+                                for angle in [angle, angle.wrapping_neg()] {
+                                    let want = core.estimate_plain(load, angle);
+                                    assert_eq!(core.estimate(load, angle), want, "{load} {angle}");
+                                    if want.is_ok() {
+                                        answers += 1;
+                                    } else {
+                                        refusals += 1;
+                                    }
+                                }
+                            }
+                        }
                     }
                 }
             }
         }
-        assert!(common > total / 4, "{common} of {total} on the common path");
+        assert!(answers > 10_000 && refusals > 1_000, "{answers} {refusals}");
     }
 }

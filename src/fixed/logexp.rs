@@ -168,27 +168,6 @@ mod tests {
         assert_eq!(log2_u32(1 << 20), 20 << 24);
     }
 
-    /// log2_u32 never decreases: over every fraction the table sees (the octave
-    /// [2^24, 2^25), where x and its fraction are one to one), and from one octave to
-    /// the next (the octave's top stays below the next octave's start). Larger x drop
-    /// bits below the fraction (floor, which keeps the order), smaller x are fractions
-    /// with trailing zeros: monotone over every u32. The fixed-point elliptic scene
-    /// relies on it to turn the critical angle's bound on log2 g0 into a bound on the
-    /// load (`FixedEllipticScene`'s heaviest load with a critical angle).
-    #[test]
-    fn log2_never_decreases() {
-        let mut last = log2_u32((1 << 24) - 1);
-        for x in (1u32 << 24)..(1u32 << 25) {
-            let l = log2_u32(x);
-            assert!(l >= last, "{x}: {l} < {last}");
-            last = l;
-        }
-        assert!(last <= log2_u32(1 << 25), "{last}");
-        for x in (1u32..=u32::MAX).step_by(7919).chain([u32::MAX]) {
-            assert!(log2_u32(x) <= log2_u32(x.saturating_add(1)), "{x}");
-        }
-    }
-
     #[test]
     fn normalize_by_search_counts_leading_zeros() {
         for x in (1u32..=u32::MAX)
