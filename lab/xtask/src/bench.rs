@@ -609,19 +609,20 @@ pub fn targets_note(rows: &[BenchRow]) -> String {
     let parts: Vec<String> = TARGETS
         .iter()
         .map(|t| {
-            let row = find(rows, t.cpu, t.model, Operation::Estimate);
-            let measured = row.map_or("not measured".to_string(), |r| {
-                format!("{} at {}", r.mean, error(r))
-            });
-            let bytes = match t.table_bytes {
-                Some(limit) => format!(
-                    " with at most {limit} bytes of tables ({})",
-                    table_bytes(t.model, Operation::Estimate).unwrap_or(0)
+            let bytes = table_bytes(t.model, Operation::Estimate).unwrap_or(0);
+            let (target_bytes, measured_bytes) = match t.table_bytes {
+                Some(limit) => (
+                    format!(", {limit} bytes of tables"),
+                    format!(", {bytes} bytes"),
                 ),
-                None => String::new(),
+                None => (String::new(), String::new()),
             };
+            let measured = find(rows, t.cpu, t.model, Operation::Estimate)
+                .map_or("not measured".to_string(), |r| {
+                    format!("{} at {}{measured_bytes}", r.mean, error(r))
+                });
             format!(
-                "{} on the {} at most {} instructions at {:.0e}{bytes}: {measured}",
+                "{} on the {}, at most {} instructions at {:.0e}{target_bytes} ({measured})",
                 t.model_name, t.cpu_name, t.instructions, t.error
             )
         })
