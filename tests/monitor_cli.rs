@@ -38,6 +38,36 @@ fn a_trace_becomes_samples_on_the_nodes_wrapping_clock() {
 }
 
 #[test]
+fn a_traces_fault_column_names_a_sensors_own_fault() {
+    use misalign::monitor::{FaultKind, SensorFault, SensorId};
+    let csv = "t,P,phi,V,fault\n0,2000,1e-4,1.5,\n0.1,0,1e-4,1.5,load:disconnected\n\
+               0.2,2000,0,,probe2:out_of_range\n0.3,2000,1e-4,1.5,probe3:stuck\n";
+    let samples = input::read_trace(csv.as_bytes()).unwrap();
+    let faults: Vec<Option<SensorFault>> = samples.iter().map(|s| s.sensor_fault).collect();
+    let fault = |sensor, kind| Some(SensorFault { sensor, kind });
+    assert_eq!(
+        faults[..3],
+        [
+            None,
+            fault(SensorId::Load, FaultKind::Disconnected),
+            fault(SensorId::Probe2, FaultKind::OutOfRange)
+        ]
+    );
+    // A fault this reader does not know: the row's values are no measurement.
+    assert_eq!(faults[3], None);
+    assert!(samples[3].load.is_nan());
+    for sensor in SensorId::ALL {
+        for kind in FaultKind::ALL {
+            let cell = format!("{}:{}", sensor.name(), input::fault_kind_name(kind));
+            assert_eq!(
+                input::sensor_fault(cell.as_bytes()),
+                Some(SensorFault { sensor, kind })
+            );
+        }
+    }
+}
+
+#[test]
 fn a_trace_without_its_columns_is_refused() {
     assert!(input::read_trace("t,P\n0,1\n".as_bytes()).is_err());
     assert!(input::read_trace("".as_bytes()).is_err());

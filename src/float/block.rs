@@ -7,7 +7,7 @@
 
 use super::elliptic::{
     FRICTION_LIMIT, HOT_GAIN_MAX, HOT_GAIN_MIN, HOT_MIN_RADIUS_FACTOR, MIN_RADIUS_FACTOR, Parts,
-    in_hot_range,
+    off_hot_range,
 };
 use super::kernels::cbrt::cbrt_hot;
 use super::{Auto, EllipticScene};
@@ -222,7 +222,7 @@ impl EllipticScene<'_> {
             let k = scenes.sample(i);
             let abs_phi = phi.abs();
             let w = k.cubed_critical_gain * load; // g0^3 (eq 18 at d/b = 1)
-            *hot = in_hot_range(abs_phi, w);
+            *hot = !off_hot_range(abs_phi, w);
             *theta = k.radius_factor * abs_phi; // eq (4)
             *g0 = cbrt_hot(w);
         }

@@ -36,7 +36,10 @@ TRACE: a row without a usable time (t empty, not a number or not finite; a field
     other than the header's; an unterminated quote) is skipped; the skipped rows are
     counted and the first few named in the summary and on stderr. A row with a time but
     a P, phi, V or F cell that is not a number becomes a sample with that value not
-    finite, which the monitor counts as a sensor fault. A time the monitor's clock cannot
+    finite, which the monitor counts as a sensor fault; an optional `fault` column names
+    a sensor's own fault as a node reports it (load, probe1, probe2 or speed, a colon,
+    and disconnected, bus, saturated, stuck, jump or out_of_range: what `cargo xtask
+    pico --samples` writes). A time the monitor's clock cannot
     represent refuses the trace before the replay, naming the row: beyond 2^53 ms (t in
     ns, say), or a step of 2^31 ms (24.8 days) or more between rows, which the node's
     wrapping u32 millisecond counter cannot tell from a shorter one. Times within the
