@@ -328,12 +328,15 @@ fn reference_cold(
     reference_one(inputs, out, i, cache)
 }
 
+#[inline(always)]
 pub(super) fn reference(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) -> usize {
     let mut cache = Cache::new();
     if out.details.is_some() || inputs.choice == ModelChoice::Line {
         // Every row the reference's: with its further numbers, or forced line contact
         // (which the fast path never takes).
-        return (0..n).map(|i| reference_one(inputs, out, i, &mut cache)).sum();
+        return (0..n)
+            .map(|i| reference_one(inputs, out, i, &mut cache))
+            .sum();
     }
     if !inputs.one_scene_for_all() {
         return reference_lanes(inputs, out, n, &mut cache, |start, lanes| {
@@ -382,9 +385,8 @@ fn per_lane_scenes(
     for i in 0..LANES {
         let l = if has_length { Some(length[i]) } else { None };
         let (c, normal) = reference::fast::Constants::of(r1[i], r2[i], g[i], nu[i], mu[i], l);
-        valid[i] = normal
-            & (i < lanes)
-            & Scene::accepts_rollers(r1[i], r2[i], g[i], nu[i], mu[i], l);
+        valid[i] =
+            normal & (i < lanes) & Scene::accepts_rollers(r1[i], r2[i], g[i], nu[i], mu[i], l);
         k.c[i] = c.c;
         k.inverse_c[i] = c.inverse_c;
         k.friction[i] = c.friction;

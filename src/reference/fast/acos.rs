@@ -120,7 +120,10 @@ const fn asin(x: Dd) -> Dd {
     while j < 60 {
         let jf = j as f64;
         term = mul(term, x2);
-        coeff = div(mul(coeff, Dd((2.0 * jf + 1.0) * (2.0 * jf + 2.0), 0.0)), 4.0 * (jf + 1.0) * (jf + 1.0));
+        coeff = div(
+            mul(coeff, Dd((2.0 * jf + 1.0) * (2.0 * jf + 2.0), 0.0)),
+            4.0 * (jf + 1.0) * (jf + 1.0),
+        );
         sum = add(sum, div(mul(coeff, term), 2.0 * jf + 3.0));
         j += 1;
     }

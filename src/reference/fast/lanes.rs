@@ -275,10 +275,8 @@ pub fn rows<S: SceneLanes, const N: usize>(
         let (mut longer, mut near) = (false, false);
         if length {
             let r3 = k.ratio_cubed_per_load * m_cubed[i] * load[i];
-            clear &= positive_normal(r3)
-                & clear_of(r3, 1.0)
-                & clear_of(r3, lo3)
-                & clear_of(r3, hi3);
+            clear &=
+                positive_normal(r3) & clear_of(r3, 1.0) & clear_of(r3, lo3) & clear_of(r3, hi3);
             longer = r3 > 1.0;
             near = (r3 >= lo3) & (r3 <= hi3);
         }
