@@ -339,25 +339,47 @@ pub(super) fn reference(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) ->
             .sum();
     }
     if !inputs.one_scene_for_all() {
-        return reference_lanes(inputs, out, n, &mut cache, |start, lanes| {
-            per_lane_scenes(inputs, start, lanes)
-        });
+        return reference_lanes(inputs, out, n, &mut cache, PerRowScenes(inputs));
     }
     let fast = inputs
         .scene(0)
         .ok()
         .and_then(|s| reference::fast::Prepared::new(&s, inputs.choice));
     match fast {
-        Some(fast) => {
-            let constants = *fast.constants();
-            reference_lanes(inputs, out, n, &mut cache, |_, _| {
-                (constants, [true; LANES])
-            })
-        }
+        Some(fast) => reference_lanes(inputs, out, n, &mut cache, *fast.constants()),
         // A refused scene, or one outside the fast path: row by row.
         None => (0..n)
             .map(|i| reference_one(inputs, out, i, &mut cache))
             .sum(),
+    }
+}
+
+/// The scenes of a block of LANES rows from `start` (`lanes` of them in the batch): their
+/// constants for the fast path, and which lanes may take it. A method, not a closure,
+/// so that it inlines into each build of the batch (a closure is compiled where it is
+/// written, without the features of `estimate_avx2`).
+trait LaneScenes {
+    type Lanes: reference::fast::SceneLanes;
+    fn scenes(&mut self, start: usize, lanes: usize) -> (Self::Lanes, [bool; LANES]);
+}
+
+/// One scene for every row, prepared once.
+impl LaneScenes for reference::fast::Constants {
+    type Lanes = reference::fast::Constants;
+    #[inline(always)]
+    fn scenes(&mut self, _: usize, _: usize) -> (Self::Lanes, [bool; LANES]) {
+        (*self, [true; LANES])
+    }
+}
+
+/// A scene per row ([`per_lane_scenes`]).
+struct PerRowScenes<'i, 'a>(&'i Inputs<'a>);
+
+impl LaneScenes for PerRowScenes<'_, '_> {
+    type Lanes = reference::fast::PerLane<LANES>;
+    #[inline(always)]
+    fn scenes(&mut self, start: usize, lanes: usize) -> (Self::Lanes, [bool; LANES]) {
+        per_lane_scenes(self.0, start, lanes)
     }
 }
 
@@ -434,19 +456,19 @@ fn lanes_of<const N: usize>(column: Column<'_>, start: usize) -> [f64; N] {
 /// take the fast path); its elliptic answers written column by column, every other row
 /// then one at a time ([`reference_cold`]).
 #[inline(always)]
-fn reference_lanes<S: reference::fast::SceneLanes>(
+fn reference_lanes(
     inputs: &Inputs<'_>,
     out: &mut Outputs<'_>,
     n: usize,
     cache: &mut Cache<Prepared>,
-    mut scenes: impl FnMut(usize, usize) -> (S, [bool; LANES]),
+    mut scenes: impl LaneScenes,
 ) -> usize {
     let length = inputs.length.is_some();
     let mut bad = 0;
     let mut start = 0;
     while start < n {
         let lanes = LANES.min(n - start);
-        let (k, valid) = scenes(start, lanes);
+        let (k, valid) = scenes.scenes(start, lanes);
         let load = lanes_of::<LANES>(inputs.load, start);
         let phi = lanes_of::<LANES>(inputs.phi, start);
         let r = reference::fast::rows(&k, inputs.choice, length, &load, &phi);
@@ -572,40 +594,70 @@ fn float_per_row(
     n: usize,
     tables: &EllipticScene<'static>,
 ) -> usize {
-    let mut hot = HotPerSample {
-        radius_factor: [0.0; BLOCK],
-        inv_radius_factor: [0.0; BLOCK],
-        friction: [0.0; BLOCK],
-        cubed_critical_gain: [0.0; BLOCK],
-    };
-    let mut sure = [false; BLOCK];
     let mut cache = Cache::new();
     let choice = inputs.choice;
-    float_blocks(
-        out,
-        n,
-        inputs.load,
-        inputs.phi,
-        |start, b| {
-            let [r1, r2, g, nu, mu, _] = scene_lanes::<BLOCK>(inputs, start);
-            for i in 0..BLOCK {
-                let (h, ok) = hot_of(r1[i], r2[i], g[i], nu[i], mu[i]);
-                hot.radius_factor[i] = h.radius_factor;
-                hot.inv_radius_factor[i] = h.inv_radius_factor;
-                hot.friction[i] = h.friction;
-                hot.cubed_critical_gain[i] = h.cubed_critical_gain;
-                sure[i] = ok;
-            }
-            tables.estimate_block_per_sample(&hot, choice, b);
-            for (h, s) in b.hot.iter_mut().zip(&sure) {
-                *h &= *s;
-            }
+    let per_row = PerRowBlocks {
+        inputs,
+        tables,
+        hot: HotPerSample {
+            radius_factor: [0.0; BLOCK],
+            inv_radius_factor: [0.0; BLOCK],
+            friction: [0.0; BLOCK],
+            cubed_critical_gain: [0.0; BLOCK],
         },
-        |i| match cache.get(inputs, i, |s| Auto::with_choice(s, choice)) {
+        sure: [false; BLOCK],
+    };
+    float_blocks(out, n, inputs.load, inputs.phi, per_row, |i| {
+        match cache.get(inputs, i, |s| Auto::with_choice(s, choice)) {
             Ok(core) => float_row_cold(core, inputs.load.at(i), inputs.phi.at(i)),
             Err(e) => Err(*e),
-        },
-    )
+        }
+    })
+}
+
+/// The hot path of a block of the f32 core's rows ([`float_blocks`]): answers the
+/// block's rows from `start` where it can. A method, not a closure, so that it inlines
+/// into each build of the batch (a closure is compiled where it is written, without
+/// the features of `estimate_avx2`).
+trait BlockHotPath {
+    fn answer(&mut self, start: usize, b: &mut Block);
+}
+
+/// One scene for every row.
+impl BlockHotPath for &Auto {
+    #[inline(always)]
+    fn answer(&mut self, _: usize, b: &mut Block) {
+        self.estimate_block(b);
+    }
+}
+
+/// A scene per row: each row's hot constants from its scene ([`hot_of`]), the tables
+/// and risk threshold of `tables`.
+struct PerRowBlocks<'i, 'a> {
+    inputs: &'i Inputs<'a>,
+    tables: &'i EllipticScene<'static>,
+    hot: HotPerSample,
+    sure: [bool; BLOCK],
+}
+
+impl BlockHotPath for PerRowBlocks<'_, '_> {
+    #[inline(always)]
+    fn answer(&mut self, start: usize, b: &mut Block) {
+        let [r1, r2, g, nu, mu, _] = scene_lanes::<BLOCK>(self.inputs, start);
+        for i in 0..BLOCK {
+            let (h, ok) = hot_of(r1[i], r2[i], g[i], nu[i], mu[i]);
+            self.hot.radius_factor[i] = h.radius_factor;
+            self.hot.inv_radius_factor[i] = h.inv_radius_factor;
+            self.hot.friction[i] = h.friction;
+            self.hot.cubed_critical_gain[i] = h.cubed_critical_gain;
+            self.sure[i] = ok;
+        }
+        self.tables
+            .estimate_block_per_sample(&self.hot, self.inputs.choice, b);
+        for (h, s) in b.hot.iter_mut().zip(&self.sure) {
+            *h &= *s;
+        }
+    }
 }
 
 /// A prepared scene of a core, over rows.
@@ -748,17 +800,12 @@ impl At for Repeat {
 /// then one by one through [`float_row`].
 #[inline(always)]
 fn float_rows(core: &Auto, out: &mut Outputs<'_>, n: usize, load: impl At, phi: impl At) -> usize {
-    float_blocks(
-        out,
-        n,
-        load,
-        phi,
-        |_, b| core.estimate_block(b),
-        |i| float_row_cold(core, load.at(i), phi.at(i)),
-    )
+    float_blocks(out, n, load, phi, core, |i| {
+        float_row_cold(core, load.at(i), phi.at(i))
+    })
 }
 
-/// The f32 core's rows in blocks: `hot_path(start, block)` answers the block's rows
+/// The f32 core's rows in blocks: `hot_path.answer(start, block)` answers the block's rows
 /// from `start` where it can (P and phi given as f32), its answers written column by
 /// column; the rows it leaves, `row(i)` one by one. A row on the hot path took P and
 /// phi as f32 without a refusal of [`narrow`] (both finite, not rounded to 0 or inf,
@@ -770,7 +817,7 @@ fn float_blocks(
     n: usize,
     load: impl At,
     phi: impl At,
-    mut hot_path: impl FnMut(usize, &mut Block),
+    mut hot_path: impl BlockHotPath,
     mut row: impl FnMut(usize) -> Result<Row, Error>,
 ) -> usize {
     let Some((s, f, c, r, m, g, t)) = columns(out, n) else {
@@ -792,7 +839,7 @@ fn float_blocks(
         load.narrow_into(start, &mut b.load);
         phi.narrow_into(start, &mut b.phi);
         phi.large_angle_into(start, &mut large);
-        hot_path(start, &mut b);
+        hot_path.answer(start, &mut b);
         // Every row as if on the hot path, a column at a time.
         for (y, x) in s.iter_mut().zip(&b.slip_ratio) {
             *y = f64::from(*x);
