@@ -425,15 +425,16 @@ fn per_lane_scenes(
 #[inline(always)]
 fn scene_lanes<const N: usize>(inputs: &Inputs<'_>, start: usize) -> [[f64; N]; 6] {
     let length = inputs.length.unwrap_or(Column::One(0.0));
+    // Each column by name, not by `map` over them: a closure would not inline into the
+    // AVX2 build (and `map` copies the arrays once more).
     [
-        inputs.r1,
-        inputs.r2,
-        inputs.shear_modulus,
-        inputs.poisson_ratio,
-        inputs.friction,
-        length,
+        lanes_of(inputs.r1, start),
+        lanes_of(inputs.r2, start),
+        lanes_of(inputs.shear_modulus, start),
+        lanes_of(inputs.poisson_ratio, start),
+        lanes_of(inputs.friction, start),
+        lanes_of(length, start),
     ]
-    .map(|c| lanes_of(c, start))
 }
 
 /// Rows `start..start + N` of a column (NaN past its end).
