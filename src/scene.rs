@@ -115,8 +115,7 @@ impl Scene {
             & positive_finite(r2)
             & (radius != 0.0)
             & positive_finite(shear_modulus)
-            & (poisson_ratio >= 0.0)
-            & (poisson_ratio <= 0.5)
+            & (0.0..=0.5).contains(&poisson_ratio)
             & positive_finite(friction);
         match length {
             None => rollers,

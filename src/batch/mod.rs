@@ -562,8 +562,11 @@ pub fn estimate(
 /// [`estimate`] compiled for x86-64 with AVX2: the reference's SIMD lanes four f64
 /// wide instead of SSE2's two, the same numbers bit for bit (no fused multiply-add is
 /// enabled, so every operation rounds as in [`estimate`]; tests/batch.rs compares
-/// them). The caller checks that the CPU has AVX2 (`is_x86_feature_detected!`), which
-/// is why calling it from code compiled without AVX2 takes `unsafe`.
+/// them).
+///
+/// # Safety
+/// The CPU must have AVX2 (`is_x86_feature_detected!("avx2")`): calling it from code
+/// compiled without AVX2 takes `unsafe` for that reason alone.
 ///
 /// # Errors
 /// As [`estimate`].

@@ -513,8 +513,9 @@ fn reference_lanes(
         // The rows the lanes did not answer, over what was written for them.
         let answered = (0..lanes).fold(true, |all, j| all & valid[j] & r.elliptic[j]);
         if !answered {
-            for j in 0..lanes {
-                if !(valid[j] & r.elliptic[j]) {
+            let lanes_answered = valid.iter().zip(&r.elliptic).map(|(&v, &e)| v & e);
+            for (j, answered) in lanes_answered.enumerate().take(lanes) {
+                if !answered {
                     bad += reference_cold(inputs, out, start + j, cache);
                 }
             }

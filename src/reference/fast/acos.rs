@@ -177,8 +177,8 @@ mod tests {
 
     #[test]
     fn table_is_acos_and_sin() {
-        for i in 0..N {
-            let (hi, lo, w) = (TABLE[0][i], TABLE[1][i], TABLE[2][i]);
+        let [his, los, ws] = &TABLE;
+        for (i, ((&hi, &lo), &w)) in his.iter().zip(los).zip(ws).enumerate() {
             let u = (i as f64 + 0.5) * H;
             assert!(libm::fabs(hi + lo - libm::acos(u)) <= 2.3e-16, "{i}");
             assert!(libm::fabs(lo) <= 1.2e-16 * hi, "{i}");

@@ -27,7 +27,7 @@ fn clear_of(x: f64, limit: f64) -> bool {
 /// A positive normal number (false for NaN, 0, infinities and subnormals).
 #[inline(always)]
 pub(crate) fn positive_normal(x: f64) -> bool {
-    x >= f64::MIN_POSITIVE && x < f64::INFINITY
+    (f64::MIN_POSITIVE..f64::INFINITY).contains(&x)
 }
 
 /// A scene's constants of the fast path.
