@@ -21,6 +21,8 @@ mod sweep;
 mod tables;
 mod tools;
 mod trace;
+#[cfg(test)]
+mod tracked;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
