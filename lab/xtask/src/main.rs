@@ -74,6 +74,10 @@ enum Task {
         /// Fail if a committed SVG differs instead of writing it.
         #[arg(long)]
         check: bool,
+        /// Instead: render every SVG under docs/ and the monitor example's figures in
+        /// Chromium, librsvg and ImageMagick and fail where two renderings differ.
+        #[arg(long, conflicts_with = "check")]
+        renderers: bool,
     },
     /// Speed against error: the benchmark image on the Cortex-M0, M3, M4F, M7 in QEMU
     /// (instructions) and the same code on the host against the reference data
@@ -146,7 +150,17 @@ fn main() -> ExitCode {
             )
         }
         Task::Sweep { quick, write } => sweep_task(quick, write),
-        Task::Figures { check } => figures::run(&root().join("docs"), check),
+        Task::Figures {
+            renderers: true, ..
+        } => match figures::render::check(&root()) {
+            Ok(true) => ExitCode::SUCCESS,
+            Ok(false) => ExitCode::FAILURE,
+            Err(e) => {
+                eprintln!("xtask figures --renderers: {e}");
+                ExitCode::FAILURE
+            }
+        },
+        Task::Figures { check, .. } => figures::run(&root().join("docs"), check),
         Task::Bench { csv, short, cpu } => bench::run(csv, short, cpu.as_deref()),
         Task::Shapes { short, csv } => shapes::run(short, csv),
         Task::Firmware { write } => firmware::run(write),
