@@ -4,6 +4,7 @@
 mod accuracy;
 mod bench;
 mod cross;
+mod docs;
 mod figures;
 mod firmware;
 mod fit;
@@ -127,6 +128,9 @@ enum Task {
     /// compared with the host's replay; or serve, feed a trace, write the register map,
     /// measure the server's cost.
     Modbus(modbus::Args),
+    /// Run every block of README.md and the pages under docs/ as a reader would, and
+    /// write the text blocks that show a command's output from what it prints.
+    Docs(docs::Args),
 }
 
 fn root() -> PathBuf {
@@ -168,6 +172,7 @@ fn main() -> ExitCode {
         Task::Nopanic => nopanic::run(),
         Task::Measurements { check } => measurements::run(check),
         Task::Modbus(args) => modbus::run(&args),
+        Task::Docs(args) => docs::run(&args),
     }
 }
 

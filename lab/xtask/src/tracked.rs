@@ -23,10 +23,12 @@ fn git(args: &[&str]) -> Result<String, String> {
 /// Tracked files that `.gitignore` says are outputs (a cache, a build, data a command
 /// wrote).
 fn tracked_outputs() -> Result<Vec<String>, String> {
-    Ok(git(&["ls-files", "--cached", "--ignored", "--exclude-standard"])?
-        .lines()
-        .map(str::to_string)
-        .collect())
+    Ok(
+        git(&["ls-files", "--cached", "--ignored", "--exclude-standard"])?
+            .lines()
+            .map(str::to_string)
+            .collect(),
+    )
 }
 
 /// What the repository's own commands write inside a clone, one example path of each
