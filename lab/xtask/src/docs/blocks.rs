@@ -170,25 +170,23 @@ fn replace_clause(s: &str) -> Option<(String, String)> {
 /// How `note` (an annotation's text) says to run a block.
 pub fn annotation(note: &str) -> Result<How, String> {
     let note = note.trim();
+    // `output of `CMD``, `extract of `CMD``: the command, and nothing after it.
+    let command = |rest: &str, what: &str| -> Result<String, String> {
+        match backticked(rest) {
+            Some((command, tail)) if tail.trim().is_empty() => Ok(command.to_string()),
+            Some((_, tail)) => Err(format!("unexpected text after the command: `{tail}`")),
+            None => Err(format!("`{what}` takes a `command`")),
+        }
+    };
     if let Some(rest) = note.strip_prefix("output of") {
-        let (command, tail) = backticked(rest).ok_or("`output of` takes a `command`")?;
-        return tail
-            .trim()
-            .is_empty()
-            .then(|| How::Output {
-                command: command.to_string(),
-            })
-            .ok_or_else(|| format!("unexpected text after the command: `{tail}`"));
+        return Ok(How::Output {
+            command: command(rest, "output of")?,
+        });
     }
     if let Some(rest) = note.strip_prefix("extract of") {
-        let (command, tail) = backticked(rest).ok_or("`extract of` takes a `command`")?;
-        return tail
-            .trim()
-            .is_empty()
-            .then(|| How::Extract {
-                command: command.to_string(),
-            })
-            .ok_or_else(|| format!("unexpected text after the command: `{tail}`"));
+        return Ok(How::Extract {
+            command: command(rest, "extract of")?,
+        });
     }
     if let Some(reason) = note.strip_prefix("not run:") {
         let reason = reason.trim();

@@ -119,20 +119,36 @@ fn write(path: &Path, size: (u32, u32), draw: impl FnOnce(&Area) -> Res<()>) -> 
     Ok(())
 }
 
-/// One legend entry, drawn at `(x, y)`: its mark, then its label; returns the x after it.
-fn legend_entry(
+/// The figure's legend in one row from `(x, y)`: per entry a short vertical line in its
+/// style (an event line), or dashed and horizontal (a threshold), then its label.
+fn legend_row(
     area: &Area,
-    (x, y): (i32, i32),
-    mark: impl FnOnce(&Area, (i32, i32)) -> Res<()>,
-    label: &str,
-) -> Res<i32> {
-    mark(area, (x, y))?;
-    area.draw_text(
-        label,
-        &style(13, BLACK, HPos::Left, VPos::Center),
-        (x + 30, y),
-    )?;
-    Ok(x + 30 + 7 * label.chars().count() as i32 + 16)
+    (mut x, y): (i32, i32),
+    entries: &[(ShapeStyle, bool, &str)],
+) -> Res<()> {
+    for &(line, dashed, label) in entries {
+        if dashed {
+            area.draw(&DashedPathElement::new(
+                vec![(x, y), (x + 22, y)],
+                5,
+                3,
+                line,
+            ))?;
+        } else {
+            area.draw(&PathElement::new(
+                vec![(x + 11, y - 8), (x + 11, y + 8)],
+                line,
+            ))?;
+        }
+        area.draw_text(
+            label,
+            &style(13, BLACK, HPos::Left, VPos::Center),
+            (x + 30, y),
+        )?;
+        // About 7 px a character at 13 px.
+        x += 30 + 7 * label.chars().count() as i32 + 16;
+    }
+    Ok(())
 }
 
 /// d/b, margin, F and the state over time (h), events as vertical lines (one per bin of
@@ -151,45 +167,18 @@ pub fn timeline(
             (500, 10),
         )?;
         // The legend of the event lines and thresholds, one row under the title.
-        let y = 50;
-        let mut x = 80;
-        x = legend_entry(
+        legend_row(
             root,
-            (x, y),
-            |a, (x, y)| {
-                a.draw(&PathElement::new(
-                    vec![(x + 11, y - 8), (x + 11, y + 8)],
-                    GREY.stroke_width(1),
-                ))?;
-                Ok(())
-            },
-            "a state change",
-        )?;
-        x = legend_entry(
-            root,
-            (x, y),
-            |a, (x, y)| {
-                a.draw(&PathElement::new(
-                    vec![(x + 11, y - 8), (x + 11, y + 8)],
+            (80, 50),
+            &[
+                (GREY.stroke_width(1), false, "a state change"),
+                (
                     VERMILION.stroke_width(2),
-                ))?;
-                Ok(())
-            },
-            "approaching (time to critical) or a friction event",
-        )?;
-        legend_entry(
-            root,
-            (x, y),
-            |a, (x, y)| {
-                a.draw(&DashedPathElement::new(
-                    vec![(x, y), (x + 22, y)],
-                    5,
-                    3,
-                    BLACK.stroke_width(1),
-                ))?;
-                Ok(())
-            },
-            "warning and alarm thresholds",
+                    false,
+                    "approaching (time to critical) or a friction event",
+                ),
+                (BLACK.stroke_width(1), true, "warning and alarm thresholds"),
+            ],
         )?;
         let body = root.margin(70, 0, 0, 0);
         let panels = body.split_evenly((4, 1));
