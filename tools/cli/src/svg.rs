@@ -102,13 +102,13 @@ impl Tag {
             .unwrap_or(1.0);
         for (paint, own) in [("fill", "fill-opacity"), ("stroke", "stroke-opacity")] {
             let alpha = all * self.remove(own).map(number).transpose()?.unwrap_or(1.0);
-            if let Some(colour) = self.get(paint).map(str::to_string) {
-                if alpha < 1.0 && colour != "none" {
-                    let blended = over_white(&colour, alpha).ok_or_else(|| {
-                        format!("<{}>: {paint} `{colour}` with opacity", self.name)
-                    })?;
-                    self.set(paint, blended);
-                }
+            if let Some(colour) = self.get(paint).map(str::to_string)
+                && alpha < 1.0
+                && colour != "none"
+            {
+                let blended = over_white(&colour, alpha)
+                    .ok_or_else(|| format!("<{}>: {paint} `{colour}` with opacity", self.name))?;
+                self.set(paint, blended);
             }
         }
         Ok(())
@@ -166,19 +166,21 @@ pub fn portable(svg: &str) -> Result<String, String> {
         }
         let mut tag = Tag::parse(inner)?;
         tag.opaque()?;
-        match tag.name.as_str() {
-            "text" => tag.text()?,
-            "polyline" | "path" => {
-                if tag.get("stroke-linejoin").is_none() {
-                    tag.set("stroke-linejoin", "round".into());
-                }
+        // What a renderer would otherwise choose on its own: the joins of a line, the
+        // stroke of a filled shape.
+        let default = match tag.name.as_str() {
+            "text" => {
+                tag.text()?;
+                None
             }
-            "polygon" | "rect" | "circle" | "ellipse" => {
-                if tag.get("stroke").is_none() {
-                    tag.set("stroke", "none".into());
-                }
-            }
-            _ => {}
+            "polyline" | "path" => Some(("stroke-linejoin", "round")),
+            "polygon" | "rect" | "circle" | "ellipse" => Some(("stroke", "none")),
+            _ => None,
+        };
+        if let Some((key, value)) = default
+            && tag.get(key).is_none()
+        {
+            tag.set(key, value.into());
         }
         out.push_str(&tag.write());
     }

@@ -315,13 +315,11 @@ fn strip_comment(line: &str) -> &str {
 pub fn static_problems(root: &Path, block: &Block, how: &How) -> Vec<String> {
     let mut problems = Vec::new();
     match how {
-        How::Doctest => {
-            if !doctest_page(root, &block.page) {
-                problems.push(format!(
-                    "a doctest on a page src/lib.rs does not include (include_str!(\"../{}\"))",
-                    block.page
-                ));
-            }
+        How::Doctest if !doctest_page(root, &block.page) => {
+            problems.push(format!(
+                "a doctest on a page src/lib.rs does not include (include_str!(\"../{}\"))",
+                block.page
+            ));
         }
         How::Ci => {
             let ci = std::fs::read_to_string(root.join(".ci/run")).unwrap_or_default();
@@ -352,10 +350,8 @@ pub fn static_problems(root: &Path, block: &Block, how: &How) -> Vec<String> {
                 }
             }
         }
-        How::Transcript => {
-            if !block.body.first().is_some_and(|l| l.starts_with("$ ")) {
-                problems.push("a transcript starts with a `$ command` line".into());
-            }
+        How::Transcript if !block.body.first().is_some_and(|l| l.starts_with("$ ")) => {
+            problems.push("a transcript starts with a `$ command` line".into());
         }
         How::Run { .. } if !matches!(block.lang(), "sh" | "bash" | "shell" | "python") => {
             problems.push(format!("cannot run a `{}` block", block.lang()));
@@ -368,8 +364,11 @@ pub fn static_problems(root: &Path, block: &Block, how: &How) -> Vec<String> {
     problems
 }
 
+/// A block and how it is run, or what is wrong with its annotation.
+pub type Classified = (Block, Result<How, String>);
+
 /// Every block of every page, with how it is run (or the error in its annotation).
-pub fn all(root: &Path) -> Result<Vec<(Block, Result<How, String>)>, String> {
+pub fn all(root: &Path) -> Result<Vec<Classified>, String> {
     let mut out = Vec::new();
     for page in pages(root)? {
         let text = std::fs::read_to_string(root.join(&page)).map_err(|e| format!("{page}: {e}"))?;
