@@ -15,6 +15,7 @@ mod measurements;
 mod modbus;
 mod node;
 mod nopanic;
+mod pico;
 mod records;
 mod seeds;
 mod shapes;
@@ -131,6 +132,9 @@ enum Task {
     /// Run every block of README.md and the pages under docs/ as a reader would, and
     /// write the text blocks that show a command's output from what it prints.
     Docs(docs::Args),
+    /// The Raspberry Pi Pico node in an emulator of its chip (rp2040js, lab/pico), its
+    /// sensors simulated at the pins: the checks, --serve, --trace, --uf2, --measure.
+    Pico(pico::Args),
 }
 
 fn root() -> PathBuf {
@@ -173,6 +177,7 @@ fn main() -> ExitCode {
         Task::Measurements { check } => measurements::run(check),
         Task::Modbus(args) => modbus::run(&args),
         Task::Docs(args) => docs::run(&args),
+        Task::Pico(args) => pico::run(&args),
     }
 }
 

@@ -200,7 +200,7 @@ fn registers() -> Result<(), String> {
     Ok(())
 }
 
-fn registers_text() -> Result<String, String> {
+pub(crate) fn registers_text() -> Result<String, String> {
     let mut text = String::new();
     misalign::modbus::registers_csv(&mut text).map_err(|e| e.to_string())?;
     Ok(text)
@@ -343,7 +343,7 @@ fn boot(
 }
 
 /// The virtual environment with the pinned packages; its python.
-fn venv() -> Result<PathBuf, String> {
+pub(crate) fn venv() -> Result<PathBuf, String> {
     let dir = crate::root().join("target/modbus-venv");
     let python = dir.join("bin/python");
     let stamp = dir.join("installed.txt");
@@ -756,7 +756,7 @@ fn trace(
 
 /// Runs tools/commission.py against the node on 127.0.0.1:`port` with `args` (its
 /// status lines on stdout).
-fn commission_py(
+pub(crate) fn commission_py(
     python: &Path,
     port: u16,
     registers: &Path,
@@ -782,7 +782,7 @@ fn commission_py(
 /// The host's side: what the node must answer, from the same samples through the same
 /// library (`misalign::modbus::Server`, `misalign::monitor::Monitor`) and the same
 /// estimator as the node's (`node::core`).
-mod host {
+pub(crate) mod host {
     use crate::node::{self, Core};
     use misalign::Estimator;
     use misalign::modbus::map::{Table, TableMap};
@@ -1073,6 +1073,36 @@ mod host {
             csv,
             events: got.len(),
         })
+    }
+
+    /// The events of `raw` (master.py's `--events`: each event's registers) in
+    /// `examples/monitor --events`'s format, those of samples after `end_ms` left out.
+    pub fn events_csv(raw: &Path, end_ms: Option<u32>) -> Result<Compared, String> {
+        let text = std::fs::read_to_string(raw).map_err(|e| format!("{}: {e}", raw.display()))?;
+        let mut csv = format!("{}\n", misalign_cli::monitor_output::EVENTS_HEADER);
+        let mut events = 0;
+        for (i, line) in text.lines().enumerate().skip(1) {
+            let words: Vec<u16> = line
+                .split(',')
+                .skip(1)
+                .map(|w| {
+                    w.parse()
+                        .map_err(|_| format!("{}:{}: {w}", raw.display(), i + 1))
+                })
+                .collect::<Result<_, _>>()?;
+            let event = match event_from_registers(&words) {
+                Ok(Some(event)) => event,
+                Ok(None) => return Err(format!("{}:{}: an empty slot", raw.display(), i + 1)),
+                Err(e) => return Err(format!("{}:{}: {e:?}", raw.display(), i + 1)),
+            };
+            if end_ms.is_some_and(|end| event.time_ms > end) {
+                continue;
+            }
+            csv += &event_row(&event);
+            csv.push('\n');
+            events += 1;
+        }
+        Ok(Compared { csv, events })
     }
 
     /// The monitor as the node's server runs it (`Monitor::process`), over `samples`.
