@@ -52,7 +52,7 @@ pub use scene::{SHORT_ROLLER_PRESSURE, Scene, ThetaRelation};
 struct FirmwareGuideDoctests;
 
 /// The technician's page's firmware outline compiles against the sensors' API
-/// (`cargo test --features sensors,ads1x1x --doc SensorsGuideDoctests`).
+/// (`cargo test --features sensors,_sim,ads1x1x --doc SensorsGuideDoctests`).
 #[cfg(all(doctest, feature = "sensors", feature = "ads1x1x"))]
 #[doc = include_str!("../docs/SENSORS.md")]
 struct SensorsGuideDoctests;
