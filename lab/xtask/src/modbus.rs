@@ -21,6 +21,8 @@
 //!   and pytest, pinned, in a virtual environment under `target/modbus-venv`.
 //!   With `--boards`, the node on its own samples also on the Cortex-M7 and M3 (MPS2,
 //!   CMSDK UART0) and the STM32F405 (`netduinoplus2`, USART1).
+//!   Last, every command and snippet of docs/modbus.md as the page shows them
+//!   (`tests/modbus/test_docs.py`; `--docs`: that alone).
 //! - `--serve PORT [--target TRIPLE]`: boots the node and serves until killed.
 //! - `--trace T.csv --scene S.csv --events OUT.csv [--model f32|fixed] [--target
 //!   TRIPLE]`: feeds a trace to the node over Modbus, reads its events back, writes
@@ -148,6 +150,10 @@ pub struct Args {
     /// its table.
     #[arg(long, conflicts_with = "boards")]
     measure: bool,
+    /// Run only docs/modbus.md's commands and snippets (tests/modbus/test_docs.py),
+    /// which the whole test runs last.
+    #[arg(long, conflicts_with_all = ["boards", "measure", "trace", "serve", "registers"])]
+    docs: bool,
 }
 
 /// `cargo xtask modbus`.
@@ -160,6 +166,8 @@ pub fn run(args: &Args) -> ExitCode {
         measure()
     } else if let Some(port) = &args.serve {
         serve(port, args.target.as_deref())
+    } else if args.docs {
+        prepare().and_then(|(python, _, _)| docs(&python))
     } else if args.trace.is_some() {
         trace(
             args.trace.as_deref(),
@@ -432,11 +440,37 @@ fn tests(boards: bool) -> Result<(), String> {
             failures.push(format!("{what}: {e}"));
         }
     }
+    println!(
+        "\n=== docs/modbus.md: every command and snippet ({}s)",
+        start.elapsed().as_secs()
+    );
+    if let Err(e) = docs(&python) {
+        failures.push(format!("docs/modbus.md: {e}"));
+    }
     if failures.is_empty() {
-        println!("modbus: every test passed on every node");
+        println!("modbus: every test passed on every node and the page");
         return Ok(());
     }
     Err(failures.join("\n"))
+}
+
+/// Every command and snippet of docs/modbus.md, as the page shows them
+/// (`tests/modbus/test_docs.py`): the page's own `cargo xtask modbus --serve` boots
+/// its nodes.
+fn docs(python: &Path) -> Result<(), String> {
+    let start = Instant::now();
+    let status = Command::new(python)
+        .current_dir(crate::root())
+        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+        .arg("tests/modbus/test_docs.py")
+        .status()
+        .map_err(|e| format!("pytest: {e}"))?;
+    println!("  docs/modbus.md: {} s", start.elapsed().as_secs());
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("pytest tests/modbus/test_docs.py: {status}"))
+    }
 }
 
 fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result<(), String> {
