@@ -24,6 +24,8 @@ impl SensorCalibration {
     pub fn validate(&self) -> Result<(), CalibrationError> {
         self.load.validate()?;
         self.misalignment.validate()?;
-        self.speed.as_ref().map_or(Ok(()), SpeedCalibration::validate)
+        self.speed
+            .as_ref()
+            .map_or(Ok(()), SpeedCalibration::validate)
     }
 }
