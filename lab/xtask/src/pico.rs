@@ -804,7 +804,8 @@ fn measure() -> Result<(), String> {
     let st = h.command("status")?;
     drop(h);
     let stack = json_num(&st, "stack").ok_or("the harness measured no stack")? as u64;
-    let stack_reserved = json_num(&st, "stack_reserved").ok_or("the image reserves no stack")? as u64;
+    let stack_reserved =
+        json_num(&st, "stack_reserved").ok_or("the image reserves no stack")? as u64;
     if stack + STACK_HEADROOM > stack_reserved {
         return Err(format!(
             "the deepest stack, {stack} B, leaves less than {STACK_HEADROOM} B of its \
