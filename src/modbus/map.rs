@@ -475,7 +475,7 @@ pub static DISCRETES: TableMap = TableMap {
 
 /// The register map's version (holding register `map_version`): a change of an
 /// address, a type or a meaning increments it.
-pub const MAP_VERSION: u16 = 2;
+pub const MAP_VERSION: u16 = 3;
 
 /// Where the event window's header starts (input registers).
 pub const EVENT_WINDOW_ADDRESS: u16 = 82;

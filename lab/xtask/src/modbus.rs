@@ -154,6 +154,10 @@ pub struct Args {
     /// which the whole test runs last.
     #[arg(long, conflicts_with_all = ["boards", "measure", "trace", "serve", "registers"])]
     docs: bool,
+    /// Run only the nodes with flash across resets (tests/modbus/test_reset.py and
+    /// test_line.py, on the Cortex-M4F and the Cortex-M0), without the page.
+    #[arg(long, conflicts_with_all = ["boards", "measure", "trace", "serve", "registers", "docs"])]
+    stored: bool,
 }
 
 /// `cargo xtask modbus`.
@@ -177,7 +181,7 @@ pub fn run(args: &Args) -> ExitCode {
             args.target.as_deref(),
         )
     } else {
-        tests(args.boards)
+        tests(args.boards, args.stored)
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -396,7 +400,7 @@ fn prepare() -> Result<(PathBuf, PathBuf, PathBuf), String> {
 }
 
 /// The whole test: both cores, both sample sources.
-fn tests(boards: bool) -> Result<(), String> {
+fn tests(boards: bool, stored_only: bool) -> Result<(), String> {
     let start = Instant::now();
     let (python, dir, registers) = prepare()?;
     let mut failures = Vec::new();
@@ -416,6 +420,9 @@ fn tests(boards: bool) -> Result<(), String> {
                 ..Node::on(cpu(id), true)
             });
         }
+    }
+    if stored_only {
+        nodes.retain(|n| n.stored && !n.cut);
     }
     if boards {
         nodes.extend(OTHER_BOARDS.map(|(id, machine, memory_x)| Node {
@@ -444,7 +451,9 @@ fn tests(boards: bool) -> Result<(), String> {
         "\n=== docs/modbus.md: every command and snippet ({}s)",
         start.elapsed().as_secs()
     );
-    if let Err(e) = docs(&python) {
+    if stored_only {
+        println!("  (not with --stored)");
+    } else if let Err(e) = docs(&python) {
         failures.push(format!("docs/modbus.md: {e}"));
     }
     if failures.is_empty() {
@@ -486,7 +495,7 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
             if node.cut {
                 &["tests/modbus/test_power_cut.py"][..]
             } else {
-                &["tests/modbus/test_reset.py"][..]
+                &["tests/modbus/test_reset.py", "tests/modbus/test_line.py"][..]
             },
             dir.join(format!("reset-{id}.csv")),
         )
