@@ -219,20 +219,28 @@ BAUD_RATES = (9600, 19200, 38400, 57600, 115200)
 PARITY = {0: "N", 1: "O", 2: "E"}
 
 
-def confirm_line(node, staged):
-    """After a commit that moved the node (a new unit id, baud rate or parity): asks
-    it at its new settings, which confirms them (`line_status` bit 1 clears)."""
-    moved = {n: w for n, w, _ in staged if n in MOVES}
-    if not moved:
+def line_in_force(node, staged):
+    """Before a commit that moves the node (a new unit id, baud rate or parity): its
+    unit id, baud rate and parity in force, read while it answers there; None when the
+    commit moves nothing."""
+    if not any(n in MOVES for n, _, _ in staged):
+        return None
+    return {n: node.read("active_" + n[len("config_"):]) for n in MOVES}
+
+
+def confirm_line(node, staged, was):
+    """After a commit that moved the node from `was` (`line_in_force`): asks it at its
+    new settings, which confirms them (`line_status` bit 1 clears)."""
+    if was is None:
         return
-    was = {n: node.read("active_" + n[len("config_"):]) for n in MOVES}
+    moved = {n: w for n, w, _ in staged if n in MOVES}
     now = {**was, **moved}
     unit, baud, parity = now["config_unit_id"][0], u32(now["config_baud"]), now["config_parity"][0]
     node.move(unit, baud, PARITY[parity])
     for _ in range(3):
         try:
             status = node.read("line_status", "input")[0]
-        except Failed:
+        except Exception:  # noqa: BLE001 (no answer yet: asked again)
             continue
         if status & 2 == 0:
             return
@@ -303,6 +311,7 @@ def commission(node, code, settings, scene, reset_statistics=False):
             if u32(node.read("scene_staged_crc")) != crc:
                 raise Failed("the staged scene's CRC differs from the file's: bytes lost on the way")
         if staged or scene is not None:
+            line_was = line_in_force(node, staged)
             x = node.write("command", [COMMIT])
             if x is not None:
                 why = node.read("commit_error")[0]
@@ -312,7 +321,7 @@ def commission(node, code, settings, scene, reset_statistics=False):
             # keeps them.
             was = node.unit
             try:
-                confirm_line(node, staged)
+                confirm_line(node, staged, line_was)
             except Failed as e:
                 node.unit = was
                 raise e
