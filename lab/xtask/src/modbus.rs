@@ -862,7 +862,8 @@ pub(crate) mod host {
     }
 
     /// The default configuration (`Config::default()`) as tools/commission.py's
-    /// `--config` file (`name,value`, one `config_*` register a line), read through
+    /// `--config` file (`name,value`, one `config_*` register a line, the line
+    /// settings' not among them), read through
     /// the library's server from its staged view, which reads as the active one
     /// before a first write. `registers`: the map's CSV, for the names and types.
     pub fn write_default_config(core: &Core, registers: &Path, out: &Path) -> Result<(), String> {
@@ -878,7 +879,11 @@ pub(crate) mod host {
                 && access == "rw"
             {
                 let at = address.parse::<u16>().map_err(|e| format!("{name}: {e}"))?;
-                rows.push((at, name, ty));
+                // The monitor's configuration only: a file of line settings given to
+                // every node would put them all at one unit id.
+                if at < misalign::modbus::map::LINE_ADDRESS {
+                    rows.push((at, name, ty));
+                }
             }
         }
         let start = rows
