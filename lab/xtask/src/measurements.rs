@@ -1,15 +1,21 @@
 //! `cargo xtask measurements [--check]`: every table of docs/measurements.md, and the
 //! README's headline, drawn from the committed CSVs under `docs/` (each measuring
-//! command writes its CSV and then calls [`update`]). `--check` fails if a committed
+//! command writes its CSV and then calls [`update`]; the tables are drawn here, from
+//! the CSVs alone, never by the commands' modules). `--check` fails if a committed
 //! table differs from what the CSVs draw, as `cargo xtask figures --check` does for the
 //! SVGs; a unit test does the same under `cargo test`.
 //!
 //! Each table sits between `<!-- NAME:begin -->` and `<!-- NAME:end -->`; the prose
 //! around it is the page's own and carries no measured number.
 
-use crate::bench::{self, find};
+pub mod accuracy;
+pub mod bench;
+pub mod firmware;
+pub mod shapes;
+pub mod sweep;
+
 use crate::records::{self, AccuracyRow, BenchRow, NodeRow, PicoRow, ShapeRow, SizeRow, SweepRow};
-use crate::{accuracy, firmware, shapes, sweep};
+use bench::find;
 use misalign_workload::{Model, Operation};
 use std::fmt::Write as _;
 use std::process::ExitCode;

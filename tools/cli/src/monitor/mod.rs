@@ -412,7 +412,14 @@ fn replay<E: Estimator + Copy>(
         let _ = writeln!(io.err, "wrote {}", path.display());
     }
     if let Some(path) = &args.plot {
-        plot::timeline(path, &timeline)?;
+        let source = match &args.trace {
+            Some(trace) => trace.file_name().map_or_else(
+                || trace.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            ),
+            None => "the built-in 8 h scenario".to_string(),
+        };
+        plot::timeline(path, &timeline, &config.thresholds, &source)?;
         let _ = writeln!(io.err, "wrote {}", path.display());
     }
     if let Some(path) = &args.thresholds {
