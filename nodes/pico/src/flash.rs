@@ -4,7 +4,6 @@
 //! masked), in the regions memory.x reserves at the end of the flash, outside the
 //! program's.
 
-use crate::persist::{EVENTS_SIZE, STORE_SIZE};
 use embassy_rp::flash::{Blocking, ERASE_SIZE, Flash};
 use embassy_rp::peripherals::FLASH;
 use embedded_storage::nor_flash::{
@@ -14,6 +13,10 @@ use embedded_storage::nor_flash::{
 
 /// The erase unit (bytes): a 4 KiB sector.
 pub const SECTOR: usize = ERASE_SIZE;
+/// The store's region (the state's and the configuration's records).
+pub const STORE_SIZE: usize = 4 * SECTOR;
+/// The event queue's region.
+pub const EVENTS_SIZE: usize = 2 * SECTOR;
 /// The Pico's flash (W25Q16JV, 2 MiB).
 const FLASH_SIZE: usize = 2 * 1024 * 1024;
 /// The flash's address in the memory map (XIP).
