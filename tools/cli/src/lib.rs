@@ -12,4 +12,6 @@ pub mod estimate;
 pub mod monitor;
 pub mod monitor_input;
 pub mod monitor_output;
+pub mod reference_core;
+pub mod replay;
 pub mod table;
