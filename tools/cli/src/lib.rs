@@ -12,6 +12,7 @@ pub mod estimate;
 pub mod monitor;
 pub mod monitor_input;
 pub mod monitor_output;
+pub mod prepare;
 pub mod reference_core;
 pub mod replay;
 pub mod table;
