@@ -295,6 +295,38 @@ impl Replay {
     }
 }
 
+/// The planner's table (`monitor_output::threshold_rows`) on `model`'s core for
+/// `scene`, its contact model chosen once for loads up to `range_max` (N, as a replay
+/// chooses it for its trace), under `config`, over loads up to `load_max` (N).
+///
+/// # Errors
+/// The model choice's and the core's errors for the scene.
+pub fn plan(
+    model: Model,
+    scene: &Scene,
+    config: &Config,
+    range_max: f64,
+    load_max: f32,
+) -> Res<Vec<ThresholdRow>> {
+    Ok(match model {
+        Model::F32 => output::threshold_rows(
+            &scenario::estimator_for::<Auto>(scene, range_max)?,
+            config,
+            load_max,
+        ),
+        Model::Fixed => output::threshold_rows(
+            &scenario::estimator_for::<FixedAuto>(scene, range_max)?,
+            config,
+            load_max,
+        ),
+        Model::Reference => output::threshold_rows(
+            &scenario::estimator_for::<ReferenceCore>(scene, range_max)?,
+            config,
+            load_max,
+        ),
+    })
+}
+
 /// Where the second pass's output goes, as it happens.
 pub trait Sink {
     /// An event, in the order the monitor raised it.
