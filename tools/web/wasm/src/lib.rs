@@ -51,15 +51,15 @@ pub struct Reviewed {
     pub thresholds: Option<String>,
     /// Counts, states, the trace's skipped rows: a JSON object.
     pub summary: String,
-    /// The timeline's bins for the plot.
-    pub plot: plot::Bins,
+    /// The timeline's bins for the plot (when asked).
+    pub plot: Option<plot::Bins>,
 }
 
 /// The page's side of the second pass: the events file and the plot, and the
 /// progress every `PROGRESS_EVERY` samples.
 struct PageSink<'a> {
     events: EventsWriter<Vec<u8>>,
-    plot: plot::Bins,
+    plot: Option<plot::Bins>,
     done: u64,
     total: u64,
     progress: &'a mut dyn FnMut(u8, f64),
@@ -78,7 +78,9 @@ impl replay::Sink for PageSink<'_> {
         replay: &Replay,
         state: RiskState,
     ) -> Result<(), Box<dyn std::error::Error>> {
-        self.plot.add(replay.elapsed_ms(), state, replay.reading());
+        if let Some(plot) = &mut self.plot {
+            plot.add(replay.elapsed_ms(), state, replay.reading());
+        }
         self.done += 1;
         if self.done.is_multiple_of(PROGRESS_EVERY) {
             (self.progress)(2, self.done as f64 / self.total.max(1) as f64);
@@ -104,13 +106,13 @@ impl<R: Read> Read for Counted<R> {
 /// The monitor example's replay, as `cargo run --example monitor -- [--trace T]
 /// [--scene S] --model M --events E [--plot P --thresholds H]` runs it: a first pass
 /// over the samples `open` gives (`None`: the built-in scenario; `size` bytes), then
-/// the replay; `progress(pass, fraction)` now and then.
+/// the replay, with the plot's bins if `plot`; `progress(pass, fraction)` now and then.
 pub fn review<R: Read>(
     mut open: impl FnMut() -> Option<R>,
     size: u64,
     scene: Option<&str>,
     model: Model,
-    planner: bool,
+    (planner, plot): (bool, bool),
     progress: &mut dyn FnMut(u8, f64),
 ) -> Res<Reviewed> {
     let scene = scene_of(scene)?;
@@ -139,7 +141,7 @@ pub fn review<R: Read>(
     let mut replay = Replay::new(model, &scene, &mut survey).map_err(|e| e.to_string())?;
     let mut sink = PageSink {
         events: EventsWriter::new(Vec::new()).map_err(|e| e.to_string())?,
-        plot: plot::Bins::new(),
+        plot: plot.then(plot::Bins::new),
         done: 0,
         total,
         progress,
@@ -215,13 +217,13 @@ fn summary<R: BufRead>(replay: &Replay, samples: &Samples<R>, total: u64) -> Str
 /// scenario) and `scene` (`None`: the demo rollers) on `model`.
 pub fn events_text(trace: Option<&[u8]>, scene: Option<&str>, model: Model) -> Res<String> {
     let size = trace.map_or(0, |t| t.len() as u64);
-    review(|| trace, size, scene, model, false, &mut |_, _| {}).map(|r| r.events)
+    review(|| trace, size, scene, model, (false, false), &mut |_, _| {}).map(|r| r.events)
 }
 
 /// The `--thresholds` file of the monitor example for `trace` and `scene` on `model`.
 pub fn thresholds_text(trace: Option<&[u8]>, scene: Option<&str>, model: Model) -> Res<String> {
     let size = trace.map_or(0, |t| t.len() as u64);
-    let r = review(|| trace, size, scene, model, true, &mut |_, _| {})?;
+    let r = review(|| trace, size, scene, model, (true, false), &mut |_, _| {})?;
     Ok(r.thresholds.unwrap_or_default())
 }
 
@@ -308,7 +310,7 @@ pub fn review_trace(
         size as u64,
         scene.as_deref(),
         model,
-        planner,
+        (planner, true),
         &mut report,
     )
     .map(Review)
@@ -337,7 +339,8 @@ impl Read for JsSource {
                 &(want as f64).into(),
             )
             .map_err(|e| std::io::Error::other(format!("{e:?}")))?;
-        let chunk = js_sys::Uint8Array::new(&chunk);
+        // The function gives a Uint8Array: taken as it is (`Uint8Array::new` would copy).
+        let chunk: js_sys::Uint8Array = chunk.unchecked_into();
         let n = (chunk.length() as usize).min(buf.len());
         chunk.subarray(0, n as u32).copy_to(&mut buf[..n]);
         self.offset += n as u64;
@@ -369,24 +372,31 @@ impl Review {
     /// The width of a plot bin (s).
     #[wasm_bindgen(getter)]
     pub fn bin_s(&self) -> f64 {
-        self.0.plot.bin_s()
+        self.plot().bin_s()
     }
     /// How many bins.
     #[wasm_bindgen(getter)]
     pub fn bins(&self) -> usize {
-        self.0.plot.len()
+        self.plot().len()
     }
     /// Curve `k`'s lowest value in each bin (NaN: none there).
     pub fn low(&self, k: usize) -> Vec<f32> {
-        self.0.plot.low(k)
+        self.plot().low(k)
     }
     /// Curve `k`'s highest value in each bin.
     pub fn high(&self, k: usize) -> Vec<f32> {
-        self.0.plot.high(k)
+        self.plot().high(k)
     }
     /// Each bin's most severe state (`RiskState::index`; 255 none).
     pub fn states(&self) -> Vec<u8> {
-        self.0.plot.states()
+        self.plot().states()
+    }
+}
+
+impl Review {
+    fn plot(&self) -> &plot::Bins {
+        static EMPTY: plot::Bins = plot::Bins::new();
+        self.0.plot.as_ref().unwrap_or(&EMPTY)
     }
 }
 
@@ -437,6 +447,13 @@ pub fn prepare_scene(scene: &str, fpu: bool) -> Result<Vec<u8>, JsError> {
     let scene = scene_of(Some(scene)).map_err(js)?;
     misalign_cli::prepare::prepared(&scene, &misalign_cli::prepare::Options::for_core(fpu))
         .map_err(|e| JsError::new(&format!("scene: {e}")))
+}
+
+/// `defaultCode()`: the site code a node has until a commit changes it
+/// (`misalign::modbus::DEFAULT_UNLOCK_CODE`).
+#[wasm_bindgen(js_name = defaultCode)]
+pub fn default_code() -> u16 {
+    misalign::modbus::DEFAULT_UNLOCK_CODE
 }
 
 /// `f32Text(bits)`: an f32 as Rust prints it (the shortest digits that read back),

@@ -35,7 +35,7 @@ impl Default for Bins {
 
 impl Bins {
     /// Empty, bins of 1 ms until wider ones are needed.
-    pub fn new() -> Self {
+    pub const fn new() -> Self {
         Bins {
             bin_ms: 1,
             low: Vec::new(),
@@ -52,6 +52,7 @@ impl Bins {
             for i in 0..pairs {
                 let (a, b) = (2 * i, (2 * i + 1).min(self.state.len() - 1));
                 for k in 0..CURVES.len() {
+                    // f32::min and max take the number over NaN (an empty bin).
                     self.low[i][k] = self.low[a][k].min(self.low[b][k]);
                     self.high[i][k] = self.high[a][k].max(self.high[b][k]);
                 }
@@ -86,11 +87,17 @@ impl Bins {
                 r.load * 1e-3,
                 r.phi * 1e3,
             ];
+            let (low, high) = (&mut self.low[i], &mut self.high[i]);
             for (k, v) in values.into_iter().enumerate() {
+                // Comparisons, not f32::min (a libm call in WebAssembly); an empty
+                // bin's NaN is replaced by the first value.
                 if v.is_finite() {
-                    // f32::min and max take the number over NaN (an empty bin).
-                    self.low[i][k] = self.low[i][k].min(v);
-                    self.high[i][k] = self.high[i][k].max(v);
+                    if !(low[k] <= v) {
+                        low[k] = v;
+                    }
+                    if !(high[k] >= v) {
+                        high[k] = v;
+                    }
                 }
             }
         }
