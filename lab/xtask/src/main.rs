@@ -21,6 +21,7 @@ mod sweep;
 mod tables;
 mod tools;
 mod trace;
+mod web;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -121,6 +122,9 @@ enum Task {
     /// compared with the host's replay; or serve, feed a trace, write the register map,
     /// measure the server's cost.
     Modbus(modbus::Args),
+    /// The web console (tools/web): build it; or serve it, run its browser tests,
+    /// measure its download, start and replay rate.
+    Web(web::Args),
 }
 
 fn root() -> PathBuf {
@@ -152,6 +156,7 @@ fn main() -> ExitCode {
         Task::Nopanic => nopanic::run(),
         Task::Measurements { check } => measurements::run(check),
         Task::Modbus(args) => modbus::run(&args),
+        Task::Web(args) => web::run(&args),
     }
 }
 

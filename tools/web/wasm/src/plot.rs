@@ -92,10 +92,10 @@ impl Bins {
                 // Comparisons, not f32::min (a libm call in WebAssembly); an empty
                 // bin's NaN is replaced by the first value.
                 if v.is_finite() {
-                    if !(low[k] <= v) {
+                    if low[k].is_nan() || v < low[k] {
                         low[k] = v;
                     }
-                    if !(high[k] >= v) {
+                    if high[k].is_nan() || v > high[k] {
                         high[k] = v;
                     }
                 }
