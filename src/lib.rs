@@ -46,6 +46,50 @@ pub use estimator::{Estimate, Estimator, FrictionInverse};
 
 pub use scene::{SHORT_ROLLER_PRESSURE, Scene, ThetaRelation};
 
+/// Every error type of the crate is a `core::error::Error` (so a `std::error::Error` on
+/// the host) with no feature, and a `defmt::Format` with `defmt`: checked wherever the
+/// crate compiles, for the features it compiles with. (`u8` stands for a driver's
+/// error in the generic ones.)
+const _: () = {
+    const fn error<E: core::error::Error>() {}
+    #[cfg(feature = "defmt")]
+    const fn format<E: defmt::Format>() {}
+    macro_rules! every_error {
+        ($($e:ty),* $(,)?) => {
+            $(
+                error::<$e>();
+                #[cfg(feature = "defmt")]
+                format::<$e>();
+            )*
+        };
+    }
+    every_error!(
+        Error,
+        crate::bytes::FieldError,
+        crate::prepared::PreparedError,
+        crate::monitor::ConfigError,
+        crate::sensor_fault::SensorFault,
+    );
+    #[cfg(feature = "sensors")]
+    every_error!(
+        crate::sensors::AdcError<u8>,
+        crate::sensors::PinError<u8, u8>,
+        crate::sensors::CalibrationError,
+    );
+    #[cfg(feature = "_sim")]
+    every_error!(crate::sensors::sim::SimError);
+    #[cfg(feature = "sequential-storage")]
+    every_error!(
+        crate::storage::CodecError,
+        crate::storage::StoreConfigError,
+        crate::storage::StorageError<u8>,
+    );
+    #[cfg(feature = "_mock-flash")]
+    every_error!(crate::storage::MockError);
+    #[cfg(feature = "modbus")]
+    every_error!(crate::modbus::ServerConfigError, crate::modbus::DecodeError,);
+};
+
 /// The firmware guide's examples run as doctests, as the README's do.
 #[cfg(doctest)]
 #[doc = include_str!("../docs/firmware.md")]

@@ -4,7 +4,7 @@
 
 mod common;
 use common::{Worst, num, read_rows};
-use misalign::batch::{self, Column, Details, Inputs, Mismatch, Model, Outputs};
+use misalign::batch::{self, Column, Counts, Details, Inputs, Mismatch, Model, Outputs};
 use misalign::fixed::FixedAuto;
 use misalign::float::Auto;
 use misalign::reference::ModelChoice;
@@ -227,10 +227,10 @@ fn cores_in_a_batch_answer_as_row_by_row() {
     };
     let f32_core = Auto::new(&scene).unwrap();
     let fixed_core = FixedAuto::new(&scene, 1e-2, 1e-10).unwrap();
-    let fixed = Model::Fixed {
+    let fixed = Model::Fixed(Counts::Adc {
         load_lsb: 1e-2,
         angle_lsb: Some(1e-10),
-    };
+    });
     let mut lines = 0;
     for inputs in [&one, &per_row] {
         let mut a = Owned::new(n);
@@ -309,10 +309,10 @@ fn one_scene_answers_every_column_as_a_scene_per_row() {
     load.truncate(1000); // a partial block at the end
     phi.truncate(1000);
     let n = load.len();
-    let fixed = Model::Fixed {
+    let fixed = Model::Fixed(Counts::Adc {
         load_lsb: 1e-2,
         angle_lsb: None,
-    };
+    });
     for (scene, choice) in [
         (Scene::DEMO, ModelChoice::Section9),
         (Scene::DEMO.with_length(0.2).unwrap(), ModelChoice::Section9),
@@ -385,10 +385,10 @@ fn bad_rows_get_their_error_and_the_others_their_values() {
         Some(Error::Angle),
         Some(Error::Friction),
     ];
-    let fixed = Model::Fixed {
+    let fixed = Model::Fixed(Counts::Adc {
         load_lsb: 1e-2,
         angle_lsb: None,
-    };
+    });
     for model in [Model::Reference, Model::F32, fixed] {
         let mut out = Owned::new(load.len());
         let bad = batch::estimate(&inputs, &mut out.outputs(true), model).unwrap();
@@ -488,10 +488,10 @@ fn every_model_of_a_batch_draws_the_right_angle_at_f64s() {
     let load = [1e3; 4];
     let inputs = Inputs::one_scene(&scene, Column::Each(&load), Column::Each(&phi));
     let angle = batch::status_of(Error::Angle);
-    let fixed = Model::Fixed {
+    let fixed = Model::Fixed(Counts::Adc {
         load_lsb: 1e-2,
         angle_lsb: Some(1e-6),
-    };
+    });
     for model in [Model::Reference, Model::F32, fixed] {
         let mut out = Owned::new(phi.len());
         assert_eq!(
@@ -545,4 +545,71 @@ fn reference_without_details_is_the_reference() {
             assert!(slow.model.contains(&0) && slow.model.contains(&1));
         }
     }
+}
+
+/// The largest relative error of d/b, F and phi0 of `model` against the reference over
+/// the rows.
+fn worst_against_reference(model: Model, load: &[f64], phi: &[f64]) -> f64 {
+    let inputs = Inputs::one_scene(&Scene::DEMO, Column::Each(load), Column::Each(phi));
+    let mut want = Owned::new(load.len());
+    let mut got = Owned::new(load.len());
+    batch::estimate(&inputs, &mut want.outputs(false), Model::Reference).unwrap();
+    assert_eq!(
+        batch::estimate(&inputs, &mut got.outputs(false), model),
+        Ok(0)
+    );
+    let rel = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| if x == y { 0.0 } else { (x / y - 1.0).abs() })
+            .fold(0.0, f64::max)
+    };
+    rel(&got.s, &want.s)
+        .max(rel(&got.f, &want.f))
+        .max(rel(&got.phi0, &want.phi0))
+}
+
+#[test]
+fn exact_counts_carry_the_cores_error_and_an_adc_its_rounding() {
+    // Small loads and angles, where an ADC's 10 mN and finest angle are few counts
+    // (0.104 N rounds to 10 counts, 4 % less).
+    let load = [0.104, 0.1049, 0.376, 1.004, 25.3, 2e3, 1.7e4];
+    let phi = [1.1e-7, 3.3e-4, 2.2e-7, 1.1e-7, 5e-5, 2e-4, -7e-4];
+    let exact = worst_against_reference(Model::Fixed(Counts::Exact), &load, &phi);
+    assert!(exact < 1e-5, "exact counts: {exact:e}");
+    let adc = Model::Fixed(Counts::Adc {
+        load_lsb: 1e-2,
+        angle_lsb: None,
+    });
+    let rounded = worst_against_reference(adc, &load, &phi);
+    assert!(
+        rounded > 1e-2,
+        "an ADC's rounding at 10 counts: {rounded:e}"
+    );
+}
+
+#[test]
+fn an_adc_lsb_the_core_cannot_take_is_named() {
+    let scene = Scene::DEMO;
+    let refused = |load: f64, angle: Option<f64>| {
+        batch::adc_lsb_refused(&scene, ModelChoice::Section9, load, angle)
+    };
+    assert_eq!(refused(1e-2, None), None);
+    assert_eq!(refused(1e-2, Some(1e-8)), None);
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-300, 1e300] {
+        assert_eq!(refused(bad, None), Some(batch::RefusedLsb::Load), "{bad:e}");
+        assert_eq!(
+            refused(1e-2, Some(bad)),
+            Some(batch::RefusedLsb::Angle),
+            "{bad:e}"
+        );
+    }
+    // Finer than the tables allow: one count below theta = 2^-40 rad.
+    assert_eq!(refused(1e-2, Some(1e-14)), Some(batch::RefusedLsb::Angle));
+    // A scene refused whatever the LSBs: not the LSBs' fault.
+    let plane = Scene::new(0.05, f64::INFINITY, 79.3e9, 0.3, 0.3).unwrap();
+    assert_eq!(
+        batch::adc_lsb_refused(&plane, ModelChoice::Elliptic, 1e-2, None),
+        None
+    );
 }

@@ -444,3 +444,63 @@ fn every_model_draws_the_right_angle_at_the_files_f64() {
         );
     }
 }
+
+/// `--model fixed` asks the core by default (each row's values held exactly);
+/// `--counts adc` asks the node with its ADC (10 mN and the finest angle, or the LSBs
+/// given), which carries the rounding; the ADC's options alone are refused.
+#[test]
+fn fixed_counts_exact_by_default_an_adc_when_asked() {
+    let input = "R1,R2,G,nu,mu,P,phi\n0.05,0.05,79.3e9,0.3,0.3,0.104,3.3e-4\n\
+                 0.05,0.05,79.3e9,0.3,0.3,2000,1.1e-7\n";
+    let s_of = |args: &[&str]| {
+        let (code, out, err) = run(args, input.as_bytes());
+        assert_eq!(code, 0, "{err}");
+        parse(&out)
+            .iter()
+            .map(|r| num(r, "s"))
+            .collect::<Vec<f64>>()
+    };
+    let reference = s_of(&["--model", "reference"]);
+    let exact = s_of(&["--model", "fixed"]);
+    assert_eq!(exact, s_of(&["--model", "fixed", "--counts", "exact"]));
+    let adc = s_of(&["--model", "fixed", "--counts", "adc"]);
+    let coarse = s_of(&["--model", "fixed", "--counts", "adc", "--angle-lsb", "1e-8"]);
+    let rel = |a: f64, b: f64| (a / b - 1.0).abs();
+    for i in 0..2 {
+        assert!(rel(exact[i], reference[i]) < 1e-5, "row {i}: {exact:?}");
+    }
+    // 0.104 N is 10 counts of 10 mN (0.1 N): d/b ~ P^(-1/3), 1.3 % up.
+    assert!(rel(adc[0], reference[0]) > 1e-2, "{adc:?}");
+    // 1.1e-7 rad is 11 counts of 1e-8 rad, exactly: no rounding of the angle.
+    assert!(rel(coarse[1], reference[1]) < 1e-5, "{coarse:?}");
+    for args in [
+        &["--model", "fixed", "--load-lsb", "0.01"][..],
+        &["--model", "reference", "--counts", "adc"],
+        &["--model", "fixed", "--counts", "adc", "--load-lsb", "0"],
+        &["--model", "fixed", "--counts", "adc", "--angle-lsb", "nan"],
+        &["--model", "fixed", "--counts", "adc", "--load-lsb", "-1"],
+    ] {
+        let (code, _, err) = run(args, input.as_bytes());
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains("lsb") || err.contains("counts"), "{err}");
+    }
+    // An angle LSB finer than the tables allow: each row says so, naming it.
+    let (code, out, _) = run(
+        &[
+            "--model",
+            "fixed",
+            "--counts",
+            "adc",
+            "--angle-lsb",
+            "1e-14",
+        ],
+        input.as_bytes(),
+    );
+    assert_eq!(code, 0);
+    assert!(
+        parse(&out)
+            .iter()
+            .all(|r| r["error"].contains("--angle-lsb")),
+        "{out}"
+    );
+}

@@ -5,7 +5,7 @@
 //! every word erased of a commit's record.
 
 use misalign::float::Auto;
-use misalign::modbus::map::{Access, SAMPLES_ADDRESS, SCENE_ADDRESS, Table, TableMap};
+use misalign::modbus::map::{Access, Domain, SAMPLES_ADDRESS, SCENE_ADDRESS, Table, TableMap};
 use misalign::modbus::{
     AlarmSet, BootSource, DEFAULT_UNLOCK_CODE, IMAGE_LEN, LOCKOUT_S, Server, ServerConfig, Stored,
     UNLOCK_TIMEOUT_S, WRONG_CODES_MAX, command, crc16, reason, staged,
@@ -695,6 +695,43 @@ fn resetting_the_statistics_needs_the_unlock_and_keeps_state_and_events() {
     assert!(s.monitor().statistics().total_energy() > 0.0);
 }
 
+/// `events_dropped` (the monitor's queue and the event window) is a statistic: it
+/// starts afresh with the others, while the events' numbers go on.
+#[test]
+fn resetting_the_statistics_starts_events_dropped_afresh() {
+    let mut s = server();
+    let dropped = |s: &mut Server<Auto>| {
+        let e = TableMap::of(Table::Input)
+            .entries
+            .iter()
+            .find(|e| e.name == "events_dropped")
+            .unwrap();
+        let pdu = request(s, 4, &words_be(&[e.address, 2]));
+        u32::from_be_bytes([pdu[2], pdu[3], pdu[4], pdu[5]])
+    };
+    // A sensor fault every 40 s, cleared after the off-delay: an event in and one
+    // out, never read.
+    let mut i = 0u32;
+    let mut sample = |s: &mut Server<Auto>| {
+        let noise = (i % 7) as f32;
+        let load = if i % 40 == 39 { f32::NAN } else { 1e3 + noise };
+        s.process(Sample::new(i * 1000, load, 5e-5 + 1e-8 * noise).with_speed(2.0));
+        i += 1;
+    };
+    while s.monitor().next_event_seq() < 20 {
+        sample(&mut s);
+    }
+    assert!(dropped(&mut s) >= 12, "{}", dropped(&mut s));
+    unlock(&mut s);
+    cmd(&mut s, command::RESET_STATISTICS).unwrap();
+    assert_eq!(dropped(&mut s), 0);
+    assert_eq!(s.monitor().next_event_seq(), 20);
+    while s.monitor().next_event_seq() < 22 {
+        sample(&mut s);
+    }
+    assert_eq!(dropped(&mut s), 2, "counted again from 0");
+}
+
 fn at_coil(name: &str) -> u16 {
     TableMap::of(Table::Coil)
         .entries
@@ -1084,7 +1121,14 @@ fn every_configuration_write_needs_the_unlock() {
     coil(&mut s, 0, true).unwrap();
     write1(&mut s, at("acknowledge_alarms"), 15).unwrap();
     write(&mut s, at("event_from"), &[0, 0]).unwrap();
-    write(&mut s, at("event_ack"), &[0xFFFF, 0xFFFF]).unwrap();
+    // An acknowledgement needs a number given (03 before any event), not the code.
+    assert_eq!(write(&mut s, at("event_ack"), &[0, 0]), Err(3));
+    let mut t = 0;
+    while s.monitor().next_event_seq() == 0 {
+        s.process(Sample::new(t, 2e3, 1e-4).with_speed(2.0));
+        t += 1000;
+    }
+    write(&mut s, at("event_ack"), &[0, 0]).unwrap();
     assert!(!s.unlocked());
 
     // Unlocked: taken, each renewing the unlock as a staged write does.
@@ -1131,4 +1175,58 @@ fn external_samples_need_no_code() {
     write(&mut s, SAMPLES_ADDRESS, &record).unwrap();
     assert_eq!(s.monitor().statistics().samples(), 1);
     assert_eq!(s.commissioning().refused, 0);
+}
+
+/// Every writable holding register refuses what its domain (the map's, the CSV's
+/// `min` and `max`) leaves out: at the write (exception 03) or at the commit (refused,
+/// its reason in `commit_error`), from the default configuration (every option on);
+/// and takes its bounds at the write, but where the value has a meaning of its own:
+/// `event_ack` takes the numbers given only (the event window's tests), `unlock` the
+/// site's code, `command` a commit with something staged.
+#[test]
+fn every_register_refuses_what_its_domain_leaves_out() {
+    let mut checked = 0;
+    for e in TableMap::of(Table::Holding).entries {
+        let (mut outside, mut bounds) = (Vec::new(), Vec::new());
+        match e.domain() {
+            Domain::ReadOnly | Domain::Any => continue,
+            Domain::Whole { min, max } => {
+                let top = if e.ty.words() == 2 { u32::MAX } else { 0xFFFF };
+                outside.extend(min.checked_sub(1));
+                outside.extend((max < top).then(|| max + 1));
+                bounds.extend([min, max]);
+            }
+            Domain::Finite { min, max } => {
+                outside.extend([f32::NAN, f32::INFINITY, f32::NEG_INFINITY].map(f32::to_bits));
+                if min > -f32::MAX {
+                    outside.push((min - 1e-30_f32.max(min.abs() * 1e-6)).to_bits());
+                }
+                bounds.extend([min.to_bits(), max.to_bits()]);
+            }
+        }
+        if matches!(e.name, "event_ack" | "unlock" | "command") {
+            bounds.clear();
+        }
+        for v in outside {
+            let mut s = server();
+            unlock(&mut s);
+            let refused = match put(&mut s, e.name, v) {
+                Err(x) => x == 3,
+                Ok(()) => cmd(&mut s, command::COMMIT) == Err(3),
+            };
+            assert!(refused, "{} = {v:#x} taken", e.name);
+            checked += 1;
+        }
+        for v in bounds {
+            let mut s = server();
+            unlock(&mut s);
+            assert_eq!(
+                put(&mut s, e.name, v),
+                Ok(()),
+                "{} = {v:#x} at the write",
+                e.name
+            );
+        }
+    }
+    assert!(checked > 40, "{checked}");
 }

@@ -41,6 +41,18 @@ fn sample(i: u32) -> Sample {
     s
 }
 
+/// A fresh monitor's state that numbers its next event `start`: the numbers before it
+/// given, up from 0 (two steps of less than 2^31, as events are numbered).
+fn numbering_from(start: u32) -> MonitorState {
+    let mut state = monitor(None).snapshot();
+    if start != 0 {
+        state.continue_events_after(start / 2);
+        state.continue_events_after(start - 1);
+    }
+    assert_eq!(state.next_event_seq(), start);
+    state
+}
+
 /// A request of `function` with `data` to unit 1.
 fn send<E: Estimator>(s: &mut Server<E>, function: u8, data: &[u8]) {
     let mut f = vec![1, function];
@@ -222,12 +234,142 @@ fn event_ack_takes_only_numbers_given_and_moves_event_from() {
     assert_eq!(input(&mut s, "checkpoint_age"), 2);
 }
 
+/// Only a number the node gave is acknowledged: on a fresh server none; after nine
+/// events 0 to 8. A number never given is exception 03 and changes nothing, whether it
+/// lies ahead or half the number space away (where a comparison modulo 2^32 alone
+/// would read it as an old one).
+#[test]
+fn event_ack_refuses_every_number_never_given() {
+    let mut s = Server::new(monitor(None), ServerConfig::default()).unwrap();
+    for n in [
+        0,
+        1,
+        9,
+        0x7FFF_FFFF,
+        0x8000_0000,
+        0x9000_0000,
+        0xFFFF_FFFE,
+        u32::MAX,
+    ] {
+        assert_eq!(ack(&mut s, n), [0x90, 3], "{n:#x} on a fresh server");
+    }
+    assert_eq!(s.acknowledged_through(), None);
+    let mut i = 0;
+    while s.monitor().next_event_seq() < 9 {
+        s.process(sample(i));
+        i += 1;
+    }
+    assert_eq!(s.monitor().next_event_seq(), 9);
+    let never = [
+        9,
+        10,
+        0x8000_0000,
+        0x8000_0008,
+        0x8000_0009,
+        0x9000_0000,
+        u32::MAX,
+    ];
+    for n in never {
+        assert_eq!(ack(&mut s, n), [0x90, 3], "{n:#x} after nine events");
+    }
+    assert_eq!(s.acknowledged_through(), None);
+    assert_eq!(
+        u32_at(&words(&pdu(&mut s, 3, &[0, 0, 0, 2])), 0),
+        0,
+        "event_from"
+    );
+    for n in 0..9 {
+        assert_eq!(ack(&mut s, n), [16, 0, 7, 0, 2], "{n}");
+        assert_eq!(s.acknowledged_through(), Some(n));
+    }
+    assert_eq!(
+        u32_at(&words(&pdu(&mut s, 3, &[0, 0, 0, 2])), 0),
+        9,
+        "event_from"
+    );
+}
+
+/// The event window's header after writing `event_from`: event_first, event_count,
+/// events_missed, and the discrete input event_available.
+fn window_from(s: &mut Server<Auto>, from: u32) -> (u32, u16, u32, bool) {
+    let [a, b, c, d] = from.to_be_bytes();
+    assert_eq!(pdu(s, 16, &[0, 0, 0, 2, 4, a, b, c, d])[0], 16);
+    let [x, y] = EVENT_WINDOW_ADDRESS.to_be_bytes();
+    let w = words(&pdu(s, 4, &[x, y, 0, 5]));
+    let available = pdu(s, 2, &[0, 9, 0, 1])[2] & 1 != 0;
+    (u32_at(&w, 0), w[2], u32_at(&w, 3), available)
+}
+
+/// `event_from` at a number never given shows nothing (the events after it are none
+/// yet), and misses nothing; at a number given, the events from it. Around the wrap of
+/// the numbering the same, on both sides of it.
+#[test]
+fn event_from_at_a_number_never_given_shows_nothing() {
+    for start in [0, u32::MAX - 4] {
+        let state = numbering_from(start);
+        let mut s = Server::new(monitor(Some(&state)), ServerConfig::default()).unwrap();
+        let mut i = 0;
+        while s.monitor().next_event_seq() != start.wrapping_add(9) {
+            s.process(sample(i));
+            i += 1;
+        }
+        let next = s.monitor().next_event_seq();
+        for never in [next, next + 1, next + 1000, next.wrapping_add(0x7FFF_FFFF)] {
+            assert_eq!(
+                window_from(&mut s, never),
+                (next, 0, 0, false),
+                "{start:#x} {never:#x}"
+            );
+        }
+        // Fresh numbers from 0 on: those below 0x8000_0000 behind the newest are not
+        // given either.
+        if start == 0 {
+            for never in [0x9000_0000, 0xFFFF_FFF0, u32::MAX] {
+                assert_eq!(
+                    window_from(&mut s, never),
+                    (next, 0, 0, false),
+                    "{never:#x}"
+                );
+            }
+        }
+        // The last four, from the first of them.
+        let first = next.wrapping_sub(4);
+        assert_eq!(window_from(&mut s, first), (first, 4, 0, true));
+        // The window holds eight of the nine: the first one missed.
+        assert_eq!(
+            window_from(&mut s, start),
+            (start.wrapping_add(1), 4, 1, true)
+        );
+        assert_eq!(
+            window_from(&mut s, next.wrapping_sub(1)),
+            (next.wrapping_sub(1), 1, 0, true)
+        );
+        // Acknowledged on both sides of the wrap; one ahead refused.
+        assert_eq!(ack(&mut s, start), [16, 0, 7, 0, 2]);
+        assert_eq!(ack(&mut s, next.wrapping_sub(1)), [16, 0, 7, 0, 2]);
+        assert_eq!(ack(&mut s, next), [0x90, 3]);
+    }
+}
+
 /// Events raised while the master reads slowly, resets between, the master
 /// acknowledging what it read: every event read once, in order, with its own number,
 /// none missed, none acknowledged read again.
 #[test]
 fn every_event_is_read_once_in_order_across_resets_and_beyond_the_window() {
-    let mut checkpoint = monitor(None).snapshot();
+    read_once_in_order_from(0);
+}
+
+/// The same across the wrap of the numbering (modulo 2^32): the events numbered from
+/// just below 2^32 on, through 0.
+#[test]
+fn every_event_is_read_once_in_order_across_the_numbers_wrap() {
+    read_once_in_order_from(u32::MAX - 20);
+}
+
+/// The master's reads and acknowledgements against the node's resets and bursts, the
+/// monitor numbering its events from `start`.
+fn read_once_in_order_from(start: u32) {
+    let mut checkpoint = numbering_from(start);
     let (mut s, mut q) = boot(Flash::new(), &checkpoint);
     let mut read: Vec<u32> = Vec::new();
     let mut i = 0u32;
@@ -242,11 +384,13 @@ fn every_event_is_read_once_in_order_across_resets_and_beyond_the_window() {
         }
         // The master: reads the window twice, acknowledges what it read.
         for _ in 0..2 {
-            let (events, missed) = read_window(&mut s, &mut q, read.last().map(|l| l + 1));
+            let from = read.last().map(|l| l.wrapping_add(1)).or(Some(start));
+            let (events, missed) = read_window(&mut s, &mut q, from);
             assert_eq!(missed, 0, "round {round}");
             for e in &events {
                 if let Some(&last) = read.last() {
-                    assert_eq!(e.seq, last + 1, "round {round}: in order, none missed");
+                    let next = last.wrapping_add(1);
+                    assert_eq!(e.seq, next, "round {round}: in order, none missed");
                 }
                 read.push(e.seq);
             }
@@ -272,16 +416,17 @@ fn every_event_is_read_once_in_order_across_resets_and_beyond_the_window() {
     }
     // Drain what is left.
     loop {
-        let (events, _) = read_window(&mut s, &mut q, read.last().map(|l| l + 1));
+        let (events, _) = read_window(&mut s, &mut q, read.last().map(|l| l.wrapping_add(1)));
         let Some(last) = events.last() else { break };
         for e in &events {
-            assert_eq!(e.seq, read.last().map_or(0, |l| l + 1));
+            assert_eq!(e.seq, read.last().map_or(start, |l| l.wrapping_add(1)));
             read.push(e.seq);
         }
         ack_stored(&mut s, &mut q, last.seq);
     }
-    let raised = s.monitor().next_event_seq();
-    assert_eq!(read, (0..raised).collect::<Vec<_>>());
+    let raised = s.monitor().next_event_seq().wrapping_sub(start);
+    let numbers: Vec<u32> = (0..raised).map(|k| start.wrapping_add(k)).collect();
+    assert_eq!(read, numbers);
     assert!(
         raised as usize > 4 * EVENT_WINDOW && resets > 10,
         "{raised} events"

@@ -479,10 +479,11 @@ fn a_length_absurd_against_the_radii_is_refused_in_every_model() {
     for model in [
         misalign::batch::Model::Reference,
         misalign::batch::Model::F32,
-        misalign::batch::Model::Fixed {
+        misalign::batch::Model::Fixed(misalign::batch::Counts::Adc {
             load_lsb: 1.0,
             angle_lsb: Some(1e-7),
-        },
+        }),
+        misalign::batch::Model::Fixed(misalign::batch::Counts::Exact),
     ] {
         let mut status = [0u8; 2];
         let (mut s, mut f, mut phi0) = ([0.0; 2], [0.0; 2], [0.0; 2]);

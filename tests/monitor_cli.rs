@@ -38,6 +38,36 @@ fn a_trace_becomes_samples_on_the_nodes_wrapping_clock() {
 }
 
 #[test]
+fn a_traces_fault_column_names_a_sensors_own_fault() {
+    use misalign::monitor::{FaultKind, SensorFault, SensorId};
+    let csv = "t,P,phi,V,fault\n0,2000,1e-4,1.5,\n0.1,0,1e-4,1.5,load:disconnected\n\
+               0.2,2000,0,,probe2:out_of_range\n0.3,2000,1e-4,1.5,probe3:stuck\n";
+    let samples = input::read_trace(csv.as_bytes()).unwrap();
+    let faults: Vec<Option<SensorFault>> = samples.iter().map(|s| s.sensor_fault).collect();
+    let fault = |sensor, kind| Some(SensorFault { sensor, kind });
+    assert_eq!(
+        faults[..3],
+        [
+            None,
+            fault(SensorId::Load, FaultKind::Disconnected),
+            fault(SensorId::Probe2, FaultKind::OutOfRange)
+        ]
+    );
+    // A fault this reader does not know: the row's values are no measurement.
+    assert_eq!(faults[3], None);
+    assert!(samples[3].load.is_nan());
+    for sensor in SensorId::ALL {
+        for kind in FaultKind::ALL {
+            let cell = format!("{}:{}", sensor.name(), input::fault_kind_name(kind));
+            assert_eq!(
+                input::sensor_fault(cell.as_bytes()),
+                Some(SensorFault { sensor, kind })
+            );
+        }
+    }
+}
+
+#[test]
 fn a_trace_without_its_columns_is_refused() {
     assert!(input::read_trace("t,P\n0,1\n".as_bytes()).is_err());
     assert!(input::read_trace("".as_bytes()).is_err());
@@ -404,4 +434,90 @@ fn replay_child() {
             .trim_end_matches("kB")
             .trim()
     );
+}
+
+/// `--thresholds` over a trace whose loads never reach above the stop load (100 N) is
+/// refused with a message, not a table for a range the trace never saw; a trace whose
+/// loads pass the configuration's `load_max` gets a table up to it, and says so.
+#[test]
+fn the_planners_range_is_refused_or_its_change_said() {
+    let rows = |p: f64| {
+        let mut csv = String::from("t,P,phi\n");
+        for i in 0..200 {
+            csv += &format!("{i},{p},2e-4\n");
+        }
+        csv
+    };
+    let dir = trace_file("plan-dir-marker", b"")
+        .parent()
+        .unwrap()
+        .to_owned();
+    let out = |name: &str| dir.join(name).display().to_string();
+    for (name, p) in [
+        ("plan-50.csv", 50.0),
+        ("plan-neg.csv", -100.0),
+        ("plan-nan.csv", f64::NAN),
+    ] {
+        let trace = trace_file(name, rows(p).as_bytes());
+        let thresholds = out(&format!("{name}-thresholds.csv"));
+        let _ = std::fs::remove_file(&thresholds);
+        let (code, _, err) = monitor(&[
+            "--trace",
+            trace.to_str().unwrap(),
+            "--plot",
+            &out(&format!("{name}.svg")),
+            "--thresholds",
+            &thresholds,
+        ]);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(err.contains("--thresholds:"), "{name}: {err}");
+        assert!(
+            err.contains("stop load") || err.contains("no finite load"),
+            "{name}: {err}"
+        );
+        assert!(!std::path::Path::new(&thresholds).exists(), "{name}");
+    }
+    // Above the configuration's maximum load (50 kN): the table ends there, said.
+    let trace = trace_file("plan-high.csv", rows(49_000.0).as_bytes());
+    let thresholds = out("plan-high-thresholds.csv");
+    let (code, _, err) = monitor(&[
+        "--trace",
+        trace.to_str().unwrap(),
+        "--plot",
+        &out("plan-high.svg"),
+        "--thresholds",
+        &thresholds,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("ends at the configuration's load_max, 50000 N"),
+        "{err}"
+    );
+    let table = std::fs::read_to_string(&thresholds).unwrap();
+    let last = table.lines().last().unwrap();
+    assert!(last.starts_with("50000,"), "{last}");
+}
+
+/// `--thresholds` alone writes the planner's table (the web console and the Python
+/// package give the table without a figure too), the same bytes as beside a plot.
+#[test]
+fn the_thresholds_table_needs_no_plot() {
+    let dir = trace_file("alone-dir-marker", b"")
+        .parent()
+        .unwrap()
+        .to_owned();
+    let out = |name: &str| dir.join(name).display().to_string();
+    let alone = out("alone-thresholds.csv");
+    let (code, _, err) = monitor(&["--thresholds", &alone]);
+    assert_eq!(code, 0, "{err}");
+    let with_plot = out("with-plot-thresholds.csv");
+    let (code, _, err) = monitor(&["--plot", &out("with-plot.svg"), "--thresholds", &with_plot]);
+    assert_eq!(code, 0, "{err}");
+    let table = std::fs::read(&alone).unwrap();
+    assert!(
+        table.starts_with(b"P,"),
+        "{}",
+        String::from_utf8_lossy(&table)
+    );
+    assert_eq!(table, std::fs::read(&with_plot).unwrap());
 }

@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Commissions a misalign node over Modbus RTU (docs/modbus.md, "Commissioning from the
 PC"): from what a reliability engineer planned (a scene file, a configuration file, the
-monitor example's `--thresholds` table) it prepares the scene's bytes, unlocks the node
-with the site's code, writes the configuration and the scene to its staged copy, reads
-them back, commits, checks that the node runs them, and prints the node's status.
+monitor example's `--thresholds` table) it prepares the scene's bytes, checks every
+value, unlocks the node with the site's code, writes the configuration and the scene to
+its staged copy, reads them back, commits, checks that the node runs them, and prints
+the node's status.
 
     python3 tools/commission.py --tcp 127.0.0.1:5020 --code 1234 \\
         --scene scene.csv --config config.csv --thresholds thresholds.csv
@@ -18,26 +19,31 @@ them back, commits, checks that the node runs them, and prints the node's status
 - `--config C.csv`: `name,value` lines, a `config_*` register of the map (the prefix may
   be left out, here and in `--set`), `new_code`, or one of the switches `latching` (the
   alarms that latch, bits 0-3) and `external_mode` (1: samples from the bus), which
-  the node applies as they are written and keeps with the commit; `--set NAME=VALUE`
-  adds or overrides one.
+  the node applies as they are written and keeps with the commit (written alone, they
+  need no commit); `--set NAME=VALUE` adds or overrides one.
   `cargo xtask modbus --default-config C.csv` writes the defaults.
-- `--thresholds T.csv`: the planner's table (`P,phi0,phi_warning,...`). It holds no
-  register (its angles follow from the scene and the configuration's thresholds): it is
-  checked against the configuration the node will run, its loads within the stop load
-  and the highest accepted load, and its alarm angles summed up on the way.
+- `--thresholds T.csv` (with `--scene`): the planner's table (`P,phi0,phi_warning,...`).
+  It holds no register: it is checked against the scene and the configuration the node
+  will run (its loads within the stop load and the highest accepted load; at each load
+  the scene's critical angle, and d/b, or the margin, at the configuration's
+  thresholds by the f64 reference, `examples/estimate --model reference`), and its
+  alarm angles summed up on the way.
 - `--events OUT.csv`: the events the node holds, in the monitor example's `--events`
   format (decoded as `misalign::modbus::event_from_registers` does), from its
   `event_from` or `--events-from SEQ`; read through the window, `event_from` put back,
   nothing acknowledged.
 - `--reset-statistics`: the node's statistics (counts, time and energy per state,
-  extremes) start afresh, after a roller change say (the command 4, before anything
-  is written); alone, nothing is committed.
+  extremes, events dropped) start afresh, after a roller change say (the command 4),
+  once everything else is in force: a refused run resets nothing.
 - Without `--code`, nothing is written: the node's status and events only.
 
-Register names and types come from the register map (`--registers`, default
-docs/modbus/registers.csv); 32-bit values high word first. Exit status 0 when the node
-runs what was written; otherwise the reason (a wrong code, a lock-out, the commit's
-`commit_error`) on stderr and status 1, and whatever was staged is reverted.
+Register names, types and domains come from the register map (`--registers`, default
+docs/modbus/registers.csv beside this tool, so that it runs from any folder); 32-bit
+values high word first. Every value is checked against its register's type and domain
+(the map's `min` and `max`) before the node is touched. Exit status 0 when the node
+runs what was written; otherwise the reason (a value outside its register, a wrong
+code, a lock-out, the commit's `commit_error`, any failure once unlocked) on stderr
+and status 1, the switches put back, whatever was staged reverted, the node locked.
 Needs pymodbus (3.16).
 """
 
@@ -75,12 +81,31 @@ class Failed(Exception):
     pass
 
 
-class Node:
-    def __init__(self, client, registers, unit):
-        self.c = client
-        self.unit = unit
-        with open(registers, newline="") as f:
-            self.rows = {(r["table"], r["name"]): r for r in csv.DictReader(f)}
+# The repository this tool sits in: the register map and `cargo run --example ...`.
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+REGISTERS = os.path.join(ROOT, "docs", "modbus", "registers.csv")
+
+
+def f32_bits(x):
+    """`x` rounded to the nearest f32, as its bits; OverflowError beyond the largest."""
+    return struct.unpack(">I", struct.pack(">f", x))[0]
+
+
+def f32(words):
+    return struct.unpack(">f", struct.pack(">HH", *words))[0]
+
+
+class Map:
+    """The register map (docs/modbus/registers.csv's columns): each row by table and
+    name, and each value a master writes checked against its register's type and
+    domain (the columns `min` and `max`)."""
+
+    def __init__(self, path):
+        try:
+            with open(path, newline="") as f:
+                self.rows = {(r["table"], r["name"]): r for r in csv.DictReader(f)}
+        except OSError as e:
+            raise Failed(f"the register map {path}: {e.strerror}") from None
 
     def row(self, name, table="holding"):
         try:
@@ -89,14 +114,46 @@ class Node:
             raise Failed(f"the register map has no {table} register {name}") from None
 
     def words(self, name, value):
-        ty = self.row(name)["type"]
+        """`value` (text or a number) as the holding register's words, high word first;
+        Failed, naming the register, for a value its type or domain does not hold."""
+        r = self.row(name)
+        if r["access"] != "rw":
+            raise Failed(f"{name} is read only")
+        ty, lo, hi, unit = r["type"], r.get("min", ""), r.get("max", ""), r["unit"]
+        text = str(value).strip()
+        within = f"from {lo} to {hi}{' ' + unit if unit else ''}"
         if ty == "f32":
-            return list(struct.unpack(">HH", struct.pack(">f", float(value))))
-        v = int(value, 0) if isinstance(value, str) else int(value)
-        if ty in ("u32", "i32"):
-            v &= 0xFFFFFFFF
-            return [v >> 16, v & 0xFFFF]
-        return [v & 0xFFFF]
+            try:
+                x = float(text)
+                bits = f32_bits(x)
+            except ValueError:
+                raise Failed(f"{name} = {text}: not a number") from None
+            except OverflowError:
+                raise Failed(f"{name} = {text}: beyond the largest f32 ({within})") from None
+            x = f32([bits >> 16, bits & 0xFFFF])
+            if lo != "" and not math.isfinite(x):
+                raise Failed(f"{name} = {text}: not a finite number ({within})")
+            if lo != "" and not float(lo) <= x <= float(hi):
+                raise Failed(f"{name} = {text}: outside its domain, {within}")
+            return [bits >> 16, bits & 0xFFFF]
+        if ty in ("u16", "u32"):
+            try:
+                v = int(text, 16) if text.lower().startswith("0x") else int(text)
+            except ValueError:
+                raise Failed(f"{name} = {text}: not a whole number ({within})") from None
+            if not int(lo) <= v <= int(hi):
+                raise Failed(f"{name} = {text}: outside its domain, a whole number {within}")
+            return [v >> 16, v & 0xFFFF] if ty == "u32" else [v]
+        raise Failed(f"{name}: a {ty} register, which this tool does not write")
+
+
+class Node:
+    def __init__(self, client, regs, unit):
+        self.c = client
+        self.unit = unit
+        self.map = regs
+        self.rows = regs.rows
+        self.row = regs.row
 
     def read(self, name, table="holding"):
         r = self.row(name, table)
@@ -130,17 +187,13 @@ def u32(words):
 
 
 # Switches the node applies as written (behind the unlock) and keeps with the
-# committed configuration.
+# committed configuration: nothing to commit for them.
 SWITCHES = ("latching", "external_mode")
+# The register `command`'s values.
+COMMIT, REVERT, LOCK, RESET_STATISTICS = 1, 2, 3, 4
 
 
-def commission(node, code, settings, scene, reset_statistics=False):
-    if scene is not None:
-        want = node.read("scene_bytes")[0]
-        if want == 0:
-            raise Failed("this node takes no scene over the bus")
-        if len(scene) != want:
-            raise Failed(f"the node takes {want} bytes of prepared scene, the file has {len(scene)}")
+def unlock(node, code):
     x = node.write("unlock", [code])
     if x == 3:
         raise Failed("wrong code (counted by the node; a few in a row lock it out)")
@@ -148,25 +201,50 @@ def commission(node, code, settings, scene, reset_statistics=False):
         raise Failed(f"locked out for {node.read('lockout')[0]} s after wrong codes")
     if x is not None:
         raise Failed(f"unlock: exception {x}")
-    if reset_statistics:
-        x = node.write("command", [4])
-        if x is not None:
-            node.write("command", [3])  # lock
-            raise Failed(f"reset of the statistics: exception {x}")
-        if not settings and scene is None:
-            node.write("command", [3])  # lock
-            return node.read("config_source")[0]
-    # The switches as they were, put back if the commit fails.
-    switched = {name: node.read(name) for name, _ in settings if name in SWITCHES}
-    try:
-        for name, value in settings:
-            if not (name.startswith("config_") or name in ("new_code",) + SWITCHES):
-                raise Failed(f"{name} is not a configuration register "
-                             f"(config_*, new_code, {', '.join(SWITCHES)})")
-            words = node.words(name, value)
+
+
+def put_back(node, switched):
+    """After a failure: the switches as they were, the staged copy reverted, the node
+    locked; every step tried, whatever the others did. What failed, as text."""
+    failed = []
+    steps = [(name, words) for name, words in switched.items()]
+    steps += [("command", [REVERT]), ("command", [LOCK])]
+    for name, words in steps:
+        try:
             x = node.write(name, words)
             if x is not None:
-                raise Failed(f"{name} = {value}: exception {x}")
+                failed.append(f"{name} {words}: exception {x}")
+        except Exception as e:  # noqa: BLE001 (the line may be gone: say so, go on)
+            failed.append(f"{name} {words}: {e}")
+    return failed
+
+
+def commission(node, code, settings, scene, reset_statistics=False):
+    """Puts `settings` (name, words, text; every value checked against the map) and
+    `scene` (prepared bytes) on the node with the site's `code`: unlocked, written,
+    read back, committed (the switches alone need no commit), the active values read
+    back, then the statistics reset if asked; the node locked. On any failure after
+    the unlock, of any kind, the switches are put back, the staged copy reverted and
+    the node locked before the failure goes on up, unless the commit was applied
+    (then only the lock). Returns `config_source`."""
+    if scene is not None:
+        want = node.read("scene_bytes")[0]
+        if want == 0:
+            raise Failed("this node takes no scene over the bus")
+        if len(scene) != want:
+            raise Failed(f"the node takes {want} bytes of prepared scene, the file has {len(scene)}")
+    staged = [s for s in settings if s[0] not in SWITCHES]
+    # The switches as they were, put back if the run fails.
+    switched = {name: node.read(name) for name, _, _ in settings if name in SWITCHES}
+    unlock(node, code)
+    # Once a commit applied the staged copy (and ended the unlock), a failure has
+    # nothing to put back; after it the node is unlocked again only to reset.
+    committed, unlocked = False, True
+    try:
+        for name, words, text in settings:
+            x = node.write(name, words)
+            if x is not None:
+                raise Failed(f"{name} = {text}: exception {x}")
             if name != "new_code" and node.read(name) != words:
                 raise Failed(f"{name} reads back {node.read(name)}, not {words}")
         if scene is not None:
@@ -176,37 +254,64 @@ def commission(node, code, settings, scene, reset_statistics=False):
             crc = int.from_bytes(scene[-4:], "little")
             if u32(node.read("scene_staged_crc")) != crc:
                 raise Failed("the staged scene's CRC differs from the file's: bytes lost on the way")
-        x = node.write("command", [1])
-        if x is not None:
-            why = node.read("commit_error")[0]
-            raise Failed(f"commit refused: {REASONS.get(why, why)} (commit_error {why:#x})")
-    except Failed:
-        for name, words in switched.items():
-            node.write(name, words)
-        node.write("command", [2])  # revert
-        node.write("command", [3])  # lock
+        if staged or scene is not None:
+            x = node.write("command", [COMMIT])
+            if x is not None:
+                why = node.read("commit_error")[0]
+                raise Failed(f"commit refused: {REASONS.get(why, why)} (commit_error {why:#x})")
+            committed, unlocked = True, False
+            # What the node runs now.
+            for name, words, _ in staged:
+                active = "active_" + name[len("config_"):]
+                if name.startswith("config_") and node.read(active) != words:
+                    raise Failed(f"{active} reads {node.read(active)} after the commit")
+            if scene is not None and u32(node.read("scene_active_crc")) != crc:
+                raise Failed("the node does not run the scene after the commit")
+        if reset_statistics:
+            if committed:
+                # The commit ended the unlock; the code may be the one it committed.
+                new = [w[0] for n, w, _ in settings if n == "new_code"]
+                unlock(node, new[-1] if new else code)
+                unlocked = True
+            x = node.write("command", [RESET_STATISTICS])
+            if x is not None:
+                raise Failed(f"reset of the statistics: exception {x}")
+        if unlocked:
+            node.write("command", [LOCK])
+    except BaseException as e:
+        failed = []
+        if not committed:
+            failed = put_back(node, switched)
+        else:
+            e.add_note("the configuration was committed")
+            if unlocked:
+                failed = put_back(node, {})  # nothing staged to revert: the lock
+        if failed:
+            e.add_note("putting the node back failed (" + "; ".join(failed) + "): it locks "
+                       "itself when the unlock times out")
         raise
-    # What the node runs now.
-    for name, value in settings:
-        if name in SWITCHES and node.read(name) != node.words(name, value):
-            raise Failed(f"{name} reads {node.read(name)} after the commit")
-        if name.startswith("config_"):
-            active = "active_" + name[len("config_"):]
-            if node.read(active) != node.words(name, value):
-                raise Failed(f"{active} reads {node.read(active)} after the commit")
-    if scene is not None and u32(node.read("scene_active_crc")) != int.from_bytes(scene[-4:], "little"):
-        raise Failed("the node does not run the scene after the commit")
     return node.read("config_source")[0]
 
 
 STATES = {0: "stopped", 1: "normal", 2: "microslip", 3: "gross slip", 4: "sensor fault"}
 
 
-def register(name):
-    """A configuration register's name: `config_` added to a field's name."""
-    if name in ("new_code",) + SWITCHES or name.startswith("config_"):
-        return name
-    return "config_" + name
+def settings_words(regs, settings):
+    """Each (name, text) as (register, words, text): the name a configuration register
+    (`config_` may be left out), the value within its register's type and domain;
+    Failed naming the first that is not, before anything is written."""
+    out = []
+    for name, text in settings:
+        if not (name.startswith("config_") or name in ("new_code",) + SWITCHES):
+            if ("holding", "config_" + name) in regs.rows:
+                name = "config_" + name
+            elif ("holding", name) in regs.rows and regs.row(name)["access"] != "rw":
+                raise Failed(f"{name} is read only")
+            else:
+                raise Failed(f"{name} is not a configuration register "
+                             f"(config_*, new_code, {', '.join(SWITCHES)})")
+        out.append((name, regs.words(name, text), text))
+    return out
 
 
 def read_config(path):
@@ -220,7 +325,7 @@ def read_config(path):
                 continue
             if len(row) != 2:
                 raise Failed(f"{path}:{n}: name,value")
-            out.append((register(row[0].strip()), row[1].strip()))
+            out.append((row[0].strip(), row[1].strip()))
     return out
 
 
@@ -234,42 +339,103 @@ def read_scene(path):
     return [c.strip() for c in rows[1]]
 
 
+def cargo_example(name, args, stdin=None):
+    """`cargo run --release --example NAME -- ARGS` in this repository; its stdout."""
+    done = subprocess.run(["cargo", "run", "--quiet", "--release", "--example", name, "--", *args],
+                          input=stdin, capture_output=True, text=True, cwd=ROOT)
+    if done.returncode != 0:
+        raise Failed(f"examples/{name}: {done.stderr.strip()}")
+    return done.stdout
+
+
 def prepare(scene, core):
     """The scene's prepared bytes for the node's core, from examples/prepare.rs."""
     r1, r2, g, nu, mu, *length = scene
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "scene.bin")
-        cmd = ["cargo", "run", "--quiet", "--release", "--example", "prepare", "--",
-               "--type", "auto" if core == "f32" else "fixed-auto", "--out", out]
-        cmd += ["--length", length[0]] if length else []
-        done = subprocess.run(cmd + ["--", r1, r2, g, nu, mu], capture_output=True, text=True,
-                              cwd=os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-        if done.returncode != 0:
-            raise Failed(f"preparing the scene: {done.stderr.strip()}")
-        return open(out, "rb").read()
+        args = ["--type", "auto" if core == "f32" else "fixed-auto", "--out", out]
+        args += ["--length", length[0]] if length else []
+        cargo_example("prepare", args + ["--", r1, r2, g, nu, mu])
+        with open(out, "rb") as f:
+            return f.read()
 
 
-def f32(words):
-    return struct.unpack(">f", struct.pack(">HH", *words))[0]
+PLANNED = ("phi_warning", "phi_warning_clear", "phi_alarm", "phi_alarm_clear")
+# What the planner's angles are planned for, and how closely it finds them: the angle
+# where the slip ratio d/b (or the margin) reaches the threshold, to within 1e-4 of d/b
+# (1e-4 phi0 of the margin); the planner's bisection with either core is within 1e-5.
+PLANNED_WITHIN = 1e-4
 
 
-def check_thresholds(node, path, settings):
+def read_thresholds(path, scene):
+    """The planner's table, and the reference model's answer at each of its angles
+    (examples/estimate --model reference: phi0, d/b, whether near the switch of
+    contact models, where the planner's model for the whole range may be the other)."""
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as e:
+        raise Failed(f"{path}: {e.strerror}") from None
+    if not rows or not {"P", "phi0", *PLANNED} <= set(rows[0]):
+        raise Failed(f"{path}: not the planner's table (P,phi0,{','.join(PLANNED)})")
+    if scene is None:
+        raise Failed("--thresholds needs the scene file (--scene) the table was planned for")
+    r1, r2, g, nu, mu, *length = scene
+    points = [(r["P"], r[c] or "0") for r in rows for c in ("phi0",) + PLANNED]
+    lines = ["R1,R2,G,nu,mu,P,phi" + (",length" if length else "")]
+    lines += [",".join([r1, r2, g, nu, mu, P, phi] + length) for P, phi in points]
+    answers = list(csv.DictReader(cargo_example("estimate", ["--model", "reference"],
+                                                "\n".join(lines) + "\n").splitlines()))
+    if len(answers) != len(points):
+        raise Failed(f"{path}: the reference model answered {len(answers)} rows of {len(points)}")
+    return rows, answers
+
+
+def check_thresholds(node, path, table, settings):
     """The planner's table against the configuration the node will run: its loads
-    within (stop load, highest accepted load]. A summary line."""
+    within (stop load, highest accepted load], its critical angles the scene's, and
+    each angle where the configuration's d/b (or margin) thresholds are reached. A
+    summary line."""
+    rows, answers = table
+
     def value(name):
-        for n, v in reversed(settings):
+        for n, words, _ in reversed(settings):
             if n == name:
-                return float(v)
-        return f32(node.read(name))
+                break
+        else:
+            words = node.read(name)
+        return f32(words) if len(words) == 2 else words[0]
     stop, top = value("config_stop_load"), value("config_load_max")
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
-    if not rows or "P" not in rows[0] or "phi_alarm" not in rows[0]:
-        raise Failed(f"{path}: not the planner's table (P,phi0,phi_warning,...)")
     loads = [float(r["P"]) for r in rows]
     if min(loads) <= stop or max(loads) > top * (1 + 1e-6):
         raise Failed(f"{path}: loads {min(loads)} to {max(loads)} N, outside the configuration's "
                      f"stop load {stop} N to highest load {top} N: planned with another configuration")
+    margin = value("config_thresholds_on") == 1
+    w, a, d = value("config_warning"), value("config_alarm"), value("config_deadband")
+    sign = 1 if margin else -1
+    targets = {"phi_warning": (w, "config_warning"),
+               "phi_warning_clear": (w + sign * d, "config_warning " + "-+"[margin] + " config_deadband"),
+               "phi_alarm": (a, "config_alarm"),
+               "phi_alarm_clear": (a + sign * d, "config_alarm " + "-+"[margin] + " config_deadband")}
+    per_row = 1 + len(PLANNED)
+    for i, r in enumerate(rows):
+        at = answers[i * per_row:(i + 1) * per_row]
+        if any("near_model_switch" in x["flags"] or x["error"] for x in at):
+            continue
+        phi0 = float(at[0]["phi0"])
+        if abs(float(r["phi0"]) - phi0) > PLANNED_WITHIN * phi0:
+            raise Failed(f"{path}: at P = {r['P']} N phi0 is {r['phi0']} rad, the scene's is "
+                         f"{phi0:.6g} rad: planned for another scene")
+        for col, x in zip(PLANNED, at[1:]):
+            if r[col] == "":
+                continue
+            target, what = targets[col]
+            got = phi0 - float(r[col]) if margin else float(x["s"])
+            if abs(got - target) > PLANNED_WITHIN * (phi0 if margin else 1):
+                quantity = "the margin" if margin else "d/b"
+                raise Failed(f"{path}: at P = {r['P']} N, {col} = {r[col]} rad gives {quantity} "
+                             f"{got:.6g}, where the configuration's {what} is {target:.6g}: "
+                             f"planned with another configuration")
     alarms = [float(r["phi_alarm"]) for r in rows if r["phi_alarm"] != ""]
     at = f", alarm at {min(alarms):.4g} to {max(alarms):.4g} rad" if alarms else ""
     return f"thresholds planned for {min(loads):.4g} to {max(loads):.4g} N{at}"
@@ -399,8 +565,9 @@ def main():
     p.add_argument("--parity", choices=["E", "O", "N"], default="E",
                    help="the serial line's parity (default E: 8E1; N: 8N2, as Modbus asks)")
     p.add_argument("--unit", type=int, default=1)
-    p.add_argument("--registers", default="docs/modbus/registers.csv")
-    p.add_argument("--code", type=int, help="the site's code (without it: the status only)")
+    p.add_argument("--registers", default=REGISTERS,
+                   help="the register map (default: this repository's docs/modbus/registers.csv)")
+    p.add_argument("--code", help="the site's code (without it: the status only)")
     p.add_argument("--scene", help="the monitor example's scene file (R1,R2,G,nu,mu[,length])")
     p.add_argument("--core", choices=["f32", "fixed"], default="f32",
                    help="the node's core, for --scene (default f32)")
@@ -410,8 +577,9 @@ def main():
                    help="a configuration register (config_*, new_code, latching, external_mode) "
                         "and its value")
     p.add_argument("--reset-statistics", action="store_true",
-                   help="start the node's statistics afresh (needs --code)")
-    p.add_argument("--thresholds", help="the monitor example's --thresholds table, checked")
+                   help="start the node's statistics afresh (needs --code), once the rest is done")
+    p.add_argument("--thresholds", help="the monitor example's --thresholds table, checked "
+                                        "(needs --scene)")
     p.add_argument("--events", metavar="OUT.csv",
                    help="the events the node holds, as the monitor example's --events")
     p.add_argument("--events-from", type=int, metavar="SEQ",
@@ -419,55 +587,76 @@ def main():
     args = p.parse_args()
     if args.scene and args.prepared:
         p.error("--scene or --prepared, not both")
+    if not (args.tcp or args.serial):
+        p.error("--tcp HOST:PORT or --serial DEVICE")
+    if args.tcp:
+        host, _, port = args.tcp.rpartition(":")
+        if not host or not port.isdigit():
+            p.error(f"--tcp {args.tcp}: HOST:PORT")
+    # Everything checked before the node is touched: the map, every value against its
+    # register's type and domain, the code, the scene, the planner's table.
+    try:
+        regs = Map(args.registers)
+        settings = read_config(args.config) if args.config else []
+        for s in args.set:
+            name, eq, value = s.partition("=")
+            if not eq:
+                p.error(f"--set {s}: NAME=VALUE")
+            settings.append((name.strip(), value.strip()))
+        settings = settings_words(regs, settings)
+        code = None
+        if args.code is not None:
+            try:
+                code = regs.words("unlock", args.code)[0]
+            except Failed:
+                r = regs.row("unlock")
+                raise Failed(f"--code {args.code}: a site's code is a whole number from "
+                             f"{r['min']} to {r['max']}") from None
+        if code is None and (settings or args.scene or args.prepared or args.reset_statistics):
+            raise Failed("writing needs the site's code (--code)")
+        scene_row = read_scene(args.scene) if args.scene else None
+        if args.scene:
+            scene = prepare(scene_row, args.core)
+        else:
+            scene = open(args.prepared, "rb").read() if args.prepared else None
+        table = read_thresholds(args.thresholds, scene_row) if args.thresholds else None
+    except (Failed, OSError) as e:
+        print(f"commission: {e}", file=sys.stderr)
+        return 1
     from pymodbus import FramerType
     if args.serial:
         from pymodbus.client import ModbusSerialClient
         client = ModbusSerialClient(args.serial, framer=FramerType.RTU, baudrate=args.baud,
                                     parity=args.parity, stopbits=2 if args.parity == "N" else 1,
                                     timeout=2)
-    elif args.tcp:
-        from pymodbus.client import ModbusTcpClient
-        host, _, port = args.tcp.rpartition(":")
-        if not host or not port.isdigit():
-            p.error(f"--tcp {args.tcp}: HOST:PORT")
-        client = ModbusTcpClient(host, port=int(port), framer=FramerType.RTU, timeout=2, retries=0)
     else:
-        p.error("--tcp HOST:PORT or --serial DEVICE")
-    try:
-        settings = read_config(args.config) if args.config else []
-        for s in args.set:
-            name, eq, value = s.partition("=")
-            if not eq:
-                p.error(f"--set {s}: NAME=VALUE")
-            settings.append((register(name.strip()), value.strip()))
-        if args.scene:
-            scene = prepare(read_scene(args.scene), args.core)
-        else:
-            scene = open(args.prepared, "rb").read() if args.prepared else None
-    except (Failed, OSError) as e:
-        print(f"commission: {e}", file=sys.stderr)
-        return 1
+        from pymodbus.client import ModbusTcpClient
+        client = ModbusTcpClient(host, port=int(port), framer=FramerType.RTU, timeout=2, retries=0)
     if not client.connect():
         print("commission: cannot connect", file=sys.stderr)
         return 1
     try:
-        node = Node(client, args.registers, args.unit)
-        planned = check_thresholds(node, args.thresholds, settings) if args.thresholds else None
-        if args.code is not None:
-            source = commission(node, args.code, settings, scene, args.reset_statistics)
-        elif settings or scene or args.reset_statistics:
-            raise Failed("writing needs the site's code (--code)")
+        node = Node(client, regs, args.unit)
+        planned = check_thresholds(node, args.thresholds, table, settings) if table else None
+        if code is not None:
+            source = commission(node, code, settings, scene, args.reset_statistics)
         lines = status(node, args.events, args.events_from)
-    except Failed as e:
-        print(f"commission: {e}", file=sys.stderr)
+    except Exception as e:  # noqa: BLE001 (any failure: said, never a traceback)
+        why = str(e) if isinstance(e, Failed) else f"{type(e).__name__}: {e}"
+        print("commission: " + "; ".join([why, *getattr(e, "__notes__", [])]), file=sys.stderr)
         return 1
     finally:
         client.close()
     if args.reset_statistics:
         print("statistics reset")
-    if args.code is not None and (settings or scene):
-        print(f"commissioned: {len(settings)} registers{' and the scene' if scene else ''} "
+    switched = [n for n, _, _ in settings if n in SWITCHES]
+    staged = len(settings) - len(switched)
+    if code is not None and (staged or scene):
+        print(f"commissioned: {staged} registers{' and the scene' if scene else ''} "
               f"committed, config_source {source}")
+    if code is not None and switched:
+        print(f"switched: {', '.join(switched)} (applied at once and kept), "
+              f"config_source {source}")
     if planned:
         print(planned)
     for line in lines:

@@ -137,9 +137,12 @@ fn main() -> ! {
             }
         };
         let served = if fpu {
-            node::f32_core().map(|core| serve::node(core, serve::MODEL_F32, &mut uart, clock))
+            node::f32_core()
+                .map(|core| serve::node(core, serve::MODEL_F32, &mut uart, clock, &mut serve::Bare))
         } else {
-            node::fixed_core().map(|core| serve::node(core, serve::MODEL_FIXED, &mut uart, clock))
+            node::fixed_core().map(|core| {
+                serve::node(core, serve::MODEL_FIXED, &mut uart, clock, &mut serve::Bare)
+            })
         };
         match served {
             Ok(_) => support::exit(3),

@@ -1,13 +1,16 @@
 //! The Modbus node, written once for every board: `misalign::modbus::Server` over the
 //! monitor (framing, CRC, the register map, the event window), polled over any UART
 //! implementing the `embedded-io` 0.7 traits: the QEMU images' register-level drivers
-//! (`uart.rs`) and a real board's HAL (`nodes/pico`) alike.
+//! (`uart.rs`) and a real board's HAL (`nodes/pico`) alike. What a board adds (its own
+//! sensors sampled on its timer, sleeping between requests and samples, a watchdog)
+//! comes through [`Board`]; the QEMU images have none of it ([`Bare`]).
 
 use embedded_io::{ErrorType, Read, ReadReady, Write};
 use misalign::Estimator;
+use misalign::modbus::BootSource;
 use misalign::modbus::{Identification, PreparedScene, Server, ServerConfig};
 use misalign::monitor::scenario::Scenario;
-use misalign::monitor::{Config, Monitor};
+use misalign::monitor::{Config, Monitor, Sample};
 
 /// The node's model names (function 43/14): the core and the scene.
 pub const MODEL_F32: &str = "f32 core (float::Auto), the built-in scenario's scene";
@@ -28,18 +31,55 @@ pub struct LineClock<T: FnMut() -> u32> {
     pub per_ms: u32,
 }
 
+/// What a board adds to the node.
+pub trait Board {
+    /// Whether the board samples its own sensors ([`sample`](Self::sample)) instead of
+    /// monitoring the built-in scenario when it takes no external samples.
+    const SENSORS: bool;
+    /// The board's sample if one is due now (its own timer), read through its sensors'
+    /// drivers; `None` when none is due.
+    fn sample(&mut self) -> Option<Sample>;
+    /// Nothing to do for `wait` line ticks unless a byte comes: the board may sleep
+    /// until then, its next sample or a byte (`pending`, checked with interrupts
+    /// masked, says whether one came in meanwhile).
+    fn idle(&mut self, wait: u32, pending: &mut dyn FnMut() -> bool);
+    /// Once per pass of the loop: the node is alive (a board feeds its watchdog).
+    fn alive(&mut self);
+}
+
+/// A board with none of it: the QEMU images (busy polling, no sensors, no watchdog).
+pub struct Bare;
+
+impl Board for Bare {
+    const SENSORS: bool = false;
+    fn sample(&mut self) -> Option<Sample> {
+        None
+    }
+    fn idle(&mut self, _: u32, _: &mut dyn FnMut() -> bool) {}
+    fn alive(&mut self) {}
+}
+
 /// The Modbus node: a `misalign::modbus::Server` over the monitor of `core`
 /// (`model`: its name and the scene's, function 43/14's model name), answering on
 /// `uart` forever, told of the line's silences by `clock`. With its own samples
 /// (the default) it first monitors the whole built-in scenario, so that every register
 /// holds the end of the shift, the state a host replay of the same samples reaches;
-/// with external samples it starts fresh and monitors what a master writes. `None` if
-/// the monitor refuses its configuration.
-pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut() -> u32>(
+/// with external samples it starts fresh and monitors what a master writes. On a board
+/// with sensors ([`Board::SENSORS`]) it monitors the board's samples once a
+/// configuration was committed over the bus (the scene of the site; before that it
+/// serves only, to be commissioned), each monitored sample logged as a `sample` line.
+/// `None` if the monitor refuses its configuration.
+pub fn node<
+    E: Estimator + PreparedScene,
+    U: Read + ReadReady + Write,
+    T: FnMut() -> u32,
+    B: Board,
+>(
     core: E,
     model: &'static str,
     uart: &mut U,
     mut clock: LineClock<T>,
+    board: &mut B,
 ) -> Option<core::convert::Infallible> {
     let monitor = match Monitor::new(core, Config::default()) {
         Ok(m) => m,
@@ -82,7 +122,7 @@ pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut(
             server.monitor().statistics().samples()
         );
     }
-    if !EXTERNAL_SAMPLES {
+    if !EXTERNAL_SAMPLES && !B::SENSORS {
         // The scenario's samples not yet monitored (after a restored checkpoint, those
         // after it).
         let done = server.monitor().statistics().samples() as usize;
@@ -97,6 +137,8 @@ pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut(
         model,
         if EXTERNAL_SAMPLES {
             "the master"
+        } else if B::SENSORS {
+            "the board's sensors, once commissioned"
         } else {
             "the built-in scenario"
         },
@@ -111,6 +153,14 @@ pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut(
     let (mut ms, mut ticked) = (0u32, last_byte);
     let per_ms = clock.per_ms.max(1);
     loop {
+        board.alive();
+        if let Some(sample) = board.sample()
+            && !server.external_samples()
+            && server.config_source() == BootSource::Committed
+        {
+            server.process(sample);
+            log_sample(&sample);
+        }
         if server.poll(&mut uart).is_err() {
             // A framing, parity or overrun error: bytes lost, which the framer's CRC
             // and resynchronisation deal with; the master retries.
@@ -131,7 +181,43 @@ pub fn node<E: Estimator + PreparedScene, U: Read + ReadReady + Write, T: FnMut(
             server.idle();
             waiting = false;
         }
+        if !uart.uart.read_ready().unwrap_or(true) {
+            // Until the silence ends a frame, else at least once a second (the
+            // commissioning's clock).
+            let wait = if waiting {
+                clock
+                    .silence
+                    .saturating_sub(now.wrapping_sub(last_byte))
+                    .max(1)
+            } else {
+                per_ms.saturating_mul(1000)
+            };
+            board.idle(wait, &mut || uart.uart.read_ready().unwrap_or(true));
+        }
     }
+}
+
+/// One `sample` line: what the board's sensors delivered and the monitor took, every
+/// value as its bits (the emulator's harness writes them back as a trace, lab/pico):
+/// the time (ms), P and phi, whether a speed was measured and its bits, and the
+/// sensor fault (sensor index times 16 plus the fault kind's index; 255 none).
+fn log_sample(s: &Sample) {
+    let fault = s.sensor_fault.map_or(255u8, |f| {
+        let kind = misalign::monitor::FaultKind::ALL
+            .iter()
+            .position(|&k| k == f.kind)
+            .unwrap_or(15) as u8;
+        (f.sensor.index() as u8) << 4 | kind
+    });
+    defmt::println!(
+        "sample t={=u32} P={=u32} phi={=u32} measured={=bool} V={=u32} fault={=u8}",
+        s.time_ms,
+        s.load.to_bits(),
+        s.phi.to_bits(),
+        s.speed.is_some(),
+        s.speed.map_or(0, f32::to_bits),
+        fault
+    );
 }
 
 /// A UART that notes whether a read took a byte.

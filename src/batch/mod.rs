@@ -223,17 +223,66 @@ pub enum Model {
     Reference,
     /// The f32 core ([`crate::float::Auto`]); P and phi rounded to f32.
     F32,
-    /// The fixed-point core ([`crate::fixed::FixedAuto`]): P in counts of `load_lsb`
-    /// (N), phi in counts of `angle_lsb` (rad), each rounded to the nearest count; an
-    /// `angle_lsb` of `None` takes the finest angle the scene's tables allow
-    /// ([`FixedEllipticScene::min_angle_lsb`](crate::fixed::FixedEllipticScene::min_angle_lsb)),
-    /// and at least 1e-10 rad.
-    Fixed {
+    /// The fixed-point core ([`crate::fixed::FixedAuto`]), its inputs made integer
+    /// counts as [`Counts`] says.
+    Fixed(Counts),
+}
+
+/// How a row's P and phi become the fixed-point core's integer counts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Counts {
+    /// The core: each row in counts of an LSB that holds its P and its phi exactly (up
+    /// to 2^30 counts; angles no finer than the scene's tables allow,
+    /// [`FixedEllipticScene::min_angle_lsb`](crate::fixed::FixedEllipticScene::min_angle_lsb)),
+    /// [`exact_lsb`](crate::fixed::exact_lsb): the answer carries the core's own error
+    /// only. The scene is prepared for each row's LSBs.
+    Exact,
+    /// The node with its ADC: P in counts of `load_lsb` (N), phi in counts of
+    /// `angle_lsb` (rad), each rounded to the nearest count; an `angle_lsb` of `None`
+    /// takes the finest angle the scene's tables allow, and at least 1e-10 rad. The
+    /// answer carries the rounding too.
+    Adc {
         /// N per load count.
         load_lsb: f64,
         /// rad per angle count.
         angle_lsb: Option<f64>,
     },
+}
+
+/// Which of an ADC's LSBs a scene cannot be prepared with ([`adc_lsb_refused`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RefusedLsb {
+    /// The load LSB.
+    Load,
+    /// The angle LSB.
+    Angle,
+    /// Each alone is taken; not the two together.
+    Both,
+}
+
+/// Whether `scene` is refused by the fixed-point core because of the ADC's LSBs (not
+/// because of its own constants): it is prepared with them, then, where that fails,
+/// with a load LSB of 10 mN and the finest angle LSB its tables allow in their place.
+/// `None` when the LSBs are taken, or when the scene is refused with those too.
+pub fn adc_lsb_refused(
+    scene: &Scene,
+    choice: ModelChoice,
+    load_lsb: f64,
+    angle_lsb: Option<f64>,
+) -> Option<RefusedLsb> {
+    let prepares =
+        |load: f64, angle: Option<f64>| rows::prepare_fixed(scene, choice, load, angle).is_ok();
+    if prepares(load_lsb, angle_lsb) || !prepares(rows::ADC_LOAD_LSB, None) {
+        return None;
+    }
+    match (
+        prepares(load_lsb, None),
+        prepares(rows::ADC_LOAD_LSB, angle_lsb),
+    ) {
+        (false, true) => Some(RefusedLsb::Load),
+        (true, false) => Some(RefusedLsb::Angle),
+        _ => Some(RefusedLsb::Both),
+    }
 }
 
 /// A code of [`Outputs::regime`] and [`Outputs::model`] for a row without an answer.
@@ -511,9 +560,6 @@ pub fn estimate(
     Ok(match model {
         Model::Reference => rows::reference(inputs, outputs, n),
         Model::F32 => rows::float(inputs, outputs, n),
-        Model::Fixed {
-            load_lsb,
-            angle_lsb,
-        } => rows::fixed(inputs, outputs, n, load_lsb, angle_lsb),
+        Model::Fixed(counts) => rows::fixed(inputs, outputs, n, counts),
     })
 }

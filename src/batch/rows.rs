@@ -1,8 +1,8 @@
 //! The row loops of each model: a scene prepared once per run of rows with the same
 //! constants, then one estimate per row written into the output slices.
 
-use super::{Column, Inputs, NONE, OK, Outputs, flags, status_of};
-use crate::fixed::{FixedAuto, FixedEllipticScene};
+use super::{Column, Counts, Inputs, NONE, OK, Outputs, flags, status_of};
+use crate::fixed::{FixedAuto, FixedEllipticScene, exact_lsb};
 use crate::float::block::{BLOCK, Block};
 use crate::float::{Auto, AutoEstimate};
 use crate::reference::{self, ANGLE_LIMIT, ContactModel, ModelChoice, Regime, Validity};
@@ -598,25 +598,32 @@ fn float_rows(core: &Auto, out: &mut Outputs<'_>, n: usize, load: impl At, phi: 
 }
 
 /// A fixed-point scene with its LSBs (N and rad per count).
-struct FixedCore {
+pub(super) struct FixedCore {
     core: FixedAuto,
     load_lsb: f64,
     angle_lsb: f64,
 }
 
-fn prepare_fixed(
+/// The ADC's load LSB (N) where none is given: 10 mN, as the nodes.
+pub(super) const ADC_LOAD_LSB: f64 = 1e-2;
+
+/// The finest angle LSB (rad) the scene's tables allow, at least 1e-10 rad (where
+/// line contact answers, 1e-10 rad).
+fn finest_angle_lsb(scene: &Scene, choice: ModelChoice) -> f64 {
+    if scene.is_plane() || choice == ModelChoice::Line {
+        1e-10
+    } else {
+        libm::fmax(FixedEllipticScene::min_angle_lsb(scene), 1e-10)
+    }
+}
+
+pub(super) fn prepare_fixed(
     scene: &Scene,
     choice: ModelChoice,
     load_lsb: f64,
     angle_lsb: Option<f64>,
 ) -> Result<FixedCore, Error> {
-    let angle_lsb = angle_lsb.unwrap_or_else(|| {
-        if scene.is_plane() || choice == ModelChoice::Line {
-            1e-10
-        } else {
-            libm::fmax(FixedEllipticScene::min_angle_lsb(scene), 1e-10)
-        }
-    });
+    let angle_lsb = angle_lsb.unwrap_or_else(|| finest_angle_lsb(scene, choice));
     if !(load_lsb.is_finite() && load_lsb > 0.0 && angle_lsb.is_finite() && angle_lsb > 0.0) {
         return Err(Error::OutOfRange);
     }
@@ -627,8 +634,9 @@ fn prepare_fixed(
     })
 }
 
-#[inline]
-fn fixed_row(f: &FixedCore, load: f64, phi: f64) -> Result<Row, Error> {
+/// The sample's checks, as the reference makes them.
+#[inline(always)]
+fn fixed_sample(load: f64, phi: f64) -> Result<(), Error> {
     if !(load.is_finite() && load >= 0.0) {
         return Err(Error::Load);
     }
@@ -636,12 +644,25 @@ fn fixed_row(f: &FixedCore, load: f64, phi: f64) -> Result<Row, Error> {
     if phi.is_nan() || libm::fabs(phi) > core::f64::consts::FRAC_PI_2 {
         return Err(Error::Angle);
     }
+    Ok(())
+}
+
+#[inline]
+fn fixed_row(f: &FixedCore, load: f64, phi: f64) -> Result<Row, Error> {
+    fixed_sample(load, phi)?;
     let counts = libm::round(load / f.load_lsb);
     let angle = libm::round(phi / f.angle_lsb);
     if counts > u32::MAX as f64 || libm::fabs(angle) > i32::MAX as f64 {
         return Err(Error::OutOfRange);
     }
-    let e = f.core.estimate(counts as u32, angle as i32)?;
+    fixed_answer(&f.core, counts as u32, angle as i32, phi)
+}
+
+/// The core's answer at `counts` and `angle` counts as a row (`phi` the row's f64
+/// angle, for the flags).
+#[inline(always)]
+fn fixed_answer(core: &FixedAuto, counts: u32, angle: i32, phi: f64) -> Result<Row, Error> {
+    let e = core.estimate(counts, angle)?;
     let est = e.estimate;
     let critical = est.critical_angle.map(|c| c.to_f64());
     let force = est.axial_force.to_f64();
@@ -659,16 +680,56 @@ fn fixed_row(f: &FixedCore, load: f64, phi: f64) -> Result<Row, Error> {
     })
 }
 
-pub(super) fn fixed(
-    inputs: &Inputs<'_>,
-    out: &mut Outputs<'_>,
-    n: usize,
-    load_lsb: f64,
-    angle_lsb: Option<f64>,
-) -> usize {
-    by_scene(inputs, out, n, |s| {
-        prepare_fixed(s, inputs.choice, load_lsb, angle_lsb)
+/// A scene for [`Counts::Exact`]: prepared again for each row's LSBs, as the CSV
+/// estimator does.
+struct FixedExact {
+    scene: Scene,
+    choice: ModelChoice,
+    /// The finest angle LSB the tables allow (0 where only line contact answers).
+    min_angle_lsb: f64,
+}
+
+/// Counts up to 2^30 of an LSB that holds the value exactly.
+const EXACT_COUNTS: u32 = 1 << 30;
+
+fn prepare_exact(scene: &Scene, choice: ModelChoice) -> Result<FixedExact, Error> {
+    let min_angle_lsb = if scene.is_plane() || choice == ModelChoice::Line {
+        0.0
+    } else {
+        FixedEllipticScene::min_angle_lsb(scene)
+    };
+    Ok(FixedExact {
+        scene: *scene,
+        choice,
+        min_angle_lsb,
     })
+}
+
+impl Core for FixedExact {
+    fn row(&self, load: f64, phi: f64) -> Result<Row, Error> {
+        fixed_sample(load, phi)?;
+        let (load_lsb, counts) = exact_lsb(load, EXACT_COUNTS, 0.0);
+        let (angle_lsb, angle) = exact_lsb(phi, EXACT_COUNTS, self.min_angle_lsb);
+        let angle = i32::try_from(angle).map_err(|_| Error::Angle)?;
+        let angle = if phi < 0.0 { -angle } else { angle };
+        let core = FixedAuto::with_choice(&self.scene, load_lsb, angle_lsb, self.choice)?;
+        fixed_answer(&core, counts, angle, phi)
+    }
+    fn rows(&self, out: &mut Outputs<'_>, n: usize, load: impl At, phi: impl At) -> usize {
+        core_rows(self, out, n, load, phi)
+    }
+}
+
+pub(super) fn fixed(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize, counts: Counts) -> usize {
+    match counts {
+        Counts::Exact => by_scene(inputs, out, n, |s| prepare_exact(s, inputs.choice)),
+        Counts::Adc {
+            load_lsb,
+            angle_lsb,
+        } => by_scene(inputs, out, n, |s| {
+            prepare_fixed(s, inputs.choice, load_lsb, angle_lsb)
+        }),
+    }
 }
 
 impl Core for FixedCore {
@@ -677,15 +738,15 @@ impl Core for FixedCore {
         fixed_row(self, load, phi)
     }
     fn rows(&self, out: &mut Outputs<'_>, n: usize, load: impl At, phi: impl At) -> usize {
-        fixed_rows(self, out, n, load, phi)
+        core_rows(self, out, n, load, phi)
     }
 }
 
-/// The fixed-point core's rows of one prepared scene, written straight into the
+/// A core's rows of one prepared scene, one at a time, written straight into the
 /// output columns.
 #[inline(always)]
-fn fixed_rows(
-    core: &FixedCore,
+fn core_rows<C: Core>(
+    core: &C,
     out: &mut Outputs<'_>,
     n: usize,
     load: impl At,
@@ -697,7 +758,7 @@ fn fixed_rows(
     let mut bad = 0;
     let rows = s.iter_mut().zip(f).zip(c).zip(r).zip(m).zip(g).zip(t);
     for (i, ((((((s, f), c), r), m), g), t)) in rows.enumerate() {
-        let (refused, cells) = cells(fixed_row(core, load.at(i), phi.at(i)));
+        let (refused, cells) = cells(core.row(load.at(i), phi.at(i)));
         bad += refused;
         (*s, *f, *c, *r, *m, *g, *t) = cells;
     }

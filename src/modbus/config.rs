@@ -15,8 +15,9 @@
 //! millisecond counter (u32, wrapping). Without ticks no unlock expires and no lock-out
 //! ends, so an application calls it at least once a second.
 
-use super::AlarmSet;
+use super::div::div1000;
 use super::exception::Exception;
+use crate::monitor::annunciation::AlarmSet;
 use crate::monitor::{
     Config, ConfigError, FrictionConfig, Monitor, SpikeFilter, Thresholds, TrendConfig,
 };
@@ -849,7 +850,7 @@ impl<E: Estimator> Commissioning<E> {
 /// Whole seconds in `ms`, rounded up.
 #[inline(never)]
 fn seconds(ms: u32) -> u32 {
-    let s = super::values::div1000(ms);
+    let s = div1000(ms);
     s + u32::from(s.wrapping_mul(1000) != ms)
 }
 

@@ -8,17 +8,27 @@ use heapless::Deque;
 /// sample).
 pub const EVENT_WINDOW: usize = 8;
 
-/// Whether sequence number `a` is at or after `b` (modulo 2^32).
-pub(crate) fn at_or_after(a: u32, b: u32) -> bool {
-    a.wrapping_sub(b) < 1 << 31
-}
+/// Numbers a window can tell apart: at most 2^31 back from the next one (modulo 2^32,
+/// a number further back is also one ahead).
+const SPAN_MAX: u32 = 1 << 31;
 
 /// The window.
+///
+/// Sequence numbers count modulo 2^32, so that two numbers alone do not say which
+/// came first. Every comparison here is made by the distance back from the monitor's
+/// next number, within the numbers given so far ([`span`](Self::span): from `base`,
+/// the oldest the window knows of). A number never given, ahead of the next one or
+/// older than any given, has no place among them: as `event_from` it means "after
+/// the newest", and as `event_ack` it is refused.
 #[derive(Debug, Clone)]
 pub(crate) struct EventWindow {
     events: Deque<Event, EVENT_WINDOW>,
     /// The first sequence number a master wants (holding register `event_from`).
     pub from: u32,
+    /// The oldest number known to have been given: 0, where the monitor's numbering
+    /// starts, until a number before it (across a wrap) is seen; kept within
+    /// [`SPAN_MAX`] of the next number.
+    base: u32,
     /// Events dropped from the full window before the master read them.
     pub dropped: u32,
     /// Store-and-forward: the application hands the events in, and the window never
@@ -31,23 +41,91 @@ pub(crate) struct EventWindow {
 }
 
 impl EventWindow {
-    pub(crate) const fn new(from: u32) -> Self {
-        EventWindow {
+    /// The window of a monitor whose next event is `next`, its events from `from`
+    /// (its queued events) still to come.
+    pub(crate) fn new(from: u32, next: u32) -> Self {
+        let mut w = EventWindow {
             events: Deque::new(),
             from,
+            base: 0,
             dropped: 0,
             stored: false,
             backlog: None,
+        };
+        w.know(from, next);
+        w
+    }
+
+    /// How many numbers before `next` were given, as far as the window can tell (at
+    /// most [`SPAN_MAX`] once `base` followed `next`).
+    fn span(&self, next: u32) -> u32 {
+        next.wrapping_sub(self.base)
+    }
+
+    /// `base` follows `next` within [`SPAN_MAX`]: called whenever new events came.
+    pub(crate) fn follow(&mut self, next: u32) {
+        if self.span(next) > SPAN_MAX {
+            self.base = next.wrapping_sub(SPAN_MAX);
+        }
+    }
+
+    /// Whether `seq` was given before `next` (an event was numbered so): at most
+    /// [`span`](Self::span) numbers back from `next`.
+    pub(crate) fn given(&self, seq: u32, next: u32) -> bool {
+        next.wrapping_sub(seq).wrapping_sub(1) < self.span(next)
+    }
+
+    /// `seq` was given, or is `next`: the window's numbers reach back to it (a number
+    /// from before a wrap, restored at start-up); and `base` follows `next` within
+    /// [`SPAN_MAX`]. Called whenever `next` may have moved.
+    pub(crate) fn know(&mut self, seq: u32, next: u32) {
+        if next.wrapping_sub(seq) > self.span(next) {
+            self.base = seq;
+        }
+        self.follow(next);
+    }
+
+    /// Whether `event_from` is a number given, or `next`: a place among the numbers.
+    fn event_from_placed(&self, next: u32) -> bool {
+        next.wrapping_sub(self.from) <= self.span(next)
+    }
+
+    /// How many numbers from `event_from` up to `next` are to be read: none for an
+    /// `event_from` never given (it means "after the newest").
+    fn unread_span(&self, next: u32) -> u32 {
+        if self.event_from_placed(next) {
+            next.wrapping_sub(self.from)
+        } else {
+            0
+        }
+    }
+
+    /// Whether `seq` is at or after `event_from` and before `next` (to be read), given
+    /// the window's [`unread_span`](Self::unread_span).
+    fn unread_in(&self, seq: u32, unread_span: u32) -> bool {
+        seq.wrapping_sub(self.from) < unread_span
+    }
+
+    /// Whether `seq` is to be read.
+    fn unread(&self, seq: u32, next: u32) -> bool {
+        self.unread_in(seq, self.unread_span(next))
+    }
+
+    /// A master acknowledged the events through `seq` (a number given): `event_from`
+    /// moves past it if it was at or before it.
+    pub(crate) fn acknowledge(&mut self, seq: u32, next: u32) {
+        if self.unread(seq, next) {
+            self.from = seq.wrapping_add(1);
         }
     }
 
     /// Whether an event fits without dropping one the master has not read.
-    pub(crate) fn has_room(&self) -> bool {
+    pub(crate) fn has_room(&self, next: u32) -> bool {
         !self.events.is_full()
             || self
                 .events
                 .front()
-                .is_some_and(|e| !at_or_after(e.seq, self.from))
+                .is_some_and(|e| !self.unread(e.seq, next))
     }
 
     /// Store-and-forward: takes `event` if it is the next the window wants and fits
@@ -57,9 +135,11 @@ impl EventWindow {
     /// missed). An event that does not fit stays in the store only: the window wants
     /// it later. `next` is the next event's number.
     pub(crate) fn offer(&mut self, event: Event, next: u32, from_store: bool) -> bool {
+        self.know(event.seq, next);
         if let Some(b) = self.backlog {
             let wanted = if from_store {
-                at_or_after(event.seq, b)
+                // As far back from `next` as `b` or less: at or after it.
+                next.wrapping_sub(event.seq) <= next.wrapping_sub(b)
             } else {
                 event.seq == b
             };
@@ -67,22 +147,23 @@ impl EventWindow {
                 return false;
             }
         }
-        if !self.has_room() {
+        if !self.has_room(next) {
             self.backlog.get_or_insert(event.seq);
             return false;
         }
-        self.push(event);
+        self.push(event, next);
         let after = event.seq.wrapping_add(1);
         self.backlog = self.backlog.map(|_| after).filter(|&b| b != next);
         true
     }
 
     /// Keeps `event`; a full window drops its oldest, counted when the master had
-    /// not read it yet.
-    pub(crate) fn push(&mut self, event: Event) {
+    /// not read it yet. `next` is the next event's number, which `base` has followed
+    /// ([`follow`](Self::follow)).
+    pub(crate) fn push(&mut self, event: Event, next: u32) {
         if self.events.is_full()
             && let Some(old) = self.events.pop_front()
-            && at_or_after(old.seq, self.from)
+            && self.unread(old.seq, next)
         {
             self.dropped = self.dropped.saturating_add(1);
         }
@@ -94,12 +175,13 @@ impl EventWindow {
     /// window every register of it takes, over the deque's two slices in order (a
     /// smaller loop on a Cortex-M0 than the deque's chained iterator).
     #[inline(never)]
-    pub(crate) fn slot(&self, i: u16) -> Option<&Event> {
+    pub(crate) fn slot(&self, i: u16, next: u32) -> Option<&Event> {
         let (older, newer) = self.events.as_slices();
+        let unread = self.unread_span(next);
         let mut left = i;
         for part in [older, newer] {
             for e in part {
-                if at_or_after(e.seq, self.from) {
+                if self.unread_in(e.seq, unread) {
                     if left == 0 {
                         return Some(e);
                     }
@@ -111,24 +193,23 @@ impl EventWindow {
     }
 
     /// The events in the slots (at most `slots`).
-    pub(crate) fn unread(&self, slots: u16) -> u16 {
+    pub(crate) fn count(&self, slots: u16, next: u32) -> u16 {
         (0..slots)
-            .position(|i| self.slot(i).is_none())
+            .position(|i| self.slot(i, next).is_none())
             .map_or(slots, |n| n as u16)
     }
 
     /// The sequence number of slot 0: the first event held at or after `from`, or
     /// `next` (the next event's) when none is.
     pub(crate) fn first(&self, next: u32) -> u32 {
-        self.slot(0).map_or(next, |e| e.seq)
+        self.slot(0, next).map_or(next, |e| e.seq)
     }
 
-    /// Events from `from` to slot 0 that are lost; `next` is the next event's
-    /// sequence number.
+    /// Events from `from` to slot 0 that are lost (none from a number never given);
+    /// `next` is the next event's sequence number.
     pub(crate) fn missed(&self, next: u32) -> u32 {
-        let first = self.first(next);
-        if at_or_after(first, self.from) && at_or_after(next, self.from) {
-            first.wrapping_sub(self.from)
+        if self.event_from_placed(next) {
+            self.first(next).wrapping_sub(self.from)
         } else {
             0
         }
@@ -163,8 +244,12 @@ mod tests {
     use std::vec::Vec;
 
     /// With the window wrapped round its storage at every offset (events pushed past
-    /// its capacity) and `from` before, inside and after it, each slot is the event
-    /// that filtering the window's events in order gives, and none past them.
+    /// its capacity), the monitor's numbers from 0, from just below 2^31 and from
+    /// just below 2^32 (wrapping), and `from` before, inside and after the window,
+    /// given or never given: each slot is the next event at or after `from` in order,
+    /// none past them, and the gap before slot 0 is counted as missed. A `from` never
+    /// given (ahead of the next number, before 0, half the number space away) shows
+    /// nothing and misses nothing.
     #[test]
     fn slots_are_the_unread_events_in_order() {
         let event = |seq| Event {
@@ -176,33 +261,48 @@ mod tests {
             },
             reading: Reading::default(),
         };
-        for pushed in 0..3 * EVENT_WINDOW as u32 {
-            let mut w = EventWindow::new(0);
-            for seq in 0..pushed {
-                w.push(event(seq));
-            }
-            for from in 0..pushed + 2 {
-                w.from = from;
-                let unread: Vec<u32> = w
-                    .events
-                    .iter()
-                    .map(|e| e.seq)
-                    .filter(|&s| at_or_after(s, from))
-                    .collect();
-                for i in 0..EVENT_WINDOW as u16 + 2 {
-                    let slot = w.slot(i).map(|e| e.seq);
-                    assert_eq!(
-                        slot,
-                        unread.get(usize::from(i)).copied(),
-                        "{pushed} {from} {i}"
-                    );
+        let window = EVENT_WINDOW as i64;
+        for start in [0u32, 0x7FFF_FFF0, u32::MAX - 10] {
+            for pushed in 0..3 * window {
+                let next = start.wrapping_add(pushed as u32);
+                let mut w = EventWindow::new(start, start);
+                // As the server does after each sample: `base` follows, then the
+                // new event.
+                for k in 0..pushed {
+                    let after = start.wrapping_add(k as u32 + 1);
+                    w.follow(after);
+                    w.push(event(start.wrapping_add(k as u32)), after);
                 }
-                let slots = crate::modbus::map::EVENT_SLOTS;
-                assert_eq!(
-                    usize::from(w.unread(slots)),
-                    unread.len().min(usize::from(slots))
-                );
-                assert_eq!(w.first(pushed), unread.first().copied().unwrap_or(pushed));
+                // The window holds the last EVENT_WINDOW, from offset `held`.
+                let held = (pushed - window).max(0);
+                for d in (-3..pushed + 2).chain([1 << 31, 0x9000_0000]) {
+                    w.from = start.wrapping_add(d as u32);
+                    // Given: among the numbers from 0 up to the next one, at most 2^31
+                    // back; unread from its place on.
+                    let next_abs = i64::from(start) + pushed;
+                    let back = i64::from(next.wrapping_sub(w.from));
+                    let given = back >= 1 && back <= next_abs.min(1 << 31);
+                    let d = pushed - back;
+                    let unread: Vec<u32> = (held.max(d)..pushed)
+                        .filter(|_| given)
+                        .map(|k| start.wrapping_add(k as u32))
+                        .collect();
+                    let at = format!("{start:#x} {pushed} {:#x}", w.from);
+                    for i in 0..EVENT_WINDOW as u16 + 2 {
+                        let slot = w.slot(i, next).map(|e| e.seq);
+                        assert_eq!(slot, unread.get(usize::from(i)).copied(), "{at} {i}");
+                    }
+                    let slots = crate::modbus::map::EVENT_SLOTS;
+                    let count = unread.len().min(usize::from(slots));
+                    assert_eq!(usize::from(w.count(slots, next)), count, "{at}");
+                    assert_eq!(
+                        w.first(next),
+                        unread.first().copied().unwrap_or(next),
+                        "{at}"
+                    );
+                    let missed = if given { held.max(d) - d } else { 0 };
+                    assert_eq!(i64::from(w.missed(next)), missed, "{at}");
+                }
             }
         }
     }

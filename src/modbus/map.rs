@@ -7,6 +7,7 @@
 //! samples). A 32-bit value takes two registers, the high word first.
 
 use super::config::{ConfigField, Reg};
+use super::div::div_rem;
 use crate::monitor::annunciation::AlarmSet;
 use core::fmt;
 
@@ -90,6 +91,56 @@ impl Access {
             Access::R => "r",
             Access::Rw => "rw",
         }
+    }
+}
+
+/// The values a master may write to an entry, in the register's unit (the CSV's
+/// `min` and `max`, inclusive): a value outside them is refused, at the write
+/// (exception 03: a switch, a command, a sample's flags) or at the commit (a staged
+/// configuration value: `commit_error`, and an option that is off ignores its
+/// values). Inside them a value is not always taken: the commit validates the
+/// configuration whole (`Config::validate`: a d/b threshold positive, the warning
+/// before the alarm, a spike window of 0 or 3 to 7, ...).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Domain {
+    /// Read only: no master writes it (the CSV's `min` and `max` empty).
+    ReadOnly,
+    /// Any value of the type, for an `f32` NaN and the infinities too (a sample's
+    /// value: counted as a sensor fault); empty `min` and `max`.
+    Any,
+    /// A whole number from `min` to `max`.
+    Whole {
+        /// The least.
+        min: u32,
+        /// The greatest.
+        max: u32,
+    },
+    /// A finite number (never NaN or infinite) from `min` to `max`.
+    Finite {
+        /// The least.
+        min: f32,
+        /// The greatest.
+        max: f32,
+    },
+}
+
+impl Domain {
+    /// Every value of an unsigned type of `words` registers.
+    const fn unsigned(words: u16) -> Domain {
+        Domain::Whole {
+            min: 0,
+            max: if words == 2 { u32::MAX } else { 0xFFFF },
+        }
+    }
+
+    /// From 0 to `max`.
+    const fn up_to(max: u32) -> Domain {
+        Domain::Whole { min: 0, max }
+    }
+
+    /// Any finite f32 at or above `min`.
+    const fn from(min: f32) -> Domain {
+        Domain::Finite { min, max: f32::MAX }
     }
 }
 
@@ -226,6 +277,70 @@ impl Entry {
     /// The address after the value.
     pub const fn end(&self) -> u16 {
         self.address.saturating_add(self.ty.words())
+    }
+
+    /// The values a master may write ([`Domain`]).
+    pub fn domain(&self) -> Domain {
+        use crate::monitor::{SPIKE_WINDOW_CAPACITY, TREND_CAPACITY};
+        let any = match self.ty {
+            Type::U16 | Type::U32 => Domain::unsigned(self.ty.words()),
+            Type::I16 | Type::I32 | Type::F32 => Domain::Any,
+        };
+        if self.access == Access::R {
+            return Domain::ReadOnly;
+        }
+        let bit = Domain::up_to(1);
+        let alarms = Domain::up_to(u32::from(AlarmSet::ALL.bits()));
+        let finite = Domain::Finite {
+            min: -f32::MAX,
+            max: f32::MAX,
+        };
+        match self.field {
+            // A coil: off or on.
+            F::Acknowledge | F::Latching(_) | F::ExternalSamples => bit,
+            F::AcknowledgeAlarms | F::LatchingAlarms => alarms,
+            F::ExternalMode => bit,
+            F::Commission(Reg::Command) => Domain::Whole {
+                min: u32::from(super::config::command::COMMIT),
+                max: u32::from(super::config::command::RESET_STATISTICS),
+            },
+            F::Sample(SampleField::Flags) => Domain::up_to(3),
+            F::Staged(f) => match f {
+                G::ThresholdsOn | G::Friction => bit,
+                G::SpikeWindow => Domain::up_to(SPIKE_WINDOW_CAPACITY as u32),
+                G::TrendPoints => Domain::up_to(TREND_CAPACITY as u32),
+                // Thresholds on the margin may be negative; on d/b the commit asks
+                // them positive.
+                G::Warning | G::Alarm | G::LoadMin | G::LoadMax => finite,
+                G::Deadband
+                | G::StopLoad
+                | G::StopSpeed
+                | G::NominalSpeed
+                | G::AngleMax
+                | G::SpeedMax
+                | G::ForceMax
+                | G::SpikeK
+                | G::SpikeLoadFloor
+                | G::SpikeAngleFloor
+                | G::SmoothingTau
+                | G::TrendHorizon
+                | G::FrictionSensitivity
+                | G::FrictionTau
+                | G::FrictionBand
+                | G::FrictionDeadband => Domain::from(0.0),
+                G::OnDelay
+                | G::OffDelay
+                | G::FaultDelay
+                | G::Inhibit
+                | G::Stuck
+                | G::Gap
+                | G::TrendInterval
+                | G::FrictionBaselineAfter
+                | G::FrictionBaselineEstimates
+                | G::FrictionDelay => any,
+            },
+            _ => any,
+        }
     }
 }
 
@@ -1023,25 +1138,19 @@ impl Served {
     }
 }
 
-/// `n / d` and `n % d` (`None` for `d` 0) by shifts and subtractions, 16 steps: no
-/// division routine linked into a node without a divider (the Cortex-M0), for the few
-/// divisions by a block's stride, none of them on a poll's path. Out of line: one
-/// copy for its three callers.
-#[inline(never)]
-pub(crate) fn div_rem(n: u16, d: u16) -> Option<(u16, u16)> {
-    if d == 0 {
-        return None;
-    }
-    let (mut q, mut r) = (0u16, 0u32);
-    for i in (0..16).rev() {
-        r = r << 1 | u32::from(n >> i & 1);
-        q <<= 1;
-        if r >= u32::from(d) {
-            r -= u32::from(d);
-            q |= 1;
+/// A bound of a [`Domain::Finite`] as the CSV writes it: a whole number as such, the
+/// largest f32 in the shortest exponent form that reads back to it.
+struct Bound(f32);
+
+impl fmt::Display for Bound {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let whole = self.0 as i32;
+        if whole as f32 == self.0 && -1e9 < self.0 && self.0 < 1e9 {
+            write!(f, "{whole}")
+        } else {
+            write!(f, "{:e}", self.0)
         }
     }
-    Some((q, r as u16))
 }
 
 /// An address located in the map.
@@ -1057,27 +1166,37 @@ pub(crate) struct Located {
 }
 
 /// Writes the map as CSV with the header
-/// `table,address,name,type,scale,unit,access,description`: one row per value, a
-/// block's records expanded (`event_0_seq`, ...). `docs/modbus/registers.csv` is this
+/// `table,address,name,type,scale,unit,access,description,min,max`: one row per value,
+/// a block's records expanded (`event_0_seq`, ...); `min` and `max` the values a
+/// master may write ([`Entry::domain`]; empty for a read-only value, and for an `f32`
+/// that takes any value). `docs/modbus/registers.csv` is this
 /// output (`cargo run --example modbus_registers --features modbus > docs/modbus/registers.csv`).
 pub fn registers_csv(out: &mut impl fmt::Write) -> fmt::Result {
-    writeln!(out, "table,address,name,type,scale,unit,access,description")?;
+    writeln!(
+        out,
+        "table,address,name,type,scale,unit,access,description,min,max"
+    )?;
     let row = |out: &mut dyn fmt::Write, e: &Entry, address: u16, prefix: Option<(&str, u16)>| {
         write!(out, "{},{},", e.table.as_str(), address)?;
         if let Some((p, i)) = prefix {
             write!(out, "{p}_{i}_")?;
         }
         // Descriptions hold commas: quoted, as CSV quotes (they hold no quote).
-        writeln!(
+        write!(
             out,
-            "{},{},{},{},{},\"{}\"",
+            "{},{},{},{},{},\"{}\",",
             e.name,
             e.ty.as_str(),
             e.scale,
             e.unit,
             e.access.as_str(),
             e.description
-        )
+        )?;
+        match e.domain() {
+            Domain::ReadOnly | Domain::Any => writeln!(out, ","),
+            Domain::Whole { min, max } => writeln!(out, "{min},{max}"),
+            Domain::Finite { min, max } => writeln!(out, "{},{}", Bound(min), Bound(max)),
+        }
     };
     for table in MAP {
         for e in table.entries {
@@ -1165,31 +1284,6 @@ mod tests {
                 );
                 let slots: std::vec::Vec<Slot> = b.fields.iter().map(Slot::of).collect();
                 assert_eq!(sb.fields, &slots[..], "{}", b.prefix);
-            }
-        }
-    }
-
-    #[test]
-    fn div_rem_is_division() {
-        for n in 0..=u16::MAX {
-            for d in [
-                0,
-                1,
-                2,
-                3,
-                6,
-                7,
-                11,
-                25,
-                255,
-                256,
-                1000,
-                0x7FFF,
-                0x8000,
-                u16::MAX,
-            ] {
-                let expected = n.checked_div(d).zip(n.checked_rem(d));
-                assert_eq!(div_rem(n, d), expected, "{n} {d}");
             }
         }
     }

@@ -92,6 +92,7 @@
 
 mod config;
 mod crc;
+mod div;
 mod events;
 mod exception;
 mod ident;
@@ -100,6 +101,7 @@ mod io;
 pub mod map;
 mod pdu;
 pub mod rtu;
+mod state;
 mod values;
 
 pub use crate::monitor::annunciation::{AlarmSet, Annunciator};
@@ -114,7 +116,8 @@ pub use exception::Exception;
 pub use ident::Identification;
 pub use map::registers_csv;
 pub use rtu::{ADU_MAX, FramingCounters};
-pub use values::{DecodeError, event_from_registers, fault_code, fault_from_code};
+pub use state::Counters;
+pub use values::{DecodeError, NONE, event_from_registers, fault_code, fault_from_code};
 
 use crate::monitor::{Event, Monitor, MonitorState, RiskState, Sample};
 use crate::{Estimator, FrictionInverse};
@@ -122,10 +125,7 @@ use config::Commissioning;
 use core::fmt;
 use events::EventWindow;
 use rtu::Framer;
-
-/// What a register holds for a value that is not there (no reading yet, no critical
-/// angle at this load, no time to critical): the quiet NaN, `0x7FC0_0000`.
-pub const NONE: u32 = 0x7FC0_0000;
+use state::{Core, Step};
 
 /// The default unit id.
 pub const DEFAULT_UNIT_ID: u8 = 1;
@@ -190,62 +190,12 @@ impl fmt::Display for ServerConfigError {
 
 impl core::error::Error for ServerConfigError {}
 
-/// What the server has counted (besides the monitor's own statistics).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Counters {
-    /// The framer's counts: frames with a valid CRC, bytes discarded.
-    pub framing: FramingCounters,
-    /// Requests for this unit or broadcast.
-    pub server_messages: u32,
-    /// Exception responses sent.
-    pub exceptions: u32,
-    /// Responses replaced by the answer to a later request before they were sent.
-    pub responses_overwritten: u32,
-    /// External samples taken from the bus and processed.
-    pub external_accepted: u32,
-    /// Writes of external samples refused (none of their samples processed).
-    pub external_refused: u32,
-}
-
-/// How a sample reaches the monitor: `Monitor::process`, or
-/// `Monitor::process_with_friction` (f32 scenes).
-type Step<E> = fn(&mut Monitor<E>, Sample) -> RiskState;
-
 /// The Modbus RTU server: the monitor, the register map's state, the framer.
 #[derive(Debug, Clone)]
 #[repr(C)]
 pub struct Server<E> {
     framer: Framer,
     core: Core<E>,
-}
-
-/// Everything but the framer (whose buffer holds the request being answered).
-/// `repr(C)`: what every request touches first, the buffers and the monitor after.
-#[derive(Debug, Clone)]
-#[repr(C)]
-struct Core<E> {
-    /// The response's length; 0: none due.
-    response_len: usize,
-    /// The response waits for the application's storage ([`Server::stored`]).
-    held: bool,
-    unit: u8,
-    step: Step<E>,
-    ident: Identification,
-    model_name: &'static str,
-    annunciator: Annunciator,
-    events: EventWindow,
-    external: bool,
-    /// The last sample's own timestamp.
-    last_time_ms: u32,
-    counters: Counters,
-    /// The last acknowledgement a master wrote (`event_ack`).
-    ack: Option<u32>,
-    storage: StorageStatus,
-    response: [u8; ADU_MAX],
-    monitor: Monitor<E>,
-    /// The staged configuration, the unlock, the commits.
-    commissioning: Commissioning<E>,
 }
 
 impl<E: Estimator> Server<E> {
@@ -267,7 +217,8 @@ impl<E: Estimator> Server<E> {
             return Err(ServerConfigError::UnitId);
         }
         let pending = monitor.pending_events() as u32;
-        let from = monitor.next_event_seq().wrapping_sub(pending);
+        let monitor_next = monitor.next_event_seq();
+        let from = monitor_next.wrapping_sub(pending);
         let model_name = if config.ident.model_name.is_empty() {
             core::any::type_name::<E>()
         } else {
@@ -283,7 +234,7 @@ impl<E: Estimator> Server<E> {
                 ident: config.ident,
                 model_name,
                 annunciator: Annunciator::new(config.latching),
-                events: EventWindow::new(from),
+                events: EventWindow::new(from, monitor_next),
                 external: config.external_samples,
                 last_time_ms: 0,
                 counters: Counters::default(),
@@ -469,6 +420,8 @@ impl<E: Estimator> Server<E> {
     /// start the conditioning and the trend afresh.
     pub fn resume(&mut self, state: &MonitorState) {
         self.core.monitor.resume(state);
+        let next = self.core.monitor.next_event_seq();
+        self.core.events.follow(next);
     }
 
     /// The monitor back, the server given up.
@@ -489,6 +442,7 @@ impl<E: Estimator> Server<E> {
         let w = &mut self.core.events;
         w.stored = true;
         if let Some(f) = first {
+            w.know(f, next);
             w.from = f;
             w.backlog = Some(f).filter(|&f| f != next);
         }
@@ -519,7 +473,8 @@ impl<E: Estimator> Server<E> {
     /// holds none at or after it, call [`end_backlog`](Self::end_backlog).
     pub fn wanted_event(&self) -> Option<u32> {
         let w = &self.core.events;
-        w.backlog.filter(|_| w.has_room())
+        let next = self.core.monitor.next_event_seq();
+        w.backlog.filter(|_| w.has_room(next))
     }
 
     /// Store-and-forward: an event read from the store, the first at or after
@@ -574,25 +529,5 @@ impl<E: Estimator + FrictionInverse> Server<E> {
         config: ServerConfig,
     ) -> Result<Self, ServerConfigError> {
         Self::with_step(monitor, config, Monitor::process_with_friction)
-    }
-}
-
-impl<E: Estimator> Core<E> {
-    fn process(&mut self, sample: Sample) -> RiskState {
-        let state = (self.step)(&mut self.monitor, sample);
-        self.last_time_ms = sample.time_ms;
-        self.drain();
-        state
-    }
-
-    /// The monitor's queued events into the window (unless the application takes
-    /// them: [`Server::store_events`]); the alarms from its state.
-    fn drain(&mut self) {
-        while !self.events.stored
-            && let Some(e) = self.monitor.pop_event()
-        {
-            self.events.push(e);
-        }
-        self.annunciator.update(AlarmSet::of(&self.monitor));
     }
 }

@@ -3,10 +3,14 @@
 //! exceptions, broadcasts.
 
 use super::config::{ConfigField, Reg};
+use super::div::div_rem;
 use super::exception::Exception;
-use super::map::{Access, Field, Located, Served, SlotBlock, Table, div_rem};
-use super::{ADU_MAX, Core, crc, ident};
+use super::map::{Access, Field, Located, Served, SlotBlock, Table};
+use super::rtu::ADU_MAX;
+use super::state::Core;
+use super::{crc, ident};
 use crate::Estimator;
+use crate::monitor::annunciation::AlarmSet;
 
 /// Most bits one read returns.
 const READ_BITS_MAX: u16 = 2000;
@@ -543,10 +547,7 @@ impl<E: Estimator> Core<E> {
             Field::EventFrom => true,
             // Only numbers already given: a later one would acknowledge an event not
             // yet raised.
-            Field::EventAck => {
-                let newest = self.monitor.next_event_seq().wrapping_sub(1);
-                super::events::at_or_after(newest, v)
-            }
+            Field::EventAck => self.events.given(v, self.monitor.next_event_seq()),
             Field::Commission(Reg::Unlock | Reg::Command) if !alone => {
                 return Err(Exception::IllegalDataAddress);
             }
@@ -571,7 +572,7 @@ impl<E: Estimator> Core<E> {
         // Guarded by the caller (`protected_bit`).
         let latching = self.annunciator.latching();
         match field {
-            Field::Acknowledge if on => self.annunciator.acknowledge(super::AlarmSet::ALL),
+            Field::Acknowledge if on => self.annunciator.acknowledge(AlarmSet::ALL),
             Field::Latching(which) => self.switch(latching.with(which, on), self.external),
             Field::ExternalSamples => self.switch(latching, on),
             _ => {}
@@ -580,7 +581,7 @@ impl<E: Estimator> Core<E> {
 
     /// Latching and the samples' source set (the guard passed); a change is kept as a
     /// commit is (`Server::take_committed`), a write of the same values stores nothing.
-    fn switch(&mut self, latching: super::AlarmSet, external: bool) {
+    fn switch(&mut self, latching: AlarmSet, external: bool) {
         if (latching, external) != (self.annunciator.latching(), self.external) {
             self.annunciator.set_latching(latching);
             self.external = external;
@@ -589,15 +590,13 @@ impl<E: Estimator> Core<E> {
     }
 
     fn write_word(&mut self, field: Field, v: u32) -> Result<(), Exception> {
-        let bits = super::AlarmSet::from_bits(v as u8);
+        let bits = AlarmSet::from_bits(v as u8);
         let c = &mut self.commissioning;
         match field {
             Field::EventFrom => self.events.from = v,
             Field::EventAck => {
                 self.ack = Some(v);
-                if super::events::at_or_after(v, self.events.from) {
-                    self.events.from = v.wrapping_add(1);
-                }
+                self.events.acknowledge(v, self.monitor.next_event_seq());
             }
             Field::AcknowledgeAlarms => self.annunciator.acknowledge(bits),
             Field::LatchingAlarms => self.switch(bits, self.external),
@@ -605,7 +604,14 @@ impl<E: Estimator> Core<E> {
             Field::Staged(f) => c.write_staged(f, v, self.monitor.config()),
             Field::Commission(Reg::NewCode) => c.write_new_code(v as u16),
             Field::Commission(Reg::Unlock) => c.unlock(v as u16)?,
-            Field::Commission(Reg::Command) => c.command(v as u16, &mut self.monitor)?,
+            Field::Commission(Reg::Command) => {
+                c.command(v as u16, &mut self.monitor)?;
+                // The events lost count with the statistics (`events_dropped`): the
+                // window's share starts afresh with the monitor's.
+                if v == u32::from(super::config::command::RESET_STATISTICS) {
+                    self.events.dropped = 0;
+                }
+            }
             _ => {}
         }
         Ok(())
@@ -650,7 +656,7 @@ mod tests {
     fn every_read_of_bits_is_each_bits_value() {
         let config = ServerConfig {
             external_samples: true,
-            latching: super::super::AlarmSet::ALARM,
+            latching: super::AlarmSet::ALARM,
             ..ServerConfig::default()
         };
         let mut server = server(config);

@@ -2,24 +2,22 @@
 //! states, event kinds and faults; external sample records decoded; and the decoding
 //! of an event slot for a master written in Rust.
 
+use super::div::div1000;
 use super::map::{EventField, Field, SlotBlock};
-use super::{AlarmSet, Core, NONE};
+use super::state::{Core, Counters};
 use crate::Estimator;
+use crate::monitor::annunciation::AlarmSet;
 use crate::monitor::{Channel, Event, EventKind, FaultCause, Reading, RiskState, Sample};
 use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 use core::fmt;
 
+/// What a register holds for a value that is not there (no reading yet, no critical
+/// angle at this load, no time to critical): the quiet NaN, `0x7FC0_0000`.
+pub const NONE: u32 = 0x7FC0_0000;
+
 /// The bits of an optional f32: [`NONE`] for none.
 fn opt(x: Option<f32>) -> u32 {
     x.map_or(NONE, f32::to_bits)
-}
-
-/// `x / 1000` for every u32, by a multiplication: `x` times 2^41 / 1000 rounded up
-/// (2199023256, 448 / 1000 above it: less than 2^(41 - 32) / 1000, so exact for every
-/// 32-bit `x`, Granlund and Montgomery's bound), shifted down 41 bits. No division
-/// routine is linked into a node without a divider (the Cortex-M0).
-pub(crate) fn div1000(x: u32) -> u32 {
-    ((u64::from(x) * 2_199_023_256) >> 41) as u32
 }
 
 /// Whole seconds in `ms` (saturated at `u32::MAX`) and the milliseconds left over, by
@@ -333,7 +331,7 @@ impl<E: Estimator> Core<E> {
             Field::Indicated(w) => bit(a.indicated(), w),
             Field::Unacknowledged(w) => bit(a.unacknowledged(), w),
             Field::Running => u32::from(m.state() != RiskState::Stopped),
-            Field::EventAvailable => u32::from(self.events.slot(0).is_some()),
+            Field::EventAvailable => u32::from(self.events.slot(0, m.next_event_seq()).is_some()),
             Field::Status => self.status(),
             Field::Alarms => {
                 u32::from(a.indicated().bits())
@@ -384,9 +382,15 @@ impl<E: Estimator> Core<E> {
             Field::BusDiscarded => self.bus(|c| c.framing.discarded),
             Field::BusExceptions => self.bus(|c| c.exceptions),
             Field::EventFirst => self.events.first(m.next_event_seq()),
-            Field::EventCount => u32::from(self.events.unread(super::map::EVENT_SLOTS)),
+            Field::EventCount => u32::from(
+                self.events
+                    .count(super::map::EVENT_SLOTS, m.next_event_seq()),
+            ),
             Field::EventsMissed => self.events.missed(m.next_event_seq()),
-            Field::Event(f) => self.events.slot(record).map_or(0, |e| event_value(e, f)),
+            Field::Event(f) => self
+                .events
+                .slot(record, m.next_event_seq())
+                .map_or(0, |e| event_value(e, f)),
             Field::EventFrom => self.events.from,
             Field::UnitId => u32::from(self.unit),
             Field::MapVersion => u32::from(super::map::MAP_VERSION),
@@ -409,34 +413,14 @@ impl<E: Estimator> Core<E> {
     }
 
     /// A bus counter, modulo 2^16 (its register is 16 bits).
-    fn bus(&self, f: impl Fn(&super::Counters) -> u32) -> u32 {
+    fn bus(&self, f: impl Fn(&Counters) -> u32) -> u32 {
         f(&self.counters) & 0xFFFF
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{div1000, split_seconds};
-
-    /// Every u32 near a multiple of 1000 (where a quotient changes), the extremes and
-    /// a spread of others.
-    #[test]
-    fn div1000_is_division() {
-        let near = (0..=4_294_967u32).flat_map(|k| {
-            let m = k.wrapping_mul(1000);
-            [m, m.wrapping_sub(1), m.wrapping_add(999)]
-        });
-        let mut x = 0x2545_F491u32;
-        let spread = (0..1_000_000).map(|_| {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            x
-        });
-        for v in near.chain(spread).chain([u32::MAX, u32::MAX - 1, 1 << 31]) {
-            assert_eq!(div1000(v), v / 1000, "{v}");
-        }
-    }
+    use super::split_seconds;
 
     /// The long division gives what u64 division gives, saturated where the seconds
     /// pass u32.

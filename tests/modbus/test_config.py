@@ -184,18 +184,33 @@ def test_the_commissioning_tool_writes_a_scene_the_node_was_not_built_with(clien
     assert get(client, "config_source") == 1
 
 
+def plan(tmp_path, scene):
+    """The planner's table for `scene` (the monitor example's --thresholds, with the
+    default configuration), on the node's core."""
+    table = tmp_path / "thresholds.csv"
+    done = subprocess.run(
+        ["cargo", "run", "--quiet", "--release", "--example", "monitor", "--", "--model",
+         os.environ["MODBUS_CORE"], "--scene", str(scene), "--plot", str(tmp_path / "plan.svg"),
+         "--thresholds", str(table)], capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stderr
+    return table
+
+
 PLANNED = "P,phi0,phi_warning,phi_warning_clear,phi_alarm,phi_alarm_clear\n"
+# The thresholds the planner plans with (monitor::Config::default()).
+DEFAULT_THRESHOLDS = "warning,0.8\nalarm,1.0\ndeadband,0.05\n"
 
 
 def test_the_commissioning_tool_takes_what_an_engineer_planned(client, tmp_path):
     """A scene file (prepared by the tool), a configuration file and the planner's
-    table in; the node runs them; a table planned for other loads is refused."""
+    table in; the node runs them. A table planned for other loads, or with another
+    warning than the configuration's, is refused before anything is written."""
     scene = tmp_path / "scene.csv"
     scene.write_text("R1,R2,G,nu,mu,length\n0.06,0.04,79.3e9,0.3,0.25,0.02\n")
     config = tmp_path / "config.csv"
-    config.write_text("name,value\n# on-delay and warning\nconfig_on_delay,6000\nwarning,0.75\n")
-    table = tmp_path / "thresholds.csv"
-    table.write_text(PLANNED + "500,0.0006,0.0004,0.00038,0.0005,0.00048\n2000,0.0007,,,0.0006,\n")
+    config.write_text("name,value\n# on-delay and the planner's thresholds\nconfig_on_delay,6000\n"
+                      + DEFAULT_THRESHOLDS)
+    table = plan(tmp_path, scene)
     wide = tmp_path / "wide.csv"
     wide.write_text(PLANNED + "500,0.0006,0.0004,0.00038,0.0005,0.00048\n90000,0.0007,,,,\n")
     crc = get(client, "scene_active_crc")
@@ -204,18 +219,125 @@ def test_the_commissioning_tool_takes_what_an_engineer_planned(client, tmp_path)
                              "--config", str(config), "--thresholds", str(wide))
     assert status == 1 and "planned with another configuration" in err, err
     assert get(client, "staged") == 0 and get(client, "active_on_delay") != 6000
+    # The table says the warning is raised at d/b 0.8; the configuration says 0.75.
+    status, err = commission(client, "--code", str(code()), "--scene", str(scene), "--core", core,
+                             "--config", str(config), "--set", "warning=0.75",
+                             "--thresholds", str(table))
+    assert status == 1 and "planned with another configuration" in err, err
+    assert "config_warning is 0.75" in err and "Traceback" not in err, err
+    assert get(client, "staged") == 0 and get(client, "unlock") == 0
+    assert get(client, "active_on_delay") != 6000
+    # A table for another scene (the critical angles differ).
+    other = tmp_path / "other"
+    other.mkdir()
+    other_scene = other / "scene.csv"
+    other_scene.write_text("R1,R2,G,nu,mu\n0.05,0.05,79.3e9,0.3,0.3\n")
+    status, err = commission(client, "--code", str(code()), "--scene", str(scene), "--core", core,
+                             "--config", str(config), "--thresholds", str(plan(other, other_scene)))
+    assert status == 1 and "planned for another scene" in err, err
     events = tmp_path / "events.csv"
+    refusals = get(client, "refused_writes")
     status, out = commission(client, "--code", str(code()), "--scene", str(scene), "--core", core,
                              "--config", str(config), "--thresholds", str(table),
                              "--events", str(events))
     assert status == 0, out
-    assert "thresholds planned for 500 to 2000 N" in out and "events held" in out, out
+    assert get(client, "refused_writes") == refusals, "the tool wrote nothing the node refused"
+    assert "thresholds planned for " in out and "events held" in out, out
     assert get(client, "active_on_delay") == 6000
-    assert get(client, "active_warning") == f32(0.75)
+    assert get(client, "active_warning") == f32(0.8)
     assert get(client, "scene_active_crc") not in (0, crc)
     held = events.read_text().splitlines()
     assert held[0] == "t,seq,state,from,kind,fault,P,phi,s,F,phi0,margin,time_to_critical,time_ms"
     assert len(held) - 1 == int(out.split(" events held")[0].split()[-1]) > 0, out
+
+
+def test_the_commissioning_tool_runs_from_any_folder(client, tmp_path):
+    """The register map and the examples are found beside the tool, not in the
+    working folder."""
+    client.close()
+    time.sleep(0.1)
+    done = subprocess.run(
+        [sys.executable, os.path.abspath("tools/commission.py"), "--tcp",
+         f"127.0.0.1:{os.environ['MODBUS_PORT']}"],
+        capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    time.sleep(0.1)
+    assert client.connect()
+    assert done.returncode == 0, done.stderr
+    assert "config_source" in done.stdout and "Traceback" not in done.stderr, done.stderr
+
+
+def untouched(client):
+    """What a refused run must leave as it was."""
+    return {n: get(client, n) for n in ("latching", "staged", "unlock", "config_on_delay",
+                                        "active_on_delay", "config_spike_window", "unlock_failures",
+                                        "refused_writes", "staged_generation", "config_source")}
+
+
+def test_a_value_outside_its_register_is_refused_before_anything_is_written(client, tmp_path):
+    """Each value checked against its register's type and domain (the map's min and
+    max): refused with a message naming it, the node not even unlocked; a bad value
+    after a good one in a configuration file leaves the node as it was."""
+    before = untouched(client)
+    config = tmp_path / "config.csv"
+    config.write_text("name,value\nlatching,15\nconfig_on_delay,5000.5\n")
+    cases = [
+        (["--config", str(config)], "config_on_delay = 5000.5"),
+        (["--set", "config_on_delay=-1"], "config_on_delay = -1"),
+        (["--set", "config_spike_window=65541"], "config_spike_window = 65541"),
+        (["--set", "new_code=70000"], "new_code = 70000"),
+        (["--set", "config_warning=nan"], "config_warning = nan"),
+        (["--set", "config_deadband=-0.1"], "config_deadband = -0.1"),
+        (["--set", "active_on_delay=5"], "active_on_delay is read only"),
+    ]
+    for args, named in cases:
+        status, err = commission(client, "--code", str(code()), *args)
+        assert status == 1 and named in err and "Traceback" not in err, (args, err)
+    for bad in ("70000", "-1", "12a"):
+        status, err = commission(client, "--code", bad, "--set", "config_on_delay=6000")
+        assert status == 1 and f"--code {bad}" in err and "Traceback" not in err, err
+    assert untouched(client) == before
+
+
+def test_any_failure_after_the_unlock_puts_the_node_back(client):
+    """Whatever fails once the node is unlocked (here the line, while the third value
+    is written): the switch put back, the staged copy reverted, the node locked, and
+    the failure goes on up."""
+    sys.path.insert(0, os.path.abspath("tools"))
+    import commission as tool
+    regs = tool.Map(os.environ["MODBUS_REGISTERS"])
+    before = untouched(client)
+    settings = tool.settings_words(regs, [("latching", str(before["latching"] ^ 15)),
+                                          ("config_on_delay", "7777"), ("config_warning", "0.71")])
+
+    class LineDrops(tool.Node):
+        def write(self, name, words):
+            if name == "config_warning":
+                raise ConnectionError("the line dropped")
+            return super().write(name, words)
+
+    node = LineDrops(client, regs, UNIT)
+    try:
+        tool.commission(node, code(), settings, None)
+        raise AssertionError("the failure was swallowed")
+    except ConnectionError:
+        pass
+    after = untouched(client)
+    for name in ("latching", "staged", "unlock", "config_on_delay", "active_on_delay"):
+        assert after[name] == before[name], (name, before, after)
+
+
+def test_a_switch_alone_is_written_without_a_commit(client):
+    """`--set latching=N` alone: applied and kept, nothing to commit, the node locked."""
+    latching = get(client, "latching")
+    refusals = get(client, "refused_writes")
+    status, out = commission(client, "--code", str(code()), "--set", f"latching={latching ^ 5}")
+    assert status == 0 and "switched: latching" in out, out
+    assert get(client, "refused_writes") == refusals
+    assert get(client, "latching") == latching ^ 5 and get(client, "unlock") == 0
+    assert get(client, "config_source") == 1
+    status, out = commission(client, "--code", str(code()), "--set", f"latching={latching}")
+    assert status == 0, out
+    assert get(client, "latching") == latching
 
 
 def samples_counted(client):
@@ -231,10 +353,20 @@ def test_the_commissioning_tool_resets_the_statistics(client):
     assert counted > 0
     refused(write(client, "command", 4), ILLEGAL_FUNCTION)
     assert samples_counted(client) == counted
-    status, out = commission(client, "--code", str(code()), "--reset-statistics")
+    # A run refused (a value outside its domain; a commit refused, the warning after
+    # the alarm) resets nothing.
+    for value in ("nan", "2.5"):
+        status, err = commission(client, "--code", str(code()), "--reset-statistics",
+                                 "--set", f"config_warning={value}")
+        assert status == 1 and ("config_warning" in err or "commit refused" in err), err
+        assert samples_counted(client) == counted, value
+        assert get(client, "unlock") == 0 and get(client, "staged") == 0
+    refusals = get(client, "refused_writes")
+    status, out = commission(client, "--code", str(code()), "--reset-statistics",
+                             "--set", "config_on_delay=6500")
     assert status == 0 and "statistics reset" in out, out
-    assert samples_counted(client) == 0
-    assert get(client, "unlock") == 0
+    assert samples_counted(client) == 0 and get(client, "active_on_delay") == 6500
+    assert get(client, "unlock") == 0 and get(client, "refused_writes") == refusals
 
 
 # Last: the lock-out lasts minutes of the node's time.

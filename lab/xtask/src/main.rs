@@ -14,6 +14,7 @@ mod measurements;
 mod modbus;
 mod node;
 mod nopanic;
+mod pico;
 mod records;
 mod seeds;
 mod shapes;
@@ -122,6 +123,9 @@ enum Task {
     /// compared with the host's replay; or serve, feed a trace, write the register map,
     /// measure the server's cost.
     Modbus(modbus::Args),
+    /// The Raspberry Pi Pico node in an emulator of its chip (rp2040js, lab/pico), its
+    /// sensors simulated at the pins: the checks, --serve, --trace, --uf2, --measure.
+    Pico(pico::Args),
     /// The web console (tools/web): build it; or serve it, run its browser tests,
     /// measure its download, start and replay rate.
     Web(web::Args),
@@ -156,6 +160,7 @@ fn main() -> ExitCode {
         Task::Nopanic => nopanic::run(),
         Task::Measurements { check } => measurements::run(check),
         Task::Modbus(args) => modbus::run(&args),
+        Task::Pico(args) => pico::run(&args),
         Task::Web(args) => web::run(&args),
     }
 }

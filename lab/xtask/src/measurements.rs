@@ -8,7 +8,9 @@
 //! around it is the page's own and carries no measured number.
 
 use crate::bench::{self, find};
-use crate::records::{self, AccuracyRow, BenchRow, NodeRow, ShapeRow, SizeRow, SweepRow, WebRow};
+use crate::records::{
+    self, AccuracyRow, BenchRow, NodeRow, PicoRow, ShapeRow, SizeRow, SweepRow, WebRow,
+};
 use crate::{accuracy, firmware, shapes, sweep};
 use misalign_workload::{Model, Operation};
 use std::fmt::Write as _;
@@ -33,6 +35,7 @@ fn blocks() -> Result<Vec<Block>, String> {
     let sizes = records::read::<SizeRow>()?;
     let nodes = records::read::<NodeRow>()?;
     let accuracy = records::read::<AccuracyRow>()?;
+    let pico = records::read::<PicoRow>()?;
     let web = records::read::<WebRow>()?;
     let block = |file, name, text| Block { file, name, text };
     Ok(vec![
@@ -45,6 +48,7 @@ fn blocks() -> Result<Vec<Block>, String> {
         block(PAGE, "sweep", sweep::markdown(&sweep, false)),
         block(PAGE, "firmware", sizes_block(&sizes)),
         block(PAGE, "node", node(&nodes)),
+        block(PAGE, "pico", pico_table(&pico)),
         block(PAGE, "web", web_table(&web)?),
     ])
 }
@@ -111,6 +115,29 @@ fn node(rows: &[NodeRow]) -> String {
         }
         _ => table,
     }
+}
+
+/// The Pico node's table (docs/pico.csv).
+fn pico_table(rows: &[PicoRow]) -> String {
+    let mut s = String::from(
+        "| board | flash | RAM: statics + deepest stack | of the board's RAM | samples monitored |\n\
+         |---|--:|--:|--:|--:|\n",
+    );
+    for r in rows {
+        writeln!(
+            s,
+            "| {} | {} | {} + {} = {} | {} | {} |",
+            r.board,
+            r.flash,
+            r.ram,
+            r.stack,
+            r.ram + r.stack,
+            r.board_ram,
+            r.samples
+        )
+        .unwrap();
+    }
+    s
 }
 
 /// The web console's table (docs/web.csv, `cargo xtask web --measure`), with its

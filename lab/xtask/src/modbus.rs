@@ -21,6 +21,8 @@
 //!   and pytest, pinned, in a virtual environment under `target/modbus-venv`.
 //!   With `--boards`, the node on its own samples also on the Cortex-M7 and M3 (MPS2,
 //!   CMSDK UART0) and the STM32F405 (`netduinoplus2`, USART1).
+//!   Last, every command and snippet of docs/modbus.md as the page shows them
+//!   (`tests/modbus/test_docs.py`; `--docs`: that alone).
 //! - `--serve PORT [--target TRIPLE]`: boots the node and serves until killed.
 //! - `--trace T.csv --scene S.csv --events OUT.csv [--model f32|fixed] [--target
 //!   TRIPLE]`: feeds a trace to the node over Modbus, reads its events back, writes
@@ -148,6 +150,10 @@ pub struct Args {
     /// its table.
     #[arg(long, conflicts_with = "boards")]
     measure: bool,
+    /// Run only docs/modbus.md's commands and snippets (tests/modbus/test_docs.py),
+    /// which the whole test runs last.
+    #[arg(long, conflicts_with_all = ["boards", "measure", "trace", "serve", "registers"])]
+    docs: bool,
 }
 
 /// `cargo xtask modbus`.
@@ -160,6 +166,8 @@ pub fn run(args: &Args) -> ExitCode {
         measure()
     } else if let Some(port) = &args.serve {
         serve(port, args.target.as_deref())
+    } else if args.docs {
+        prepare().and_then(|(python, _, _)| docs(&python))
     } else if args.trace.is_some() {
         trace(
             args.trace.as_deref(),
@@ -200,7 +208,7 @@ fn registers() -> Result<(), String> {
     Ok(())
 }
 
-fn registers_text() -> Result<String, String> {
+pub(crate) fn registers_text() -> Result<String, String> {
     let mut text = String::new();
     misalign::modbus::registers_csv(&mut text).map_err(|e| e.to_string())?;
     Ok(text)
@@ -343,7 +351,7 @@ fn boot(
 }
 
 /// The virtual environment with the pinned packages; its python.
-fn venv() -> Result<PathBuf, String> {
+pub(crate) fn venv() -> Result<PathBuf, String> {
     let dir = crate::root().join("target/modbus-venv");
     let python = dir.join("bin/python");
     let stamp = dir.join("installed.txt");
@@ -432,11 +440,37 @@ fn tests(boards: bool) -> Result<(), String> {
             failures.push(format!("{what}: {e}"));
         }
     }
+    println!(
+        "\n=== docs/modbus.md: every command and snippet ({}s)",
+        start.elapsed().as_secs()
+    );
+    if let Err(e) = docs(&python) {
+        failures.push(format!("docs/modbus.md: {e}"));
+    }
     if failures.is_empty() {
-        println!("modbus: every test passed on every node");
+        println!("modbus: every test passed on every node and the page");
         return Ok(());
     }
     Err(failures.join("\n"))
+}
+
+/// Every command and snippet of docs/modbus.md, as the page shows them
+/// (`tests/modbus/test_docs.py`): the page's own `cargo xtask modbus --serve` boots
+/// its nodes.
+fn docs(python: &Path) -> Result<(), String> {
+    let start = Instant::now();
+    let status = Command::new(python)
+        .current_dir(crate::root())
+        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+        .arg("tests/modbus/test_docs.py")
+        .status()
+        .map_err(|e| format!("pytest: {e}"))?;
+    println!("  docs/modbus.md: {} s", start.elapsed().as_secs());
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("pytest tests/modbus/test_docs.py: {status}"))
+    }
 }
 
 fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result<(), String> {
@@ -756,7 +790,7 @@ fn trace(
 
 /// Runs tools/commission.py against the node on 127.0.0.1:`port` with `args` (its
 /// status lines on stdout).
-fn commission_py(
+pub(crate) fn commission_py(
     python: &Path,
     port: u16,
     registers: &Path,
@@ -782,7 +816,7 @@ fn commission_py(
 /// The host's side: what the node must answer, from the same samples through the same
 /// library (`misalign::modbus::Server`, `misalign::monitor::Monitor`) and the same
 /// estimator as the node's (`node::core`).
-mod host {
+pub(crate) mod host {
     use crate::node::{self, Core};
     use misalign::Estimator;
     use misalign::modbus::map::{Table, TableMap};
@@ -1073,6 +1107,36 @@ mod host {
             csv,
             events: got.len(),
         })
+    }
+
+    /// The events of `raw` (master.py's `--events`: each event's registers) in
+    /// `examples/monitor --events`'s format, those of samples after `end_ms` left out.
+    pub fn events_csv(raw: &Path, end_ms: Option<u32>) -> Result<Compared, String> {
+        let text = std::fs::read_to_string(raw).map_err(|e| format!("{}: {e}", raw.display()))?;
+        let mut csv = format!("{}\n", misalign_cli::monitor_output::EVENTS_HEADER);
+        let mut events = 0;
+        for (i, line) in text.lines().enumerate().skip(1) {
+            let words: Vec<u16> = line
+                .split(',')
+                .skip(1)
+                .map(|w| {
+                    w.parse()
+                        .map_err(|_| format!("{}:{}: {w}", raw.display(), i + 1))
+                })
+                .collect::<Result<_, _>>()?;
+            let event = match event_from_registers(&words) {
+                Ok(Some(event)) => event,
+                Ok(None) => return Err(format!("{}:{}: an empty slot", raw.display(), i + 1)),
+                Err(e) => return Err(format!("{}:{}: {e:?}", raw.display(), i + 1)),
+            };
+            if end_ms.is_some_and(|end| event.time_ms > end) {
+                continue;
+            }
+            csv += &event_row(&event);
+            csv.push('\n');
+            events += 1;
+        }
+        Ok(Compared { csv, events })
     }
 
     /// The monitor as the node's server runs it (`Monitor::process`), over `samples`.

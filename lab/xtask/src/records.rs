@@ -314,6 +314,22 @@ record! {
 }
 
 record! {
+    /// docs/pico.csv (`cargo xtask pico --measure`): the Pico node's image, its RAM
+    /// and the deepest stack of a commissioned node's run in the emulator.
+    PicoRow in "pico.csv" {
+        /// The board.
+        board: String = "board",
+        /// Bytes: the image's flash, its statics, the deepest stack, the board's RAM.
+        flash: u64 = "flash",
+        ram: u64 = "ram_statics",
+        stack: u64 = "stack",
+        board_ram: u64 = "board_ram",
+        /// Samples the node monitored in the run.
+        samples: u64 = "samples",
+    }
+}
+
+record! {
     /// docs/accuracy.csv (`cargo xtask accuracy`): the worst relative error of one
     /// quantity of one model, over every row of the reference data for its contact.
     AccuracyRow in "accuracy.csv" {

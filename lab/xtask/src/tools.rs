@@ -52,6 +52,15 @@ pub fn preflight() -> Result<(), String> {
     Ok(())
 }
 
+/// defmt-print (installed here if missing, pinned): what the Pico's harness decodes
+/// the node's log with.
+pub fn preflight_defmt() -> Result<(), String> {
+    if !have("defmt-print", &["--version"]) {
+        install("defmt-print", Some(DEFMT_PRINT_VERSION))?;
+    }
+    Ok(())
+}
+
 /// An LLVM tool of the toolchain (`rustup component add llvm-tools`).
 pub fn llvm_tool(name: &str) -> Result<PathBuf, String> {
     let rustc = |arg: &str| -> Result<String, String> {

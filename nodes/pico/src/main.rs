@@ -1,39 +1,55 @@
-//! The Modbus monitoring node on a Raspberry Pi Pico (RP2040, Cortex-M0+) with an
-//! RS-485 transceiver (a MAX3485 or the like): UART0 on GP0 (TX, to DI) and GP1 (RX,
-//! from RO), 115200 baud 8N1, the transceiver's DE and /RE together on GP2 (high while
-//! the node sends); 3.5 character times of silence (the RP2040's timer) end a frame.
-//! The defmt log goes over RTT (a debug probe, `probe-rs run`).
+//! The monitoring node on a Raspberry Pi Pico (RP2040, Cortex-M0+), the board a user
+//! flashes (docs/pico.md: pins, parts, power, putting the image on a board): the load
+//! cell on an HX711, two displacement probes on an ADS1115, a tachometer's pulses
+//! (`sensors.rs`), sampled on the RP2040's timer every 100 ms (the HX711 at 80 samples a second, the
+//! ADS1115 at 860) and sleeping between
+//! samples and requests (`sleep.rs`); Modbus RTU over RS-485 on UART0 with the
+//! transceiver's driver enable (`board.rs`: the pins and the line in one place); its
+//! state, committed configuration and events on its own QSPI flash (`flash.rs`), in
+//! regions memory.x reserves; the watchdog armed. The defmt log goes over RTT (a debug
+//! probe, `probe-rs run`).
 //!
-//! The node is the QEMU images' (`nodes/firmware`): the same estimator built the
-//! same way (`node.rs`: the fixed-point core, as on every core without an FPU), the
-//! same Modbus loop (`serve.rs`: `Server::poll` over the `embedded-io` traits),
-//! compiled in here unchanged. Only the UART differs: embassy-rp's buffered UART, and
-//! the driver-enable pin through embedded-hal's `OutputPin` ([`Rs485`]). Built with
-//! `MISALIGN_MODBUS_EXTERNAL=1` it monitors the samples a PLC writes over the bus
-//! (`docs/modbus.md`); without, it monitors the built-in scenario and serves its end,
-//! as the QEMU images do.
+//! The node is the QEMU images' (`nodes/firmware`), compiled in unchanged: the same
+//! estimator built the same way (`node.rs`: the fixed-point core, as on every core
+//! without an FPU), the same Modbus loop (`serve.rs`), the same storage (`persist.rs`).
+//! Until a configuration is committed over the bus (the site's scene, docs/modbus.md)
+//! it serves only; from then on it monitors its sensors, across resets. Built with
+//! `MISALIGN_MODBUS_EXTERNAL=1` (tests only) it monitors the samples a master writes.
 #![no_std]
 #![no_main]
 
+mod board;
+mod flash;
+mod sensors;
+mod sleep;
+
 use defmt_rtt as _;
 use embassy_rp::bind_interrupts;
-use embassy_rp::gpio::{Level, Output};
+use embassy_rp::gpio::{Input, Level, Output, Pull};
+use embassy_rp::interrupt::InterruptExt;
 use embassy_rp::peripherals::UART0;
+use embassy_rp::pwm::{self, Pwm};
 use embassy_rp::uart::{BufferedInterruptHandler, BufferedUart, Config};
+use embassy_rp::watchdog::Watchdog;
+use embassy_time::{Duration, Instant};
 use embedded_hal::digital::OutputPin;
 use embedded_io::{ErrorType, Read, ReadReady, Write};
+use misalign::monitor::Sample;
 use panic_probe as _;
 
-// The node's code, as the QEMU images compile it (its scenario run and its sensors
-// are theirs only).
+// The node's code, as the QEMU images compile it (its scenario run and its simulated
+// sensors are theirs only).
 #[allow(dead_code)]
 #[path = "../../firmware/node.rs"]
 mod node;
+#[path = "../../firmware/persist.rs"]
+mod persist;
 #[allow(dead_code)] // The f32 model name is the FPU images'.
 #[path = "../../firmware/serve.rs"]
 mod serve;
 
-const BAUD: u32 = 115_200;
+/// The model name (function 43/14).
+const MODEL: &str = "fixed-point core (fixed::FixedAuto), the site's scene committed over the bus";
 
 bind_interrupts!(struct Irqs {
     UART0_IRQ => BufferedInterruptHandler<UART0>;
@@ -43,10 +59,15 @@ bind_interrupts!(struct Irqs {
 /// transceiver's driver-enable pin, raised from the first byte of an answer until its
 /// last stop bit has left. `idle` says whether the UART's transmitter has sent that
 /// (`flush` empties the HAL's buffer; the shift register is the HAL's own business).
+/// `drain` moves bytes still in the UART's own FIFO into the HAL's buffer: the
+/// PL011 raises its RX interrupt only at a FIFO level (embassy-rp sets 28 bytes, 2.4
+/// ms of the line at 115200 baud) or 32 bit times after the last byte, so without it
+/// a frame's end of silence would be judged on bytes the node has not seen.
 pub struct Rs485<U, D> {
     uart: U,
     driver_enable: D,
     idle: fn(&U) -> bool,
+    drain: fn(),
 }
 
 impl<U: ErrorType, D> ErrorType for Rs485<U, D> {
@@ -55,6 +76,9 @@ impl<U: ErrorType, D> ErrorType for Rs485<U, D> {
 
 impl<U: ReadReady, D> ReadReady for Rs485<U, D> {
     fn read_ready(&mut self) -> Result<bool, U::Error> {
+        if !self.uart.read_ready()? {
+            (self.drain)();
+        }
         self.uart.read_ready()
     }
 }
@@ -81,12 +105,44 @@ impl<U: Write, D: OutputPin> Write for Rs485<U, D> {
     }
 }
 
+/// The Pico as the node's board: its sensors, its sleep, its watchdog.
+struct Pico {
+    sensors: Option<sensors::Sensors>,
+    watchdog: Watchdog,
+}
+
+impl serve::Board for Pico {
+    const SENSORS: bool = true;
+
+    fn sample(&mut self) -> Option<Sample> {
+        self.sensors.as_mut()?.sample()
+    }
+
+    fn idle(&mut self, wait: u32, pending: &mut dyn FnMut() -> bool) {
+        let until = Instant::now().as_micros() + u64::from(wait);
+        let due = self
+            .sensors
+            .as_ref()
+            .map_or(until, sensors::Sensors::due_us);
+        sensors::idle(due, until, pending);
+    }
+
+    fn alive(&mut self) {
+        self.watchdog
+            .feed(Duration::from_millis(board::WATCHDOG_MS));
+    }
+}
+
 #[cortex_m_rt::entry]
 fn main() -> ! {
     let p = embassy_rp::init(Default::default());
+    let mut watchdog = Watchdog::new(p.WATCHDOG);
+    watchdog.start(Duration::from_millis(board::WATCHDOG_MS));
+    sleep::init();
     let mut config = Config::default();
-    config.baudrate = BAUD;
-    let (mut tx_buffer, mut rx_buffer) = ([0u8; 256], [0u8; 256]);
+    config.baudrate = board::LINE.baud;
+    // The RX buffer holds 44 ms of the line: a sample's reads never overflow it.
+    let (mut tx_buffer, mut rx_buffer) = ([0u8; 256], [0u8; 512]);
     let uart = BufferedUart::new(
         p.UART0,
         p.PIN_0,
@@ -100,21 +156,57 @@ fn main() -> ! {
         uart,
         driver_enable: Output::new(p.PIN_2, Level::Low),
         idle: |u: &BufferedUart| !u.busy(),
+        drain: || {
+            if !embassy_rp::pac::UART0.uartfr().read().rxfe() {
+                // The HAL's handler empties the FIFO into its buffer whatever raised it.
+                embassy_rp::interrupt::UART0_IRQ.pend();
+            }
+        },
     };
+    let mut i2c_config = embassy_rp::i2c::Config::default();
+    i2c_config.frequency = 400_000;
+    let i2c = embassy_rp::i2c::I2c::new_blocking(p.I2C0, p.PIN_5, p.PIN_4, i2c_config);
+    let pulses = Pwm::new_input(
+        p.PWM_SLICE3,
+        p.PIN_7,
+        Pull::Down,
+        pwm::InputMode::RisingEdge,
+        pwm::Config::default(),
+    );
+    let sensors = sensors::Sensors::new(
+        Input::new(p.PIN_10, Pull::Up),
+        Output::new(p.PIN_11, Level::Low),
+        i2c,
+        pulses,
+        Input::new(p.PIN_6, Pull::Down),
+    );
+    if let Err(e) = &sensors {
+        defmt::error!("node: the sensors' calibration refused: {}", e);
+    }
+    let mut pico = Pico {
+        sensors: sensors.ok(),
+        watchdog,
+    };
+    defmt::println!(
+        "modbus: unit {=u8} at {=u32} baud 8N1 on UART0, driver enable GP2",
+        board::LINE.unit_id,
+        board::LINE.baud
+    );
     let served = node::fixed_core().map(|core| {
         let clock = serve::LineClock {
-            ticks: || embassy_time::Instant::now().as_micros() as u32,
-            silence: misalign::modbus::silence_us(BAUD),
+            ticks: || Instant::now().as_micros() as u32,
+            silence: misalign::modbus::silence_us(board::LINE.baud),
             // Microseconds.
             per_ms: 1000,
         };
-        serve::node(core, serve::MODEL_FIXED, &mut line, clock)
+        serve::node(core, MODEL, &mut line, clock, &mut pico)
     });
     match served {
         Ok(_) => defmt::error!("node: the monitor refused its configuration"),
         Err(e) => defmt::error!("node: cannot prepare the scenario's scene: {}", e),
     }
+    // The watchdog, no longer fed, restarts the node.
     loop {
-        core::hint::spin_loop();
+        cortex_m::asm::wfi();
     }
 }

@@ -13,7 +13,7 @@
 
 use crate::table::{self, LineSplitter};
 use misalign::Scene;
-use misalign::monitor::Sample;
+use misalign::monitor::{FaultKind, Sample, SensorFault, SensorId};
 use std::error::Error;
 use std::io::{BufRead, Read};
 
@@ -22,7 +22,7 @@ type Res<T> = Result<T, Box<dyn Error>>;
 /// The scene's columns.
 const SCENE: [&str; 5] = ["R1", "R2", "G", "nu", "mu"];
 
-/// The trace's columns; `V` and `F` are optional.
+/// The trace's columns; `V`, `F` and `fault` are optional.
 const TRACE: [&str; 3] = ["t", "P", "phi"];
 
 /// The longest row of a trace (bytes); a longer one is skipped.
@@ -187,6 +187,7 @@ pub struct Trace<R> {
     columns: [usize; 3],
     speed: Option<usize>,
     force: Option<usize>,
+    fault: Option<usize>,
     split: LineSplitter,
     line: Vec<u8>,
     row: u64,
@@ -204,7 +205,7 @@ impl<R: BufRead> Trace<R> {
             .take(MAX_LINE as u64)
             .read_until(b'\n', &mut line)?;
         let (delimiter, header) = table::header(&line, &TRACE)?;
-        let (at, optional) = table::find_columns(&header, &TRACE, &["V", "F"])?;
+        let (at, optional) = table::find_columns(&header, &TRACE, &["V", "F", "fault"])?;
         Ok(Trace {
             input,
             delimiter,
@@ -212,6 +213,7 @@ impl<R: BufRead> Trace<R> {
             columns: [at[0], at[1], at[2]],
             speed: optional[0],
             force: optional[1],
+            fault: optional[2],
             split: LineSplitter::new(delimiter),
             line,
             row: 1,
@@ -326,10 +328,47 @@ impl<R: BufRead> Trace<R> {
                 .filter(|&j| !table::is_blank(self.split.field(j)))
                 .map(|j| value(name, j));
         }
+        let fault = self.fault.map(|j| self.split.field(j));
+        match fault.filter(|f| !table::is_blank(f)).map(sensor_fault) {
+            Some(Some(f)) => sample.sensor_fault = Some(f),
+            Some(None) => {
+                // Not a fault this reader knows: the row's values are not measurements.
+                why.get_or_insert_with(|| "fault: not `sensor:kind`".into());
+                sample.load = f32::NAN;
+            }
+            None => {}
+        }
         if let Some(m) = why {
             self.unreadable.note(row, || m);
         }
         Ok(Some(sample))
+    }
+}
+
+/// A sensor's own fault as a trace's optional `fault` column holds it: the sensor
+/// (`load`, `probe1`, `probe2`, `speed`), a colon and the kind (`disconnected`, `bus`,
+/// `saturated`, `stuck`, `jump`, `out_of_range`), as a node's sensors report it (the
+/// Pico node's samples, `cargo xtask pico --samples`); `None` for anything else.
+pub fn sensor_fault(cell: &[u8]) -> Option<SensorFault> {
+    let text = std::str::from_utf8(cell).ok()?.trim();
+    let (sensor, kind) = text.split_once(':')?;
+    let sensor = SensorId::ALL.into_iter().find(|s| s.name() == sensor)?;
+    let kind = FaultKind::ALL
+        .into_iter()
+        .find(|k| fault_kind_name(*k) == kind)?;
+    Some(SensorFault { sensor, kind })
+}
+
+/// A fault kind's name in a trace's `fault` column.
+pub fn fault_kind_name(kind: FaultKind) -> &'static str {
+    match kind {
+        FaultKind::Disconnected => "disconnected",
+        FaultKind::Bus => "bus",
+        FaultKind::Saturated => "saturated",
+        FaultKind::Stuck => "stuck",
+        FaultKind::Jump => "jump",
+        FaultKind::OutOfRange => "out_of_range",
+        _ => "unknown",
     }
 }
 

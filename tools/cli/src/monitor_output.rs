@@ -1,6 +1,6 @@
 //! What `cargo run --example monitor` writes besides its log: every event as a row of
 //! `--events` ([`event_record`], [`events_csv`]) and the threshold planner of
-//! `--thresholds` ([`threshold_rows`], [`thresholds_csv`]). The Python package's replay
+//! `--thresholds` ([`threshold_plan`], [`thresholds_csv`]). The Python package's replay
 //! and planner call the same functions, so that their columns are these files' cells.
 
 use misalign::Estimator;
@@ -183,11 +183,159 @@ pub fn angle_for_slip_ratio<E: Estimator>(
 /// the warning is raised, cleared, the alarm raised, cleared (NaN where none is).
 pub type ThresholdRow = [f64; 6];
 
-/// The threshold planner over 60 loads from the stop load up to `load_max` (N),
-/// which is first kept within the configuration's load range (at least twice the stop
-/// load). Loads without a critical angle give no row.
-pub fn threshold_rows<E: Estimator>(core: &E, config: &Config, load_max: f32) -> Vec<ThresholdRow> {
-    let load_max = load_max.min(config.load_max).max(2.0 * config.stop_load);
+/// Where the planner's loads end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PlanRange {
+    /// Up to this load (N), as asked: refused unless above the stop load and within
+    /// the configuration's `load_max`.
+    UpTo(f32),
+    /// Up to 1.2 times a trace's 99.9th percentile of load (N; `None` for a trace
+    /// without a finite load), so that a spike does not stretch it; kept within the
+    /// configuration's `load_max` (the plan's note says so); refused when it does not
+    /// reach above the stop load.
+    Trace(Option<f32>),
+}
+
+/// The planner's table and the load range it covers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThresholdPlan {
+    /// One row per load with a critical angle.
+    pub rows: Vec<ThresholdRow>,
+    /// The range's top (N); the rows start above the stop load.
+    pub load_max: f32,
+    /// What was changed from the range asked for, if anything (one sentence).
+    pub note: Option<String>,
+}
+
+/// A load range the planner cannot honour.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PlanError {
+    /// The range asked for is not above the configuration's stop load (N): below it
+    /// the machine stands and no state is raised.
+    NotAboveStop {
+        /// The top asked for (N), or the trace's 99.9th percentile's 1.2 times.
+        load_max: f32,
+        /// The stop load (N).
+        stop_load: f32,
+        /// Whether the top came from a trace.
+        from_trace: bool,
+    },
+    /// The range asked for is above the configuration's `load_max` (N), beyond which
+    /// a load is the monitor's sensor fault.
+    AboveRange {
+        /// The top asked for (N).
+        load_max: f32,
+        /// The configuration's maximum load (N).
+        config_load_max: f32,
+    },
+    /// The trace has no finite load.
+    NoLoad,
+}
+
+impl core::fmt::Display for PlanError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            PlanError::NotAboveStop {
+                load_max,
+                stop_load,
+                from_trace,
+            } => {
+                if from_trace {
+                    write!(
+                        f,
+                        "the trace's loads (1.2 x their 99.9th percentile: {load_max} N) do not \
+                         reach above the stop load {stop_load} N: the machine stands there and \
+                         no state is raised; no load range to plan over"
+                    )
+                } else {
+                    write!(
+                        f,
+                        "load_max = {load_max} N is not above the stop load {stop_load} N: the \
+                         machine stands there and no state is raised; no load range to plan over"
+                    )
+                }
+            }
+            PlanError::AboveRange {
+                load_max,
+                config_load_max,
+            } => write!(
+                f,
+                "load_max = {load_max} N is above the configuration's load_max \
+                 {config_load_max} N, beyond which a load is a sensor fault"
+            ),
+            PlanError::NoLoad => {
+                f.write_str("the trace has no finite load (P): no load range to plan over")
+            }
+        }
+    }
+}
+
+impl std::error::Error for PlanError {}
+
+/// The threshold planner over 60 loads from above the stop load up to the top of
+/// `range` (N): the critical angle phi0(P) and the misalignment (rad) at which each
+/// state is raised and cleared. Loads without a critical angle give no row.
+///
+/// # Errors
+/// [`PlanError`] for a range the table cannot honour; a trace's range above the
+/// configuration's `load_max` is kept within it instead, and the plan's note says so.
+pub fn threshold_plan<E: Estimator>(
+    core: &E,
+    config: &Config,
+    range: PlanRange,
+) -> Result<ThresholdPlan, PlanError> {
+    let stop_load = config.stop_load;
+    let (load_max, note) = match range {
+        PlanRange::UpTo(top) => {
+            // NaN is not above it either.
+            if top.partial_cmp(&stop_load) != Some(core::cmp::Ordering::Greater) {
+                return Err(PlanError::NotAboveStop {
+                    load_max: top,
+                    stop_load,
+                    from_trace: false,
+                });
+            }
+            if top > config.load_max {
+                return Err(PlanError::AboveRange {
+                    load_max: top,
+                    config_load_max: config.load_max,
+                });
+            }
+            (top, None)
+        }
+        PlanRange::Trace(None) => return Err(PlanError::NoLoad),
+        PlanRange::Trace(Some(quantile)) => {
+            let top = quantile * 1.2;
+            // NaN is not above it either.
+            if top.partial_cmp(&stop_load) != Some(core::cmp::Ordering::Greater) {
+                return Err(PlanError::NotAboveStop {
+                    load_max: top,
+                    stop_load,
+                    from_trace: true,
+                });
+            }
+            if top > config.load_max {
+                let note = format!(
+                    "the trace's loads reach {top} N (1.2 x their 99.9th percentile); the table \
+                     ends at the configuration's load_max, {} N",
+                    config.load_max
+                );
+                (config.load_max, Some(note))
+            } else {
+                (top, None)
+            }
+        }
+    };
+    Ok(ThresholdPlan {
+        rows: threshold_rows(core, config, load_max),
+        load_max,
+        note,
+    })
+}
+
+/// The rows over 60 loads from above the stop load up to `load_max` (N), which
+/// [`threshold_plan`] has checked.
+fn threshold_rows<E: Estimator>(core: &E, config: &Config, load_max: f32) -> Vec<ThresholdRow> {
     let n = 60;
     let (w, a, d) = match config.thresholds {
         Thresholds::SlipRatio {
@@ -300,6 +448,37 @@ mod tests {
         let csv = events_csv(&[event(friction)]);
         assert_eq!(csv.lines().next(), Some(EVENTS_HEADER));
         assert_eq!(csv.lines().count(), 2);
+    }
+
+    /// A range the table cannot honour is refused; a trace's range above the
+    /// configuration's is kept within it and the note says so.
+    #[test]
+    fn the_planners_range() {
+        let scene = misalign::Scene::DEMO;
+        let core = misalign::float::Auto::new(&scene).unwrap();
+        let config = Config::default();
+        for top in [50.0, 1e-30, 0.0, -100.0, f32::NAN, 100.0] {
+            let e = threshold_plan(&core, &config, PlanRange::UpTo(top)).unwrap_err();
+            assert!(matches!(e, PlanError::NotAboveStop { .. }), "{top}: {e}");
+            assert!(e.to_string().contains("stop load 100 N"), "{e}");
+            let e = threshold_plan(&core, &config, PlanRange::Trace(Some(top / 1.2)));
+            assert!(matches!(e, Err(PlanError::NotAboveStop { .. })), "{top}");
+        }
+        for top in [5e4 * 1.01, f32::INFINITY] {
+            let e = threshold_plan(&core, &config, PlanRange::UpTo(top)).unwrap_err();
+            assert!(matches!(e, PlanError::AboveRange { .. }), "{top}: {e}");
+        }
+        assert_eq!(
+            threshold_plan(&core, &config, PlanRange::Trace(None)),
+            Err(PlanError::NoLoad)
+        );
+        let plan = threshold_plan(&core, &config, PlanRange::UpTo(3e3)).unwrap();
+        assert_eq!((plan.load_max, plan.note.as_deref()), (3e3, None));
+        assert!(plan.rows[0][0] > 100.0 && plan.rows.last().unwrap()[0] == 3e3);
+        let plan = threshold_plan(&core, &config, PlanRange::Trace(Some(1e6))).unwrap();
+        assert_eq!(plan.load_max, 5e4);
+        assert!(plan.note.unwrap().contains("load_max, 50000 N"));
+        assert!(plan.rows.last().unwrap()[0] == 5e4);
     }
 
     #[test]

@@ -9,7 +9,7 @@
 //! (`monitor_output`'s rows) is then the same bytes in each.
 
 use crate::monitor_input::Trace;
-use crate::monitor_output::{self as output, ThresholdRow};
+use crate::monitor_output::{self as output, PlanError, PlanRange, ThresholdPlan};
 use crate::reference_core::ReferenceCore;
 use misalign::fixed::FixedAuto;
 use misalign::float::Auto;
@@ -180,9 +180,9 @@ impl<E: Estimator + Copy> Core<E> {
         (self.step)(&mut self.monitor, sample)
     }
 
-    fn thresholds(&self) -> Option<Vec<ThresholdRow>> {
-        let top = self.loads.as_ref()?.value().unwrap_or(0.0);
-        Some(output::threshold_rows(&self.core, &self.config, top * 1.2))
+    fn thresholds(&self) -> Option<Result<ThresholdPlan, PlanError>> {
+        let range = PlanRange::Trace(self.loads.as_ref()?.value());
+        Some(output::threshold_plan(&self.core, &self.config, range))
     }
 }
 
@@ -288,42 +288,43 @@ impl Replay {
     }
 
     /// The planner's table (the monitor example's `--thresholds`) over loads up to
-    /// 1.2 times the trace's 99.9th percentile, on the replay's core and configuration;
-    /// `None` unless the survey counted the loads.
-    pub fn thresholds(&self) -> Option<Vec<ThresholdRow>> {
+    /// 1.2 times the trace's 99.9th percentile (`PlanRange::Trace`), on the replay's
+    /// core and configuration; `None` unless the survey counted the loads.
+    pub fn thresholds(&self) -> Option<Result<ThresholdPlan, PlanError>> {
         each!(self, m => m.thresholds())
     }
 }
 
-/// The planner's table (`monitor_output::threshold_rows`) on `model`'s core for
+/// The planner's table (`monitor_output::threshold_plan`) on `model`'s core for
 /// `scene`, its contact model chosen once for loads up to `range_max` (N, as a replay
-/// chooses it for its trace), under `config`, over loads up to `load_max` (N).
+/// chooses it for its trace), under `config`, over `range`.
 ///
 /// # Errors
-/// The model choice's and the core's errors for the scene.
+/// The model choice's and the core's errors for the scene; a range the planner
+/// cannot honour ([`PlanError`]).
 pub fn plan(
     model: Model,
     scene: &Scene,
     config: &Config,
     range_max: f64,
-    load_max: f32,
-) -> Res<Vec<ThresholdRow>> {
+    range: PlanRange,
+) -> Res<ThresholdPlan> {
     Ok(match model {
-        Model::F32 => output::threshold_rows(
+        Model::F32 => output::threshold_plan(
             &scenario::estimator_for::<Auto>(scene, range_max)?,
             config,
-            load_max,
-        ),
-        Model::Fixed => output::threshold_rows(
+            range,
+        )?,
+        Model::Fixed => output::threshold_plan(
             &scenario::estimator_for::<FixedAuto>(scene, range_max)?,
             config,
-            load_max,
-        ),
-        Model::Reference => output::threshold_rows(
+            range,
+        )?,
+        Model::Reference => output::threshold_plan(
             &scenario::estimator_for::<ReferenceCore>(scene, range_max)?,
             config,
-            load_max,
-        ),
+            range,
+        )?,
     })
 }
 

@@ -16,7 +16,9 @@ summary for a fleet on Dask or Spark is :func:`misalign.fleet.roller_summary`.
 
 from __future__ import annotations
 
+import numbers
 import sys
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Iterator, Optional, Sequence, Tuple
@@ -65,17 +67,88 @@ _CONTACT_MODELS = np.array(["elliptic", "line"] + [""] * 254, dtype=object)
 _SCENARIO_LOAD_MAX = 5e3
 
 
+def _is_real_type(t: type) -> bool:
+    """A type whose values are real numbers: not a bool (a flag, not a quantity),
+    not a string, not complex."""
+    return issubclass(t, numbers.Real) and not issubclass(t, (bool, np.bool_))
+
+
 def _as_float(name: str, x: Any) -> np.ndarray:
-    """`x` as a float64 array; ValueError for what is not a real number."""
+    """`x` as a float64 array; ValueError for what is not a real number. One rule
+    whatever holds the values: strings, bools, complex numbers, None and other objects
+    are refused, as an array of them (``<U1``, ``bool``) or inside an object array."""
     a = np.asarray(x)
     if a.dtype == object:
+        for t in {type(v) for v in a.flat}:
+            if not _is_real_type(t):
+                raise ValueError(f"{name}: not an array of real numbers (holds {t.__name__})")
         try:
             a = a.astype(np.float64)
-        except (TypeError, ValueError) as e:
-            raise ValueError(f"{name}: not an array of numbers ({e})") from None
+        except (TypeError, ValueError, OverflowError) as e:
+            raise ValueError(f"{name}: not an array of real numbers ({e})") from None
     if a.dtype.kind not in "iuf":
         raise ValueError(f"{name}: dtype {a.dtype} is not a real number type")
     return a.astype(np.float64, copy=False)
+
+
+def _real(name: str, x: Any, *, positive: bool = False) -> float:
+    """An option that is one real number (not a bool, not a string), finite; above 0
+    where ``positive``."""
+    if not _is_real_type(type(x)):
+        raise ValueError(f"{name} must be a real number, not {x!r}")
+    try:
+        v = float(x)
+    except (OverflowError, ValueError, TypeError):
+        v = float("nan")
+    if not np.isfinite(v) or (positive and not v > 0):
+        what = "a finite number above 0" if positive else "a finite number"
+        raise ValueError(f"{name} must be {what}, not {x!r}")
+    return v
+
+
+def _flag(name: str, x: Any) -> bool:
+    """An option that is True or False (Python's or numpy's), nothing else."""
+    if not isinstance(x, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, not {x!r}")
+    return bool(x)
+
+
+def _scene(scene: Any) -> Tuple[float, float, float, float, float]:
+    """A scene (R1, R2, G, nu, mu) of real numbers; R2 may be inf (a plane); the
+    values' physics is checked by the library (ValueError "scene: ...")."""
+    if scene is None:
+        return SCENE
+    if isinstance(scene, (str, bytes)) or not isinstance(scene, (Sequence, np.ndarray)) \
+            or len(scene) != 5:
+        raise ValueError(f"scene must be (R1, R2, G, nu, mu), not {scene!r}")
+    out = []
+    for name, x in zip(("R1", "R2", "G", "nu", "mu"), scene):
+        if not _is_real_type(type(x)):
+            raise ValueError(f"scene: {name} must be a real number, not {x!r}")
+        try:
+            out.append(float(x))
+        except OverflowError:
+            raise ValueError(f"scene: {name} = {x!r} is beyond f64's range") from None
+    return tuple(out)  # type: ignore[return-value]
+
+
+def _length(length: Any) -> Optional[float]:
+    """The rollers' contact length of the replay and the planner: None or a number."""
+    if length is None:
+        return None
+    if not _is_real_type(type(length)):
+        raise ValueError(f"length must be a real number (m) or None, not {length!r}")
+    return float(length)
+
+
+def _config(config: Any) -> Optional[dict]:
+    """The monitor's settings: None or a mapping of field names (each field's type and
+    range is checked by the library: ValueError "config: <field> ...")."""
+    if config is None:
+        return None
+    if not isinstance(config, Mapping):
+        raise ValueError(f"config must be a dict of the monitor's settings, not {config!r}")
+    return dict(config)
 
 
 def _columns(named: Sequence[Tuple[str, Any]]) -> Tuple[Tuple[int, ...], list]:
@@ -97,7 +170,7 @@ def _columns(named: Sequence[Tuple[str, Any]]) -> Tuple[Tuple[int, ...], list]:
 
 
 def _option(name: str, value: str, allowed: Sequence[str]) -> str:
-    if value not in allowed:
+    if not isinstance(value, str) or value not in allowed:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, allowed))}, not {value!r}")
     return value
 
@@ -154,7 +227,8 @@ def estimate(
     model: str = "reference",
     contact: str = "auto",
     details: bool = False,
-    load_lsb: float = 1e-2,
+    counts: str = "exact",
+    load_lsb: Optional[float] = None,
     angle_lsb: Optional[float] = None,
     threads: bool = True,
 ) -> Result:
@@ -164,10 +238,14 @@ def estimate(
     (Pa), ``nu`` Poisson's ratio, ``mu`` friction coefficient, ``P`` load (N; N/m in
     line contact without a length), ``phi`` misalignment (rad, signed), ``length`` the
     rollers' contact length (m) or None. ``model``: ``"reference"`` (f64, the whole
-    paper), ``"f32"`` (the Cortex-M4F core) or ``"fixed"`` (the fixed-point core, P in
-    counts of ``load_lsb`` N and phi in counts of ``angle_lsb`` rad, each rounded to the
-    nearest count; ``angle_lsb=None`` takes the finest angle the scene's tables allow,
-    at least 1e-10 rad). ``contact``: ``"auto"`` (section 9 per element: line contact
+    paper), ``"f32"`` (the Cortex-M4F core) or ``"fixed"`` (the fixed-point core).
+    ``counts``, for the fixed-point core, how P and phi become its integer counts:
+    ``"exact"`` (the core: each row in counts of an LSB that holds its values exactly,
+    as the CSV estimator's ``--counts exact``, so that the answer carries the core's
+    own error only) or ``"adc"`` (the node with its ADC: P in counts of ``load_lsb`` N,
+    default 10 mN, and phi in counts of ``angle_lsb`` rad, default the finest angle the
+    scene's tables allow and at least 1e-10 rad, each rounded to the nearest count, as
+    ``--counts adc``). ``contact``: ``"auto"`` (section 9 per element: line contact
     when the ellipse is longer than the rollers), ``"elliptic"`` or ``"line"``.
     ``details=True`` adds the reference's theta, kprime, m, n, a, b (m), p0 (Pa), d (m),
     Pstar, P0star, theta0 (rad), R (m). ``threads``: rows in chunks over both cores.
@@ -179,18 +257,25 @@ def estimate(
     where the element is fine). A bad element (NaN, infinite, negative or zero where
     not allowed) gets NaN and its message; the others their values.
 
-    Raises ValueError for inputs that do not broadcast, are not real numbers, or an
-    unknown option. The GIL is released while the rows are computed.
+    Raises ValueError for inputs that do not broadcast, are not real numbers, an
+    unknown option, or an LSB the fixed-point core cannot take for the scene (named).
+    The GIL is released while the rows are computed.
     """
     _option("model", model, _MODELS)
     _option("contact", contact, _CONTACTS)
+    _option("counts", counts, ("exact", "adc"))
+    details, threads = _flag("details", details), _flag("threads", threads)
+    lsbs = [(k, v) for k, v in (("load_lsb", load_lsb), ("angle_lsb", angle_lsb)) if v is not None]
+    if lsbs and (model != "fixed" or counts != "adc"):
+        raise ValueError(f"{lsbs[0][0]} is the ADC's: it needs model='fixed' with counts='adc'")
+    load_lsb = None if load_lsb is None else _real("load_lsb", load_lsb, positive=True)
+    angle_lsb = None if angle_lsb is None else _real("angle_lsb", angle_lsb, positive=True)
     named = [("R1", R1), ("R2", R2), ("G", G), ("nu", nu), ("mu", mu),
              ("length", 1.0 if length is None else length), ("P", P), ("phi", phi)]
     shape, cols = _columns(named)
     n = int(np.prod(shape, dtype=np.int64))
-    out = _misalign.estimate(cols, length is not None, n, model, contact, bool(details),
-                             float(load_lsb), None if angle_lsb is None else float(angle_lsb),
-                             bool(threads))
+    out = _misalign.estimate(cols, length is not None, n, model, contact, details, counts,
+                             load_lsb, angle_lsb, threads)
     numbers = {"s": out["s"], "F": out["F"], "phi0": out["phi0"]}
     if details:
         numbers.update({k: out[k] for k in _DETAILS})
@@ -337,6 +422,11 @@ def replay(t, P, phi, *, V=None, F=None, scene=None, length=None, model: str = "
     import pandas as pd
 
     _option("model", model, ("f32", "fixed"))
+    scene, length, config = _scene(scene), _length(length), _config(config)
+    progress = _flag("progress", progress)
+    if isinstance(chunk, (bool, np.bool_)) or not isinstance(chunk, numbers.Integral) \
+            or chunk < 1:
+        raise ValueError(f"chunk must be a whole number of samples, at least 1, not {chunk!r}")
     tt = _as_float("t", t)
     if tt.ndim != 1:
         raise ValueError(f"t must be one-dimensional, not of shape {tt.shape}")
@@ -349,14 +439,10 @@ def replay(t, P, phi, *, V=None, F=None, scene=None, length=None, model: str = "
     phi64 = _trace_column("phi", phi, n)
     V64 = _trace_column("V", V, n)
     F64 = _trace_column("F", F, n)
-    scene = SCENE if scene is None else tuple(float(x) for x in scene)
-    if len(scene) != 5:
-        raise ValueError("scene must be (R1, R2, G, nu, mu)")
     with np.errstate(over="ignore"):  # beyond f32: inf, as the node's f32 reads it
         P32 = P64.astype(np.float32)
-    r = _misalign.Replay(scene, None if length is None else float(length), model,
-                         _load_range(P32), config)
-    chunk = max(1, int(chunk))
+    r = _misalign.Replay(scene, length, model, _load_range(P32), config)
+    chunk = int(chunk)
     for start in range(0, n, chunk):
         end = min(n, start + chunk)
         r.feed(tt[start:end], P64[start:end], phi64[start:end], V64[start:end],
@@ -376,34 +462,47 @@ def replay(t, P, phi, *, V=None, F=None, scene=None, length=None, model: str = "
 
 def thresholds(P=None, *, scene=None, length=None, model: str = "f32",
                load_max: Optional[float] = None, config: Optional[dict] = None):
-    """The threshold planner, as the monitor example's ``--thresholds``: over 60 loads
-    from the stop load to the top of the range, the critical angle phi0(P) and the
-    misalignment at which each state is raised and cleared. A pandas DataFrame with
-    ``P`` (N), ``phi0``, ``phi_warning``, ``phi_warning_clear``, ``phi_alarm``,
-    ``phi_alarm_clear`` (rad; NaN where the state is not reached).
+    """The threshold planner, as the monitor example's ``--thresholds`` (the same
+    code): over 60 loads from above the stop load to the top of the range, the critical
+    angle phi0(P) and the misalignment at which each state is raised and cleared. A
+    pandas DataFrame with ``P`` (N), ``phi0``, ``phi_warning``, ``phi_warning_clear``,
+    ``phi_alarm``, ``phi_alarm_clear`` (rad; NaN where the state is not reached); its
+    ``attrs["load_max"]`` is the range's top (N), ``attrs["note"]`` what was changed
+    from the range asked for (or None).
 
     The load range: given ``P`` (a trace's loads, N), up to 1.2 times its 99.9th
-    percentile (so that a spike does not stretch it), as the example; else up to
-    ``load_max`` (N, default the monitor's configured maximum load). Scene, length,
-    model and config as :func:`replay`.
+    percentile (so that a spike does not stretch it), as the example; kept within the
+    configuration's ``load_max``, with a warning that says so. Else up to ``load_max``
+    (N, default the configuration's ``load_max``). Scene, length, model and config as
+    :func:`replay`.
+
+    Raises ValueError for a range the table cannot honour: not above the
+    configuration's stop load (where the machine stands and no state is raised: a
+    trace without a finite load, or whose loads stay below it), an explicit
+    ``load_max`` above the configuration's, both ``P`` and ``load_max``, or a bad
+    scene, model or configuration.
     """
     import pandas as pd
 
     _option("model", model, ("f32", "fixed"))
-    scene = SCENE if scene is None else tuple(float(x) for x in scene)
+    scene, length, config = _scene(scene), _length(length), _config(config)
     if P is not None:
+        if load_max is not None:
+            raise ValueError("give P (a trace's loads) or load_max, not both")
         with np.errstate(over="ignore"):  # beyond f32: inf, as the node's f32 reads it
             P32 = _as_float("P", P).reshape(-1).astype(np.float32)
         loads = np.sort(P32[np.isfinite(P32)])
-        top = loads[len(loads) * 999 // 1000] if len(loads) else np.float32(0.0)
-        top = float(np.float32(top) * np.float32(1.2))
+        top = float(loads[len(loads) * 999 // 1000]) if len(loads) else None
         trace_range = _load_range(P32)
     else:
-        top = float("inf") if load_max is None else float(load_max)
-        if not top > 0:
-            raise ValueError("load_max must be positive")
-        trace_range = max(_SCENARIO_LOAD_MAX, top if np.isfinite(top) else 0.0)
-    rows = _misalign.thresholds(scene, None if length is None else float(length), model,
-                                top, trace_range, config)
+        top = None if load_max is None else _real("load_max", load_max)
+        trace_range = max(_SCENARIO_LOAD_MAX, top or 0.0)
+    rows, top_used, note = _misalign.thresholds(scene, length, model, P is not None, top,
+                                                trace_range, config)
+    if note is not None:
+        warnings.warn(f"thresholds: {note}", stacklevel=2)
     cols = ["P", "phi0", "phi_warning", "phi_warning_clear", "phi_alarm", "phi_alarm_clear"]
-    return pd.DataFrame(rows, columns=cols)
+    table = pd.DataFrame(rows, columns=cols)
+    table.attrs["load_max"] = float(top_used)
+    table.attrs["note"] = note
+    return table

@@ -35,7 +35,8 @@ def estimate(
     model: Model = "reference",
     contact: Contact = "auto",
     details: bool = False,
-    load_lsb: float = 1e-2,
+    counts: Literal["exact", "adc"] = "exact",
+    load_lsb: Optional[float] = None,
     angle_lsb: Optional[float] = None,
     threads: bool = True,
 ) -> Result: ...

@@ -3,7 +3,7 @@
 //! dtypes and raises `ValueError` for bad shapes and options) and answers with numpy
 //! arrays; every long call releases the GIL.
 
-use misalign::batch::{self, Column, Details, Inputs, Model, Outputs};
+use misalign::batch::{self, Column, Counts, Details, Inputs, Model, Outputs, RefusedLsb};
 use misalign::fixed::{FixedAuto, FixedEllipticScene};
 use misalign::float::Auto;
 use misalign::monitor::{
@@ -56,6 +56,73 @@ fn empty<'py, T: numpy::Element>(py: Python<'py>, n: usize) -> PyResult<Bound<'p
     Ok(array.cast_into::<PyArray1<T>>()?)
 }
 
+/// The ADC's load LSB where none is given (N): 10 mN, as the nodes.
+const ADC_LOAD_LSB: f64 = 1e-2;
+
+/// A ValueError naming an ADC's LSB that the fixed-point core cannot take for the
+/// scene of a row it refused (out of range), rather than blaming that row.
+fn refused_lsb(
+    inputs: &Inputs<'_>,
+    status: &[u8],
+    load_lsb: f64,
+    angle_lsb: Option<f64>,
+) -> PyResult<()> {
+    let out_of_range = batch::status_of(Error::OutOfRange);
+    let at = |c: Column<'_>, i: usize| match c {
+        Column::One(x) => x,
+        Column::Each(x) => x[i],
+    };
+    let mut checked: Option<[u64; 6]> = None;
+    for (i, _) in status.iter().enumerate().filter(|(_, s)| **s == out_of_range) {
+        let constants = [
+            at(inputs.r1, i),
+            at(inputs.r2, i),
+            at(inputs.shear_modulus, i),
+            at(inputs.poisson_ratio, i),
+            at(inputs.friction, i),
+            inputs.length.map_or(f64::NAN, |l| at(l, i)),
+        ];
+        let key = constants.map(f64::to_bits);
+        if checked == Some(key) {
+            continue;
+        }
+        checked = Some(key);
+        let [r1, r2, g, nu, mu, length] = constants;
+        let Ok(scene) = Scene::new(r1, r2, g, nu, mu)
+            .and_then(|s| if length.is_nan() { Ok(s) } else { s.with_length(length) })
+        else {
+            continue;
+        };
+        let finest = FixedEllipticScene::min_angle_lsb(&scene).max(1e-10);
+        let angle = angle_lsb.map_or("the finest angle its tables allow".to_string(), |a| {
+            format!("angle_lsb = {a:e} rad")
+        });
+        let which = match batch::adc_lsb_refused(&scene, inputs.choice, load_lsb, angle_lsb) {
+            None => continue,
+            Some(RefusedLsb::Load) => format!(
+                "load_lsb = {load_lsb:e} N: the fixed-point core cannot take it"
+            ),
+            Some(RefusedLsb::Angle) => format!(
+                "{angle}: the fixed-point core cannot take it (one count must be at least \
+                 {finest:e} rad, theta = c |phi| >= 2^-40 rad on its tables, and at most pi/2)"
+            ),
+            Some(RefusedLsb::Both) => format!(
+                "load_lsb = {load_lsb:e} N with {angle}: the fixed-point core cannot take the two together"
+            ),
+        };
+        let scene_of = if inputs.one_scene_for_all() {
+            "the scene".to_string()
+        } else {
+            format!("the scene of row {i}")
+        };
+        return Err(value_error(format!(
+            "{which} for {scene_of} (constants outside its Q8.24 logarithms, or d/b and F \
+             beyond 2^+-126 over its range)"
+        )));
+    }
+    Ok(())
+}
+
 const NAMES: [&str; 8] = ["R1", "R2", "G", "nu", "mu", "length", "P", "phi"];
 
 /// The messages of the status codes: index = status (0 = fine: "").
@@ -72,7 +139,7 @@ fn error_messages() -> Vec<String> {
 /// The forward model over columns `R1, R2, G, nu, mu, length, P, phi` (each 1 or n
 /// rows; length ignored unless `has_length`).
 #[pyfunction]
-#[pyo3(signature = (columns, has_length, n, model, contact, details, load_lsb, angle_lsb, threads))]
+#[pyo3(signature = (columns, has_length, n, model, contact, details, counts, load_lsb, angle_lsb, threads))]
 #[allow(clippy::too_many_arguments)]
 fn estimate<'py>(
     py: Python<'py>,
@@ -82,17 +149,24 @@ fn estimate<'py>(
     model: &str,
     contact: &str,
     details: bool,
-    load_lsb: f64,
+    counts: &str,
+    load_lsb: Option<f64>,
     angle_lsb: Option<f64>,
     threads: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let model = match model {
-        "reference" => Model::Reference,
-        "f32" => Model::F32,
-        "fixed" => Model::Fixed {
-            load_lsb,
+    let model = match (model, counts) {
+        ("reference", _) => Model::Reference,
+        ("f32", _) => Model::F32,
+        ("fixed", "exact") => Model::Fixed(Counts::Exact),
+        ("fixed", "adc") => Model::Fixed(Counts::Adc {
+            load_lsb: load_lsb.unwrap_or(ADC_LOAD_LSB),
             angle_lsb,
-        },
+        }),
+        ("fixed", _) => {
+            return Err(value_error(format!(
+                "counts must be 'exact' or 'adc', not {counts:?}"
+            )));
+        }
         _ => {
             return Err(value_error(format!(
                 "model must be 'reference', 'f32' or 'fixed', not {model:?}"
@@ -193,6 +267,13 @@ fn estimate<'py>(
         }
     })
     .map_err(value_error)?;
+    if let Model::Fixed(Counts::Adc {
+        load_lsb,
+        angle_lsb,
+    }) = model
+    {
+        refused_lsb(&inputs, code_slices[3], load_lsb, angle_lsb)?;
+    }
     drop(float_slices);
     drop(code_slices);
     drop(float_guards);
@@ -423,6 +504,58 @@ fn scenario_samples<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
     Ok(dict)
 }
 
+/// A Python bool (or numpy's), which numbers' conversions would take as 0 or 1.
+fn is_bool(value: &Bound<'_, PyAny>) -> bool {
+    value.is_instance_of::<pyo3::types::PyBool>()
+        || value
+            .get_type()
+            .fully_qualified_name()
+            .is_ok_and(|n| n.to_string() == "numpy.bool" || n.to_string() == "numpy.bool_")
+}
+
+/// A configuration field of f32: a real number (not a bool) that f32 holds finite.
+fn number_field(key: &str, value: &Bound<'_, PyAny>) -> PyResult<f32> {
+    let x = if is_bool(value) {
+        None
+    } else {
+        value.extract::<f64>().ok()
+    };
+    match x {
+        Some(x) if x.is_finite() && (x as f32).is_finite() => Ok(x as f32),
+        _ => Err(value_error(format!(
+            "config: {key} must be a finite number within f32's range (+-3.4e38), not {}",
+            value.repr()?
+        ))),
+    }
+}
+
+/// A configuration field in ms: a whole number (not a bool) from 0 to 2^32 - 1.
+fn ms_field(key: &str, value: &Bound<'_, PyAny>) -> PyResult<u32> {
+    let x = if is_bool(value) {
+        None
+    } else {
+        value.extract::<u32>().ok()
+    };
+    x.ok_or_else(|| {
+        value_error(format!(
+            "config: {key} must be a whole number of ms from 0 to 4294967295, not {}",
+            value.repr().map_or_else(|_| "that".to_string(), |r| r.to_string())
+        ))
+    })
+}
+
+/// A configuration switch: True or False (Python's or numpy's).
+fn flag_field(key: &str, value: &Bound<'_, PyAny>) -> PyResult<bool> {
+    if is_bool(value) {
+        value.is_truthy()
+    } else {
+        Err(value_error(format!(
+            "config: {key} must be True or False, not {}",
+            value.repr()?
+        )))
+    }
+}
+
 /// The monitor's configuration: the default with the given fields replaced.
 fn config_of(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
     let mut c = Config::default();
@@ -442,16 +575,26 @@ fn config_of(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
         } => (warning, alarm, deadband, true),
     };
     for (key, value) in d.iter() {
-        let key: String = key.extract()?;
-        let f = || -> PyResult<f32> { value.extract::<f32>() };
-        let ms = || -> PyResult<u32> { value.extract::<u32>() };
+        let Ok(key) = key.extract::<String>() else {
+            return Err(value_error(format!(
+                "config: a field's name is a str, not {}",
+                key.repr()?
+            )));
+        };
+        let f = || number_field(&key, &value);
+        let ms = || ms_field(&key, &value);
+        let on = || flag_field(&key, &value);
         match key.as_str() {
             "thresholds" => {
-                let kind: String = value.extract()?;
-                on_margin = match kind.as_str() {
-                    "slip_ratio" => false,
-                    "margin" => true,
-                    _ => return Err(value_error("thresholds must be 'slip_ratio' or 'margin'")),
+                on_margin = match value.extract::<String>().as_deref() {
+                    Ok("slip_ratio") => false,
+                    Ok("margin") => true,
+                    _ => {
+                        return Err(value_error(format!(
+                            "config: thresholds must be 'slip_ratio' or 'margin', not {}",
+                            value.repr()?
+                        )));
+                    }
                 };
             }
             "warning" => warning = f()?,
@@ -473,17 +616,17 @@ fn config_of(overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
             "force_max" => c.force_max = f()?,
             "smoothing_tau_s" => c.smoothing_tau_s = f()?,
             "spikes" => {
-                if !value.extract::<bool>()? {
+                if !on()? {
                     c.spikes = None;
                 }
             }
             "trend" => {
-                if !value.extract::<bool>()? {
+                if !on()? {
                     c.trend = None;
                 }
             }
             "friction" => {
-                if !value.extract::<bool>()? {
+                if !on()? {
                     c.friction = None;
                 }
             }
@@ -783,35 +926,51 @@ fn summary<'py, E: Estimator>(py: Python<'py>, m: &Monitor<E>) -> PyResult<Bound
     Ok(d)
 }
 
-/// The threshold planner over loads up to `load_max` (N); `trace_load_max` the
-/// trace's operating range for the model choice, as the replay makes it.
+/// The threshold planner (the monitor example's `--thresholds`): over loads up to
+/// `up_to` (N; `None`: the configuration's `load_max`) or, given `trace_quantile`,
+/// up to 1.2 times a trace's 99.9th percentile of load (N; `None` for a trace without
+/// a finite load); `trace_load_max` the trace's operating range for the model choice,
+/// as the replay makes it. Returns the rows, the range's top (N) and what was changed
+/// from the range asked for (or None); a range the table cannot honour raises
+/// ValueError.
 #[pyfunction]
-#[pyo3(signature = (scene, length, model, load_max, trace_load_max, config=None))]
+#[pyo3(signature = (scene, length, model, from_trace, top, trace_load_max, config=None))]
+#[allow(clippy::too_many_arguments)]
 fn thresholds(
     py: Python<'_>,
     scene: (f64, f64, f64, f64, f64),
     length: Option<f64>,
     model: &str,
-    load_max: f32,
+    from_trace: bool,
+    top: Option<f32>,
     trace_load_max: f64,
     config: Option<&Bound<'_, PyDict>>,
-) -> PyResult<Vec<[f64; 6]>> {
+) -> PyResult<(Vec<[f64; 6]>, f32, Option<String>)> {
     let scene = scene_of(scene, length)?;
     let config = config_of(config)?;
     let choice = choice_for(&scene, trace_load_max)?;
-    match model {
+    let range = if from_trace {
+        output::PlanRange::Trace(top)
+    } else {
+        output::PlanRange::UpTo(top.unwrap_or(config.load_max))
+    };
+    let plan = match model {
         "f32" => {
             let core = Auto::with_choice(&scene, choice).map_err(value_error)?;
-            Ok(py.detach(|| output::threshold_rows(&core, &config, load_max)))
+            py.detach(|| output::threshold_plan(&core, &config, range))
         }
         "fixed" => {
             let core = fixed_core(&scene, choice).map_err(value_error)?;
-            Ok(py.detach(|| output::threshold_rows(&core, &config, load_max)))
+            py.detach(|| output::threshold_plan(&core, &config, range))
         }
-        _ => Err(value_error(format!(
-            "model must be 'f32' or 'fixed', not {model:?}"
-        ))),
+        _ => {
+            return Err(value_error(format!(
+                "model must be 'f32' or 'fixed', not {model:?}"
+            )));
+        }
     }
+    .map_err(value_error)?;
+    Ok((plan.rows, plan.load_max, plan.note))
 }
 
 /// Where the reference's time goes per row, on one thread, for the demo scene over
@@ -899,6 +1058,20 @@ fn reference_cost<'py>(
                 }
             }
         });
+        // A scene per row pays its preparation on each row.
+        let prepare_fast = per_row(&|| {
+            for _ in p {
+                black_box(reference::fast::Prepared::new(
+                    black_box(&scene),
+                    reference::ModelChoice::Section9,
+                ));
+            }
+        });
+        let prepare_f32 = per_row(&|| {
+            for _ in p {
+                let _ = black_box(Auto::new(black_box(&scene)));
+            }
+        });
         [
             shape,
             critical,
@@ -907,6 +1080,8 @@ fn reference_cost<'py>(
             batch,
             f32_core,
             f32_batch,
+            prepare_fast,
+            prepare_f32,
         ]
     });
     let d = PyDict::new(py);
@@ -918,6 +1093,8 @@ fn reference_cost<'py>(
         "batch",
         "f32_core",
         "f32_batch",
+        "prepare_fast",
+        "prepare_f32",
     ]
     .into_iter()
     .zip(figures)

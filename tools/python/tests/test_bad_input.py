@@ -173,10 +173,10 @@ def test_every_model_draws_the_right_angle_at_the_f64_given():
     for model in ["reference", "f32", "fixed"]:
         # The default angle count (the finest the tables allow) ends below a right
         # angle; counts of 1 urad reach it.
-        lsb = {"angle_lsb": 1e-6} if model == "fixed" else {}
-        r = misalign.estimate(*SCENE, 1e3, phi, model=model, **lsb)
-        assert r["error"][0] == "", (model, r["error"])
-        assert "misalignment" in r["error"][1], (model, r["error"])
+        for lsb in [{}, {"counts": "adc", "angle_lsb": 1e-6}] if model == "fixed" else [{}]:
+            r = misalign.estimate(*SCENE, 1e3, phi, model=model, **lsb)
+            assert r["error"][0] == "", (model, lsb, r["error"])
+            assert "misalignment" in r["error"][1], (model, lsb, r["error"])
     for model in ["reference", "f32"]:
         m = misalign.solve_mu(*SCENE[:4], 1e3, phi, 100.0, model=model)
         assert "pi/2" not in m["error"][0], (model, m["error"])

@@ -92,10 +92,17 @@ def test_fixed_core_near_the_reference():
     phi = (np.round(np.geomspace(2e-5, 2e-3, 30) / 1e-10) * 1e-10)[None, :]
     ref = misalign.estimate(0.05, 0.05, 79.3e9, 0.3, 0.3, P, phi)
     fix = misalign.estimate(0.05, 0.05, 79.3e9, 0.3, 0.3, P, phi, model="fixed",
-                            angle_lsb=1e-10)
+                            counts="adc", angle_lsb=1e-10)
     assert fix["s"].shape == (40, 30)
     for c in ["s", "F", "phi0"]:
         assert rel(fix[c], ref[c]).max() <= 1e-4, c
+    # The default, exact counts: any load and angle, the core's own error.
+    P = np.geomspace(0.1037, 2e4, 40)[:, None]
+    phi = np.geomspace(1.13e-7, 2e-3, 30)[None, :]
+    ref = misalign.estimate(0.05, 0.05, 79.3e9, 0.3, 0.3, P, phi)
+    fix = misalign.estimate(0.05, 0.05, 79.3e9, 0.3, 0.3, P, phi, model="fixed")
+    for c in ["s", "F", "phi0"]:
+        assert rel(fix[c], ref[c]).max() <= 1e-5, c
 
 
 def test_threads_give_the_numbers_of_one_thread():

@@ -39,6 +39,9 @@ export class RegisterMap {
       unit: r[at('unit')],
       access: r[at('access')],
       description: r[at('description')],
+      // The values a writable register takes (empty: read only).
+      min: at('min') >= 0 ? r[at('min')] : '',
+      max: at('max') >= 0 ? r[at('max')] : '',
     }));
     this.byName = new Map(this.entries.map((e) => [`${e.table}:${e.name}`, e]));
   }
@@ -63,38 +66,34 @@ export class RegisterMap {
 /** Registers a value of `type` takes. */
 export const wordsOf = (type) => (type === 'u16' ? 1 : 2);
 
-/** The largest value of each integer type a register holds. */
-const LIMITS = { u16: [0, 0xffff], u32: [0, 0xffffffff], i32: [-0x80000000, 0x7fffffff] };
-
 /**
- * `value` (text as a person types it, or a number) as the words of a register of
- * `entry`'s type, high word first; an Error naming the register if it does not fit.
+ * `value` (text as a person types it, or a number) as the words of `entry`'s
+ * register, high word first; an Error naming the register for a value its type or its
+ * domain (the map's `min` and `max`) does not hold, as tools/commission.py checks it.
  */
 export function encode(entry, value) {
   const text = String(value).trim();
+  const { name, min, max, unit } = entry;
+  if (entry.access !== 'rw') throw new Error(`${name} is read only`);
+  const within = `from ${min} to ${max}${unit ? ` ${unit}` : ''}`;
   if (entry.type === 'f32') {
     const x = Number(text);
-    if (text === '' || Number.isNaN(x)) throw new Error(`${entry.name} = ${value}: not a number`);
-    if (Number.isFinite(x) && Math.abs(x) > 3.4028234663852886e38) {
-      throw new Error(`${entry.name} = ${value}: beyond f32`);
-    }
+    if (text === '' || Number.isNaN(x)) throw new Error(`${name} = ${text}: not a number`);
+    const f = Math.fround(x);
+    if (Number.isFinite(x) && !Number.isFinite(f)) throw new Error(`${name} = ${text}: beyond the largest f32 (${within})`);
+    if (min !== '' && !Number.isFinite(f)) throw new Error(`${name} = ${text}: not a finite number (${within})`);
+    if (min !== '' && !(Number(min) <= f && f <= Number(max))) throw new Error(`${name} = ${text}: outside its domain, ${within}`);
     const view = new DataView(new ArrayBuffer(4));
-    view.setFloat32(0, x);
+    view.setFloat32(0, f);
     return [view.getUint16(0), view.getUint16(2)];
   }
-  const [lo, hi] = LIMITS[entry.type] ?? [];
-  if (lo === undefined) throw new Error(`${entry.name}: type ${entry.type}`);
-  if (!/^[+-]?(\d+|0x[0-9a-f]+)$/i.test(text)) {
-    throw new Error(`${entry.name} = ${value}: not a whole number (${entry.type})`);
+  if (entry.type !== 'u16' && entry.type !== 'u32') throw new Error(`${name}: a ${entry.type} register, which the console does not write`);
+  if (!/^(\d+|0x[0-9a-f]+)$/i.test(text)) throw new Error(`${name} = ${text}: not a whole number (${within})`);
+  const v = Number(text);
+  if (!Number.isSafeInteger(v) || v < Number(min) || v > Number(max)) {
+    throw new Error(`${name} = ${text}: outside its domain, a whole number ${within}`);
   }
-  const neg = text.startsWith('-');
-  const v = Number(text.replace(/^[+-]/, '')) * (neg ? -1 : 1);
-  if (!Number.isSafeInteger(v) || v < lo || v > hi) {
-    throw new Error(`${entry.name} = ${value}: outside ${lo} to ${hi} (${entry.type})`);
-  }
-  if (entry.type === 'u16') return [v];
-  const u = v < 0 ? v + 0x100000000 : v;
-  return [Math.floor(u / 0x10000), u % 0x10000];
+  return entry.type === 'u16' ? [v] : [Math.floor(v / 0x10000), v % 0x10000];
 }
 
 /** A register's words as its value: a number (f32 as its bits too, for exact text). */

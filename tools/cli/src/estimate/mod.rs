@@ -70,6 +70,14 @@ SOLVE (--solve mu|phi): the inverse, from a measured axial force F (signed like 
     f32; --model fixed answers every row with an error: the fixed-point core has no
     inverse. Bad rows get a message in error, and the batch goes on.
 
+FIXED-POINT COUNTS (--model fixed): --counts exact (the default) asks the core: each
+    row's P and phi become counts of an LSB that holds them exactly (up to 2^30
+    counts), so the answer carries the core's own error only. --counts adc asks the
+    node with its ADC: P in counts of --load-lsb (default 0.01 N), phi in counts of
+    --angle-lsb (default the finest angle the scene's tables allow, at least 1e-10
+    rad), each rounded to the nearest count, so the answer carries that rounding too.
+    The Python package's estimate(model=\"fixed\", counts=...) is the same choice.
+
 EXIT STATUS: 0; 1 when the input has no header, lacks a column or repeats one, or the
     output cannot be written; 2 for bad options.";
 
@@ -87,6 +95,42 @@ struct Options {
     /// estimate (SOLVE below).
     #[arg(long, value_enum)]
     solve: Option<solve::Unknown>,
+    /// With --model fixed: how P and phi become the core's integer counts.
+    #[arg(long, value_enum, default_value_t = Counts::Exact)]
+    counts: Counts,
+    /// With --counts adc: N per load count [default: 0.01].
+    #[arg(long, value_parser = lsb, allow_hyphen_values = true)]
+    load_lsb: Option<f64>,
+    /// With --counts adc: rad per angle count [default: the finest angle the scene's
+    /// tables allow, at least 1e-10].
+    #[arg(long, value_parser = lsb, allow_hyphen_values = true)]
+    angle_lsb: Option<f64>,
+}
+
+/// An LSB: a finite number above 0.
+fn lsb(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("{text:?} is not a finite number above 0")),
+    }
+}
+
+/// `--counts`: how the fixed-point core's inputs become integer counts.
+#[derive(Clone, Copy, PartialEq, Debug, ValueEnum)]
+pub enum Counts {
+    /// The core: each row's P and phi in counts of an LSB that holds them exactly (up
+    /// to 2^30 counts): the answer carries the core's own error only.
+    Exact,
+    /// The node with its ADC: P in counts of --load-lsb, phi in counts of --angle-lsb,
+    /// each rounded to the nearest count: the answer carries the rounding too.
+    Adc,
+}
+
+/// The ADC's LSBs of `--counts adc`, as given (`None`: the defaults).
+#[derive(Clone, Copy, Debug)]
+struct Adc {
+    load_lsb: Option<f64>,
+    angle_lsb: Option<f64>,
 }
 
 /// `--model`.
@@ -97,8 +141,8 @@ pub enum Model {
     /// The f32 core that runs on a Cortex-M4F (tables, kernels).
     F32,
     /// The fixed-point core for a Cortex-M0/M3; each row's P and phi become integer
-    /// counts of an LSB that holds them exactly (up to 2^30 counts). It has no
-    /// inverse: with --solve, each row's error says so.
+    /// counts as --counts says. It has no inverse: with --solve, each row's error says
+    /// so.
     Fixed,
 }
 
@@ -432,6 +476,9 @@ fn f32_row(x: &Sample) -> Result<Answer, String> {
     })
 }
 
+/// The ADC's load LSB of `--counts adc` without `--load-lsb` (N): 10 mN, as the nodes.
+const ADC_LOAD_LSB: f64 = 1e-2;
+
 /// The fixed-point core's messages, with the value and the range it missed.
 fn fixed_error(e: Error, what: &str) -> String {
     match e {
@@ -444,8 +491,9 @@ fn signed(x: Log2, negative: bool) -> f64 {
     if negative { -x.to_f64() } else { x.to_f64() }
 }
 
-/// The fixed-point core's answer for one row.
-fn fixed_row(x: &Sample) -> Result<Answer, String> {
+/// The fixed-point core's answer for one row: its counts exact (`adc` None) or an
+/// ADC's.
+fn fixed_row(x: &Sample, adc: Option<Adc>) -> Result<Answer, String> {
     let (scene, load, phi, choice) = (&x.scene, x.load, x.phi, x.choice);
     if !(load.is_finite() && load >= 0.0) {
         return Err(Error::Load.to_string());
@@ -460,12 +508,54 @@ fn fixed_row(x: &Sample) -> Result<Answer, String> {
     } else {
         FixedEllipticScene::min_angle_lsb(scene)
     };
-    let (load_lsb, p) = exact_lsb(load, 1 << 30, 0.0);
-    let (angle_lsb, a) = exact_lsb(phi, 1 << 30, min_angle);
-    let angle = i32::try_from(a).map_err(|_| Error::Angle.to_string())?;
-    let angle = if phi < 0.0 { -angle } else { angle };
+    let (load_lsb, p, angle_lsb, angle) = match adc {
+        None => {
+            let (load_lsb, p) = exact_lsb(load, 1 << 30, 0.0);
+            let (angle_lsb, a) = exact_lsb(phi, 1 << 30, min_angle);
+            let angle = i32::try_from(a).map_err(|_| Error::Angle.to_string())?;
+            (
+                load_lsb,
+                p,
+                angle_lsb,
+                if phi < 0.0 { -angle } else { angle },
+            )
+        }
+        Some(adc) => {
+            if phi.abs() > core::f64::consts::FRAC_PI_2 {
+                return Err(Error::Angle.to_string());
+            }
+            let load_lsb = adc.load_lsb.unwrap_or(ADC_LOAD_LSB);
+            let angle_lsb = adc.angle_lsb.unwrap_or(min_angle.max(1e-10));
+            let (p, a) = ((load / load_lsb).round(), (phi / angle_lsb).round());
+            if p > u32::MAX as f64 || a.abs() > i32::MAX as f64 {
+                return Err(fixed_error(
+                    Error::OutOfRange,
+                    &format!(
+                        "P or phi beyond 2^32 counts of --load-lsb {load_lsb:e} N, --angle-lsb {angle_lsb:e} rad"
+                    ),
+                ));
+            }
+            (load_lsb, p as u32, angle_lsb, a as i32)
+        }
+    };
     let auto = FixedAuto::with_choice(scene, load_lsb, angle_lsb, choice).map_err(|e| {
-        if angle_lsb < min_angle {
+        if adc.is_some() && angle_lsb < min_angle {
+            fixed_error(
+                e,
+                &format!(
+                    "--angle-lsb {angle_lsb:e} rad is finer than this scene's tables allow, \
+                     {min_angle:e} rad (theta = c |phi| >= 2^-40 rad, eq 4)"
+                ),
+            )
+        } else if adc.is_some() {
+            fixed_error(
+                e,
+                &format!(
+                    "a scene constant or --load-lsb {load_lsb:e} N, --angle-lsb {angle_lsb:e} \
+                     rad is outside its Q8.24 logarithms (2^-100 to 2^100)"
+                ),
+            )
+        } else if angle_lsb < min_angle {
             fixed_error(
                 e,
                 &format!(
@@ -603,6 +693,26 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
             };
         }
     };
+    let adc_only = [
+        ("--load-lsb", options.load_lsb),
+        ("--angle-lsb", options.angle_lsb),
+    ];
+    if let Some((name, _)) = adc_only.iter().find(|(_, v)| v.is_some())
+        && (options.model != Model::Fixed || options.counts != Counts::Adc)
+    {
+        let _ = writeln!(
+            err,
+            "estimate: {name} is the ADC's: it needs --model fixed --counts adc"
+        );
+        return 2;
+    }
+    if options.counts == Counts::Adc && options.model != Model::Fixed {
+        let _ = writeln!(
+            err,
+            "estimate: --counts is the fixed-point core's: it needs --model fixed"
+        );
+        return 2;
+    }
     let mut data = Vec::new();
     if let Err(e) = input.read_to_end(&mut data) {
         let _ = writeln!(err, "estimate: cannot read the input: {e}");
@@ -631,6 +741,10 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
         }
     };
     let choice = options.contact.choice();
+    let adc = (options.counts == Counts::Adc).then_some(Adc {
+        load_lsb: options.load_lsb,
+        angle_lsb: options.angle_lsb,
+    });
     let mut writer = csv::Writer::from_writer(output);
     let mut record = csv::ByteRecord::new();
     let (mut flags, mut message) = (String::new(), String::new());
@@ -675,7 +789,7 @@ pub fn run(args: &[String], mut input: impl Read, output: impl Write, err: &mut 
                             match options.model {
                                 Model::Reference => reference_row(&x),
                                 Model::F32 => f32_row(&x),
-                                Model::Fixed => fixed_row(&x),
+                                Model::Fixed => fixed_row(&x, adc),
                             }
                         },
                     );

@@ -34,7 +34,10 @@ TRACE: a row without a usable time (t empty, not a number or not finite; a field
     other than the header's; an unterminated quote) is skipped; the skipped rows are
     counted and the first few named in the summary and on stderr. A row with a time but
     a P, phi, V or F cell that is not a number becomes a sample with that value not
-    finite, which the monitor counts as a sensor fault. A time the monitor's clock cannot
+    finite, which the monitor counts as a sensor fault; an optional `fault` column names
+    a sensor's own fault as a node reports it (load, probe1, probe2 or speed, a colon,
+    and disconnected, bus, saturated, stuck, jump or out_of_range: what `cargo xtask
+    pico --samples` writes). A time the monitor's clock cannot
     represent refuses the trace before the replay, naming the row: beyond 2^53 ms (t in
     ns, say), or a step of 2^31 ms (24.8 days) or more between rows, which the node's
     wrapping u32 millisecond counter cannot tell from a shorter one. Times within the
@@ -74,10 +77,10 @@ struct Args {
     /// each pixel column shows the lowest and highest value in it).
     #[arg(long, value_name = "OUT.svg")]
     plot: Option<PathBuf>,
-    /// With --plot: for the scene over a load range, the critical angle phi0(P) and
-    /// the misalignment at which each state triggers and clears (CSV; its figure is
-    /// written beside the plot as *-thresholds.svg).
-    #[arg(long, value_name = "OUT.csv", requires = "plot")]
+    /// For the scene over a load range, the critical angle phi0(P) and the
+    /// misalignment at which each state triggers and clears (CSV; with --plot, its
+    /// figure is written beside the plot as *-thresholds.svg).
+    #[arg(long, value_name = "OUT.csv")]
     thresholds: Option<PathBuf>,
 }
 
@@ -361,20 +364,29 @@ fn run_replay(mut replay: Replay, args: &Args, total: u64, io: &mut Io<'_>) -> R
         plot::timeline(path, &timeline)?;
         let _ = writeln!(io.err, "wrote {}", path.display());
     }
-    if let (Some(path), Some(plot_path), Some(table)) =
-        (&args.thresholds, &args.plot, replay.thresholds())
-    {
+    if let Some(path) = &args.thresholds {
+        let plan = replay
+            .thresholds()
+            .ok_or("--thresholds: the loads were not counted")?
+            .map_err(|e| format!("--thresholds: {e}"))?;
+        if let Some(note) = &plan.note {
+            let _ = writeln!(io.err, "monitor: --thresholds: {note}");
+        }
+        let table = plan.rows;
         std::fs::write(path, output::thresholds_csv(&table))?;
         let _ = writeln!(io.err, "wrote {}", path.display());
-        let svg = plot_path.with_file_name(format!(
-            "{}-thresholds.svg",
-            plot_path
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .unwrap_or("monitor")
-        ));
-        plot::thresholds(&svg, &table, operating.points())?;
-        let _ = writeln!(io.err, "wrote {}", svg.display());
+        // Its figure beside the run's plot, when there is one.
+        if let Some(plot_path) = &args.plot {
+            let svg = plot_path.with_file_name(format!(
+                "{}-thresholds.svg",
+                plot_path
+                    .file_stem()
+                    .and_then(|s| s.to_str())
+                    .unwrap_or("monitor")
+            ));
+            plot::thresholds(&svg, &table, operating.points())?;
+            let _ = writeln!(io.err, "wrote {}", svg.display());
+        }
     }
     Ok(())
 }

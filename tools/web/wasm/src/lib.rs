@@ -148,9 +148,12 @@ pub fn review<R: Read>(
     };
     let mut second = samples(reader())?;
     replay::run(&mut replay, &mut second, &mut sink).map_err(|e| format!("trace: {e}"))?;
-    let thresholds = replay
-        .thresholds()
-        .map(|rows| output::thresholds_csv(&rows));
+    let thresholds = match replay.thresholds() {
+        None => None,
+        Some(plan) => Some(output::thresholds_csv(
+            &plan.map_err(|e| format!("the planner: {e}"))?.rows,
+        )),
+    };
     let events = String::from_utf8(sink.events.into_inner()).map_err(|e| e.to_string())?;
     Ok(Reviewed {
         events,
@@ -234,9 +237,10 @@ pub fn plan_text(scene: Option<&str>, model: Model, load_max: f64, config: &Conf
         return Err(format!("the highest load {load_max} N is not a load"));
     }
     let scene = scene_of(scene)?;
-    let rows = replay::plan(model, &scene, config, load_max, load_max as f32)
-        .map_err(|e| e.to_string())?;
-    Ok(output::thresholds_csv(&rows))
+    let range = output::PlanRange::UpTo(load_max as f32);
+    let plan = replay::plan(model, &scene, config, load_max, range)
+        .map_err(|e| format!("the planner: {e}"))?;
+    Ok(output::thresholds_csv(&plan.rows))
 }
 
 /// Section 9's contact model for `scene` over loads up to `load_max` (N), as the

@@ -1,0 +1,85 @@
+//! What the server holds besides the framer ([`Core`]): the monitor, the alarms'
+//! annunciation, the event window, the commissioning state, the counters and the
+//! response being built; and the path of a sample through them. The answers to
+//! requests are `pdu.rs`'s, the registers' values `values.rs`'s.
+
+use super::config::Commissioning;
+use super::events::{EventWindow, StorageStatus};
+use super::ident::Identification;
+use super::rtu::{ADU_MAX, FramingCounters};
+use crate::Estimator;
+use crate::monitor::annunciation::{AlarmSet, Annunciator};
+use crate::monitor::{Monitor, RiskState, Sample};
+
+/// What the server has counted (besides the monitor's own statistics).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Counters {
+    /// The framer's counts: frames with a valid CRC, bytes discarded.
+    pub framing: FramingCounters,
+    /// Requests for this unit or broadcast.
+    pub server_messages: u32,
+    /// Exception responses sent.
+    pub exceptions: u32,
+    /// Responses replaced by the answer to a later request before they were sent.
+    pub responses_overwritten: u32,
+    /// External samples taken from the bus and processed.
+    pub external_accepted: u32,
+    /// Writes of external samples refused (none of their samples processed).
+    pub external_refused: u32,
+}
+
+/// How a sample reaches the monitor: `Monitor::process`, or
+/// `Monitor::process_with_friction` (f32 scenes).
+pub(super) type Step<E> = fn(&mut Monitor<E>, Sample) -> RiskState;
+
+/// Everything but the framer (whose buffer holds the request being answered).
+/// `repr(C)`: what every request touches first, the buffers and the monitor after.
+#[derive(Debug, Clone)]
+#[repr(C)]
+pub(super) struct Core<E> {
+    /// The response's length; 0: none due.
+    pub(super) response_len: usize,
+    /// The response waits for the application's storage ([`Server::stored`](super::Server::stored)).
+    pub(super) held: bool,
+    pub(super) unit: u8,
+    pub(super) step: Step<E>,
+    pub(super) ident: Identification,
+    pub(super) model_name: &'static str,
+    pub(super) annunciator: Annunciator,
+    pub(super) events: EventWindow,
+    pub(super) external: bool,
+    /// The last sample's own timestamp.
+    pub(super) last_time_ms: u32,
+    pub(super) counters: Counters,
+    /// The last acknowledgement a master wrote (`event_ack`).
+    pub(super) ack: Option<u32>,
+    pub(super) storage: StorageStatus,
+    pub(super) response: [u8; ADU_MAX],
+    pub(super) monitor: Monitor<E>,
+    /// The staged configuration, the unlock, the commits.
+    pub(super) commissioning: Commissioning<E>,
+}
+
+impl<E: Estimator> Core<E> {
+    pub(super) fn process(&mut self, sample: Sample) -> RiskState {
+        let state = (self.step)(&mut self.monitor, sample);
+        self.last_time_ms = sample.time_ms;
+        self.drain();
+        state
+    }
+
+    /// The monitor's queued events into the window (unless the application takes
+    /// them: [`Server::store_events`](super::Server::store_events)); the alarms from its state.
+    pub(super) fn drain(&mut self) {
+        // Every queued event is numbered already: `next` is after all of them.
+        let next = self.monitor.next_event_seq();
+        self.events.follow(next);
+        while !self.events.stored
+            && let Some(e) = self.monitor.pop_event()
+        {
+            self.events.push(e, next);
+        }
+        self.annunciator.update(AlarmSet::of(&self.monitor));
+    }
+}
