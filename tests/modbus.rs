@@ -167,9 +167,20 @@ fn status_of_a_fresh_and_a_running_monitor() {
     assert_eq!(regs[0], 0x0300);
     assert_eq!(u32_at(&regs, 2), NONE);
     assert_eq!(u32_at(&regs, 14), NONE);
-    for i in 0..300u32 {
+    let sample = |i: u32| {
         let noise = (i % 7) as f32;
-        s.process(Sample::new(i * 1000, 2e3 + noise, 1e-4 + 1e-7 * noise).with_speed(2.0));
+        Sample::new(i * 1000, 2e3 + noise, 1e-4 + 1e-7 * noise).with_speed(2.0)
+    };
+    // While the first 7 samples fill the spike window, the conditioning settles: the
+    // state held (stopped), NE 107 function check; the 8th starts the machine.
+    for i in 0..7u32 {
+        s.process(sample(i));
+        assert!(s.monitor().settling());
+        assert_eq!(read(&mut s, 4, 0, 1)[0], 0x0300, "sample {i}");
+    }
+    for i in 7..300u32 {
+        s.process(sample(i));
+        assert!(!s.monitor().settling());
     }
     let regs = read(&mut s, 4, 0, 20);
     let m = s.monitor();

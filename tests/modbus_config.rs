@@ -358,11 +358,15 @@ fn a_scene_written_in_blocks_replaces_the_estimators() {
     assert_eq!(s.monitor().estimator().to_bytes().to_vec(), bytes);
     assert_eq!(get(&mut s, "scene_active_crc"), own_crc);
     assert_eq!(s.monitor().config(), &Config::default());
-    s.process(Sample::new(5000, 3e3, 2e-4).with_speed(2.0));
+    // The conditioning starts afresh with the new scene: its reading comes once 7
+    // samples have filled the spike window, at the 8th.
+    for i in 5..13 {
+        s.process(Sample::new(i * 1000, 3e3 + i as f32, 2e-4).with_speed(2.0));
+    }
     let r = s.monitor().reading().unwrap();
     let e = new_core.estimate_si(r.load, r.phi).unwrap();
     assert_eq!(r.slip_ratio.to_bits(), e.slip_ratio.to_bits());
-    assert_eq!(s.monitor().statistics().samples(), 6);
+    assert_eq!(s.monitor().statistics().samples(), 13);
 }
 
 #[test]

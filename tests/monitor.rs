@@ -27,19 +27,12 @@ fn plain() -> Config {
     }
 }
 
-/// The misalignment (rad) at which d/b = `target` at `load`, by bisection.
+#[path = "common/slip.rs"]
+mod slip;
+
+/// The misalignment (rad) at which d/b = `target` at `load`.
 fn angle_for(target: f32, load: f32) -> f32 {
-    let c = core();
-    let (mut lo, mut hi) = (0.0f32, 0.01f32);
-    for _ in 0..80 {
-        let mid = 0.5 * (lo + hi);
-        if c.estimate_si(load, mid).unwrap().slip_ratio < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
+    slip::angle_for(&core(), target, load)
 }
 
 /// Feeds one sample a second at `phi` from `t0` (s) for `n` samples; returns the
@@ -707,7 +700,8 @@ fn the_model_is_chosen_once_for_the_operating_range() {
 /// it: with a fault delay longer than the dropout, 120 s at 2 kN and 0.1 mrad (with
 /// some noise: a constant value is a stuck sensor), 10 s of `P = NaN` and then one
 /// sample at 3 mrad leave the state `Normal`; gross slip that lasts is entered after
-/// the on-delay from its own first sample.
+/// the conditioning settled (7 samples fill the spike window) and the on-delay from
+/// the first sample that decided it.
 #[test]
 fn a_pending_fault_hands_no_time_to_a_slip_candidate() {
     let config = Config {
@@ -724,10 +718,11 @@ fn a_pending_fault_hands_no_time_to_a_slip_candidate() {
         let state = m.process(Sample::new(t * 1000, f32::NAN, 1e-4));
         assert_eq!(state, RiskState::Normal);
     }
-    let states: Vec<RiskState> = (130..140u32).map(|t| m.process(noisy(t, 3e-3))).collect();
+    let states: Vec<RiskState> = (130..150u32).map(|t| m.process(noisy(t, 3e-3))).collect();
     let entered = states.iter().position(|&s| s == RiskState::GrossSlip);
-    // The first gross-slip sample at 130 s: entered at 135 s, not before.
-    assert_eq!(entered, Some(5), "{states:?}");
+    // The window filled by 136 s, the first sample that decides at 137 s: entered at
+    // 142 s, not before.
+    assert_eq!(entered, Some(12), "{states:?}");
 }
 
 /// The fit's slope over its standard error (f64), from the trend's points.
@@ -851,4 +846,155 @@ fn approaching_never_for_a_crossing_already_past() {
         }
     }
     assert_eq!(approaching, []);
+}
+
+/// Normal running at 2 kN and 0.1 mrad with some noise, one sample a second from `t0`
+/// (s) for `n` samples; the states after each.
+fn normal_run<E: Estimator>(m: &mut Monitor<E>, t0: u32, n: u32) -> Vec<RiskState> {
+    (t0..t0 + n)
+        .map(|t| {
+            let noise = (t % 7) as f32;
+            m.process(Sample::new(t * 1000, LOAD + noise, 1e-4 + 1e-7 * noise))
+        })
+        .collect()
+}
+
+/// One glitch after a dropout: with the defaults and a minute's fault delay, 120 s
+/// normal, 10 s with a NaN load, one sample at 3 mrad, then normal samples again. The
+/// conditioning starts afresh after the dropout and settles on fresh samples before
+/// any of them decides a state: the glitch never raises anything.
+#[test]
+fn one_glitch_after_a_dropout_raises_nothing() {
+    let config = Config {
+        fault_delay_ms: 60_000,
+        ..Config::default()
+    };
+    let mut m = Monitor::new(core(), config).unwrap();
+    normal_run(&mut m, 0, 120);
+    assert_eq!(m.state(), RiskState::Normal);
+    for t in 120..130 {
+        assert_eq!(
+            m.process(Sample::new(t * 1000, f32::NAN, 1e-4)),
+            RiskState::Normal
+        );
+    }
+    assert_eq!(
+        m.process(Sample::new(130_000, LOAD, 3e-3)),
+        RiskState::Normal
+    );
+    assert!(m.settling());
+    let after = normal_run(&mut m, 131, 120);
+    assert!(after.iter().all(|&s| s == RiskState::Normal), "{after:?}");
+    let changes = changes(&mut m);
+    assert_eq!(
+        changes,
+        [(7_000, RiskState::Stopped, RiskState::Normal)],
+        "only the start"
+    );
+}
+
+type Demo = Monitor<EllipticScene<'static>>;
+/// A restart of the demo monitor at `t` s; returns the time of the next sample (s).
+type Restart = fn(&mut Demo, u32) -> u32;
+
+/// Every path that starts the conditioning afresh settles before a sample decides
+/// again: after a dropout, a stop, a new configuration or scene, and a checkpoint
+/// restored mid-settling or taken under other accepted ranges, one sample at 3 mrad
+/// (gross slip) and then normal ones raise nothing. The state is held, and
+/// `settling()` says so, while 7 valid running samples fill the spike window; the 8th,
+/// the first tested, decides. A reset of the statistics leaves the conditioning as it
+/// is.
+#[test]
+fn every_restart_settles_before_a_sample_decides() {
+    let config = Config {
+        fault_delay_ms: 60_000,
+        ..Config::default()
+    };
+    let restarts: [(&str, Restart); 6] = [
+        ("a dropout", |m, t| {
+            (t..t + 10).for_each(|t| {
+                m.process(Sample::new(t * 1000, f32::NAN, 1e-4));
+            });
+            t + 10
+        }),
+        ("a stop", |m, t| {
+            (t..t + 60).for_each(|t| {
+                m.process(Sample::new(t * 1000, 20.0, 1e-4));
+            });
+            t + 60
+        }),
+        ("a new configuration", |m, t| {
+            m.set_config(*m.config()).unwrap();
+            t
+        }),
+        ("a new scene", |m, t| {
+            m.set_estimator(core());
+            t
+        }),
+        ("a checkpoint of other accepted ranges", |m, t| {
+            // Taken from a monitor that accepts loads up to 60 kN and ran at 55 kN:
+            // this one's conditioning cannot take its windows.
+            let wide = Config {
+                load_max: 60_000.0,
+                ..*m.config()
+            };
+            let mut other = Monitor::new(core(), wide).unwrap();
+            for i in 0..t {
+                other.process(Sample::new(i * 1000, 55e3 + (i % 7) as f32, 1e-4));
+            }
+            *m = Monitor::restore(core(), *m.config(), &other.snapshot()).unwrap();
+            t
+        }),
+        ("a checkpoint taken while settling", |m, t| {
+            (t..t + 10).for_each(|t| {
+                m.process(Sample::new(t * 1000, f32::NAN, 1e-4));
+            });
+            m.process(Sample::new((t + 10) * 1000, LOAD, 1e-4));
+            *m = Monitor::restore(core(), *m.config(), &m.snapshot()).unwrap();
+            t + 11
+        }),
+    ];
+    for (restart, go) in restarts {
+        let mut m = Monitor::new(core(), config).unwrap();
+        normal_run(&mut m, 0, 120);
+        let t = go(&mut m, 120);
+        let held = m.state();
+        m.process(Sample::new(t * 1000, LOAD, 3e-3));
+        assert_eq!(m.state(), held, "{restart}");
+        assert!(m.settling(), "{restart}");
+        // The glitch is the first fresh sample (the second after the checkpoint taken
+        // while settling); the 8th decides.
+        let fresh = if restart.contains("while settling") {
+            2
+        } else {
+            1
+        };
+        let deciding = 8 - fresh - 1;
+        let mut states = Vec::new();
+        for t in t + 1..t + 61 {
+            states.push(normal_run(&mut m, t, 1)[0]);
+            assert_eq!(
+                m.settling(),
+                states.len() < deciding + 1,
+                "{restart} at {t} s"
+            );
+        }
+        assert!(
+            states[..deciding].iter().all(|&s| s == held),
+            "{restart}: {states:?}"
+        );
+        assert!(
+            states[deciding..].iter().all(|&s| s == RiskState::Normal),
+            "{restart}: {states:?}"
+        );
+        // A reset of the statistics is no restart.
+        m.reset_statistics();
+        assert!(!m.settling());
+        assert_eq!(m.statistics().spikes(), 0);
+        assert_eq!(
+            m.process(Sample::new((t + 61) * 1000, LOAD, 3e-3)),
+            RiskState::Normal
+        );
+        assert_eq!(m.statistics().spikes(), 1, "{restart}: tested as a spike");
+    }
 }

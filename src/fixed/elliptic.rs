@@ -1,6 +1,6 @@
 //! The elliptic contact (paper sections 5-7) in fixed point.
 
-use super::logexp::{div3, exp2_finite, log2_u32};
+use super::logexp::{div3, exp2_finite, log2_positive, log2_u32};
 use super::tables::{
     LOG_FORCE_OVER_S, LOG_G_HIGH, LOG_G_LOW, LOG_M_HIGH, LOG_M_LOW, LOG_THETA_HIGH, LOG_THETA_LOW,
 };
@@ -180,21 +180,28 @@ impl FixedEllipticScene {
     #[inline(always)]
     pub fn estimate(&self, load: u32, angle: i32) -> Result<FixedEstimate, Error> {
         let a = angle.unsigned_abs();
-        if a > self.range.angle_max {
-            return Err(Error::Angle);
-        }
+        // The angle's range is tested once, below, at both ends; where a sample is
+        // refused before that, its angle is tested first.
+        let refusal = |load_error| {
+            if a > self.range.angle_max {
+                Error::Angle
+            } else {
+                load_error
+            }
+        };
         // load_min >= 1: one compare on the common path, zero load inside it.
         if load < self.range.load_min {
-            return if load == 0 {
+            return if load == 0 && a <= self.range.angle_max {
                 Ok(zero_load(a, self.log_risk))
             } else {
-                Err(Error::OutOfRange)
+                Err(refusal(Error::OutOfRange))
             };
         }
-        let lp = log2_u32(load);
+        // load >= 1: log2 without its test for 0. Wrapping adds below never wrap: `new`
+        // bounded the constants (|log2| < 100) and every sum over the declared range
+        // (`check_sums`); counts add < 32, tables < 42.
+        let lp = log2_positive(load);
         let lp3 = div3(lp);
-        // Wrapping adds below never wrap: `new` bounded the constants (|log2| < 100) and
-        // every sum over the declared range (`check_sums`); counts add < 32, tables < 42.
         // Critical angle: g(theta0) = g0 (eq 18 at d/b = 1), phi0 = theta0 / c.
         let z = self.log_critical.wrapping_add(lp3);
         // No critical angle above g0 = pi/2 (eq 18), nor where phi0 = theta0 / c would
@@ -202,7 +209,7 @@ impl FixedEllipticScene {
         let (critical, margin) = if z > self.log_g0_max {
             (None, None)
         } else {
-            let log_theta0 = lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z)?;
+            let log_theta0 = lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z).map_err(refusal)?;
             // Both within the tables' theta range, 2^-42 .. pi/2.
             let counts = margin_counts(log_theta0.wrapping_sub(self.log_theta_lsb), a);
             (
@@ -210,14 +217,35 @@ impl FixedEllipticScene {
                 Some(counts),
             )
         };
-        if a == 0 {
-            return Ok(zero_angle(critical, margin));
+        // Both ends of the angle's range in one unsigned compare (0 wraps above it):
+        // zero angle answers with the critical angle, above the range is refused.
+        if a.wrapping_sub(1) >= self.range.angle_max {
+            return if a == 0 {
+                Ok(zero_angle(critical, margin))
+            } else {
+                Err(Error::Angle)
+            };
         }
+        self.misaligned(a, angle < 0, (lp, lp3), critical, margin)
+    }
+
+    /// The estimate of a misaligned (`a` >= 1 counts), loaded (`load` >= load_min)
+    /// sample, with log2 of its load counts and their third, and its critical angle;
+    /// its wrapping adds are bounded as in `estimate`.
+    #[inline(always)]
+    fn misaligned(
+        &self,
+        a: u32,
+        negative: bool,
+        (lp, lp3): (i32, i32),
+        critical_angle: Option<Log2>,
+        margin: Option<i32>,
+    ) -> Result<FixedEstimate, Error> {
         // d/b = A g(theta) P^(-1/3) (eq 16).
         let log_g = lookup(
             LOG_G_LOW,
             LOG_G_HIGH,
-            self.log_theta_lsb.wrapping_add(log2_u32(a)),
+            self.log_theta_lsb.wrapping_add(log2_positive(a)),
         )?;
         let ls = self.log_slip.wrapping_add(log_g).wrapping_sub(lp3);
         // F / (mu P) = s r(s) for s < 1 (eq 21), 1 beyond (eq 29); never above 1.
@@ -233,8 +261,8 @@ impl FixedEllipticScene {
             slip_ratio: Log2(ls),
             regime,
             axial_force: Log2(self.log_force.wrapping_add(lp).wrapping_add(log_ratio)),
-            axial_force_negative: angle < 0,
-            critical_angle: critical,
+            axial_force_negative: negative,
+            critical_angle,
             margin,
             microslip_risk: ls >= self.log_risk,
         })
@@ -483,5 +511,95 @@ impl FixedEllipticScene {
         )?;
         scene.check_sums().map_err(|_| PreparedError::Value)?;
         Ok(scene)
+    }
+}
+
+#[cfg(test)]
+mod order_tests {
+    use super::*;
+    use std::vec;
+
+    impl FixedEllipticScene {
+        /// The estimate with its tests in their plain order (the angle's range, the
+        /// load's, the critical angle's bound, zero angle), as it was written before the
+        /// per-sample path merged them.
+        fn estimate_plain(&self, load: u32, angle: i32) -> Result<FixedEstimate, Error> {
+            let a = angle.unsigned_abs();
+            if a > self.range.angle_max {
+                return Err(Error::Angle);
+            }
+            if load < self.range.load_min {
+                return if load == 0 {
+                    Ok(zero_load(a, self.log_risk))
+                } else {
+                    Err(Error::OutOfRange)
+                };
+            }
+            let lp = log2_u32(load);
+            let lp3 = div3(lp);
+            let z = self.log_critical.wrapping_add(lp3);
+            let (critical, margin) = if z > self.log_g0_max {
+                (None, None)
+            } else {
+                let log_theta0 = lookup(LOG_THETA_LOW, LOG_THETA_HIGH, z)?;
+                let counts = margin_counts(log_theta0.wrapping_sub(self.log_theta_lsb), a);
+                (
+                    Some(Log2(log_theta0.wrapping_sub(self.log_radius_factor))),
+                    Some(counts),
+                )
+            };
+            if a == 0 {
+                return Ok(zero_angle(critical, margin));
+            }
+            self.misaligned(a, angle < 0, (lp, lp3), critical, margin)
+        }
+    }
+
+    /// `estimate` answers as the plain order of tests, answers and refusals alike: over
+    /// scenes of equal and very unequal radii (phi0 beyond pi/2 at heavy loads), soft
+    /// and stiff, frictions and LSBs over many decades (light loads whose critical
+    /// angle falls off the table among them), at every edge of the angle and the load.
+    #[test]
+    fn merged_tests_answer_as_the_plain_order() {
+        let (mut answers, mut refusals) = (0, 0);
+        for (r1, r2) in [(0.05, 0.05), (0.02, 0.5), (1e-3, 1.0), (1e-6, 1e3)] {
+            for (g, mu) in [(79.3e9, 0.3), (1e6, 1e-6), (1e15, 30.0)] {
+                let scene = Scene::new(r1, r2, g, 0.3, mu).unwrap();
+                for lp in (-60..=40).step_by(10) {
+                    for la in [-40, -20, -1] {
+                        let angle_lsb = f64::max(
+                            libm::exp2(la as f64),
+                            FixedEllipticScene::min_angle_lsb(&scene),
+                        );
+                        let Ok(core) =
+                            FixedEllipticScene::new(&scene, libm::exp2(lp as f64), angle_lsb)
+                        else {
+                            continue;
+                        };
+                        let (min, max) = (core.range.load_min, core.range.angle_max);
+                        let mut loads = vec![0, 1, 2, u32::MAX, min.saturating_sub(1)];
+                        loads.extend((0..64).map(|k| min.saturating_add(k * k * k)));
+                        loads.extend((0..32).map(|k| 1u32 << k));
+                        let mut angles = vec![0, 1, 2, i32::MAX, i32::MIN, i32::MIN + 1];
+                        angles.extend([max, max.wrapping_add(1), max / 2].map(|x| x as i32));
+                        angles.extend((0..31).map(|k| 1i32 << k));
+                        for &load in &loads {
+                            for &angle in &angles {
+                                for angle in [angle, angle.wrapping_neg()] {
+                                    let want = core.estimate_plain(load, angle);
+                                    assert_eq!(core.estimate(load, angle), want, "{load} {angle}");
+                                    if want.is_ok() {
+                                        answers += 1;
+                                    } else {
+                                        refusals += 1;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(answers > 10_000 && refusals > 1_000, "{answers} {refusals}");
     }
 }

@@ -34,6 +34,24 @@ pub fn log2_u32(x: u32) -> i32 {
     ((31 - lz as i32) << 24).wrapping_add(mantissa)
 }
 
+/// [`log2_u32`] for `x >= 1`, without its test for 0 (`x = 0` gives an unspecified
+/// value, never a panic): for counts that a scene's range already holds at 1 or above.
+#[inline(always)]
+pub(crate) fn log2_positive(x: u32) -> i32 {
+    // As `normalize`, with the shift wrapping: 0 shifts by 32 where `CLZ` gives it.
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    let (lz, normalized) = normalize_by_search(x);
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    let (lz, normalized) = {
+        let lz = x.leading_zeros();
+        (lz, x.wrapping_shl(lz))
+    };
+    let fraction = (normalized << 1) >> 8;
+    let mantissa = LOG2_MANTISSA.eval(fraction as i32).unwrap_or_default();
+    // lz <= 32 (32 for x = 0 only): the subtraction cannot wrap.
+    (31 - lz as i32).wrapping_shl(24).wrapping_add(mantissa)
+}
+
 /// `x / 3` for non-negative x, exactly, by shifts (a Cortex-M0 has no divider).
 /// `(lz, x << lz)` for x > 0, lz its leading zeros: one `CLZ` where the core has
 /// it; on ARMv6-M (the Cortex-M0; the Arm target without compare-and-swap atomics)

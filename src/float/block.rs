@@ -5,7 +5,7 @@
 //! them; the table reads many rows deep in flight), instead of one long dependent chain
 //! per sample. A sample off the hot path is marked and left to the caller.
 
-use super::elliptic::{Parts, in_hot_range};
+use super::elliptic::{Parts, off_hot_range};
 use super::kernels::cbrt::cbrt_hot;
 use super::{Auto, EllipticScene};
 use crate::reference::{ContactModel, Regime};
@@ -74,7 +74,7 @@ impl EllipticScene<'_> {
         {
             let abs_phi = phi.abs();
             let w = self.cubed_critical_gain * load; // g0^3 (eq 18 at d/b = 1)
-            *hot = in_hot_range(abs_phi, w);
+            *hot = !off_hot_range(abs_phi, w);
             *theta = self.radius_factor * abs_phi; // eq (4)
             *g0 = cbrt_hot(w);
         }

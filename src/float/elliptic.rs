@@ -97,14 +97,16 @@ pub(super) struct Parts {
     pub(super) critical_angle: Option<f32>,
 }
 
-/// Whether a sample is in the hot path's range: |phi| <= 1 and B^3 P = `w` in
-/// [2^-81, 1/2), on the bits, each one unsigned compare with immediates: |phi| > 1
+/// Whether a sample is outside the hot path's range, |phi| <= 1 and B^3 P = `w` in
+/// [2^-81, 1/2): on the bits, each one unsigned compare with an immediate. |phi| > 1
 /// includes inf and NaN, whose patterns lie above; B^3 P outside the range includes a
-/// load that is 0, negative, NaN or inf.
+/// load that is 0, negative, NaN or inf. Stated as the test that fails: `x > 1.0`'s
+/// bound is an immediate of Thumb-2, while the compiler forms `x <= 1.0` as `x <` the
+/// next pattern, which is not (three instructions more on the Cortex-M4F).
 #[inline(always)]
-pub(super) fn in_hot_range(abs_phi: f32, w: f32) -> bool {
-    abs_phi.to_bits() <= 1.0f32.to_bits()
-        && w.to_bits().wrapping_sub(HOT_CUBE_LOW_BITS) < HOT_CUBE_SPAN
+pub(super) fn off_hot_range(abs_phi: f32, w: f32) -> bool {
+    abs_phi.to_bits() > 1.0f32.to_bits()
+        || w.to_bits().wrapping_sub(HOT_CUBE_LOW_BITS) >= HOT_CUBE_SPAN
 }
 
 /// A prepared elliptic-contact scene: the per-sample constants of eqs (4), (16), (18).
@@ -244,7 +246,7 @@ impl<'t> EllipticScene<'t> {
     #[inline(always)]
     fn hot_parts(&self, load: f32, phi: f32, abs_phi: f32) -> Option<Parts> {
         let w = self.cubed_critical_gain * load; // g0^3 (eq 18 at d/b = 1)
-        if !in_hot_range(abs_phi, w) {
+        if off_hot_range(abs_phi, w) {
             return None;
         }
         let theta = self.radius_factor * abs_phi;

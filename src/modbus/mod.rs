@@ -10,7 +10,11 @@
 //! let core = Auto::with_choice(&scene, model_for_range(&scene, 5e3, 1e-5)?)?;
 //! let monitor = Monitor::new(core, Config::default()).expect("the defaults are valid");
 //! let mut server = Server::new(monitor, ServerConfig::default()).expect("unit 1");
-//! server.process(Sample::new(0, 2e3, 1e-4).with_speed(2.0));
+//! // About 2 kN and 0.1 mrad, one sample a second: the first 7 fill the spike window
+//! // (NE 107 function check meanwhile), the 8th starts the machine.
+//! for i in 0..8u32 {
+//!     server.process(Sample::new(i * 1000, 2e3 + i as f32, 1e-4).with_speed(2.0));
+//! }
 //! // Read input register 0 (`status`), one register, from unit 1.
 //! for byte in [0x01, 0x04, 0x00, 0x00, 0x00, 0x01, 0x31, 0xCA] {
 //!     server.receive(byte);

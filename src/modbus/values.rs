@@ -260,16 +260,16 @@ impl<E: Estimator> Core<E> {
     fn status(&self) -> u32 {
         let state = self.monitor.state();
         let a = &self.annunciator;
-        let category = if self.monitor.statistics().samples == 0 {
-            ne107::FUNCTION_CHECK
-        } else {
-            match state {
-                RiskState::SensorFault => ne107::FAILURE,
-                RiskState::GrossSlip => ne107::OUT_OF_SPECIFICATION,
-                RiskState::Microslip => ne107::MAINTENANCE_REQUIRED,
-                _ if a.active().contains(AlarmSet::APPROACHING) => ne107::MAINTENANCE_REQUIRED,
-                _ => ne107::GOOD,
-            }
+        // Function check before the first sample and while the conditioning settles
+        // (the state is held, no sample decides it); a failure before it.
+        let checking = self.monitor.statistics().samples == 0 || self.monitor.settling();
+        let category = match state {
+            RiskState::SensorFault => ne107::FAILURE,
+            _ if checking => ne107::FUNCTION_CHECK,
+            RiskState::GrossSlip => ne107::OUT_OF_SPECIFICATION,
+            RiskState::Microslip => ne107::MAINTENANCE_REQUIRED,
+            _ if a.active().contains(AlarmSet::APPROACHING) => ne107::MAINTENANCE_REQUIRED,
+            _ => ne107::GOOD,
         };
         state.index() as u32 | category << 8 | u32::from(a.unacknowledged().bits()) << 12
     }

@@ -2,6 +2,16 @@
 //! irregular time steps, of load and angle, for a sample that passed the checks and
 //! runs; the load clamped at zero. Its state: the two windows, the smoothed values and
 //! the last time step's values.
+//!
+//! **Settling.** After a start afresh (a new monitor, a fault, a stop, a new
+//! configuration or scene) the windows are empty and a value has nothing to be tested
+//! against: the first `window` valid running samples only fill the windows and
+//! condition nothing. The next one is the first the spike test can test, against all
+//! of them, and the first conditioned; the smoothing starts from it. So no single
+//! sample, whatever its value, decides what follows a restart: an outlier among the
+//! filling samples is one of three or more values, which moves neither the window's
+//! median nor its MAD far, and an outlier first tested is a spike. Without spike
+//! rejection there is no window and nothing settles.
 
 use super::config::{Config, SPIKE_WINDOW_CAPACITY, SpikeFilter};
 use super::order::{ge, key, positive, value};
@@ -326,13 +336,18 @@ pub(crate) struct Conditioned {
 }
 
 /// The stage's state: the spike windows of load and angle, the smoothed values, the
-/// last time step's values; and whether the configuration smooths at all.
+/// last time step's values, whether the last sample only filled the windows; and
+/// whether the configuration smooths at all.
 #[derive(Debug, Clone)]
 pub(crate) struct Conditioning {
     /// The spike windows of load (N) and angle (rad).
     pub(crate) windows: [Window; 2],
     /// Smoothed load (N) and angle (rad), `None` after a restart.
     pub(crate) smoothed: Option<[f32; 2]>,
+    /// Whether the last sample conditioned was settling (it only filled the windows).
+    /// Not part of the monitor's state: it follows from the windows but for the one
+    /// sample that fills them (see [`Conditioning::resumed`]).
+    pub(crate) settling: bool,
     step_cache: StepCache,
     /// Whether the smoothing is on (its time constant above zero).
     smoothing: bool,
@@ -343,6 +358,7 @@ impl Conditioning {
         Conditioning {
             windows: [Window::new(), Window::new()],
             smoothed: None,
+            settling: false,
             step_cache: StepCache::new(),
             // Above zero, by the bits (validated finite and not negative).
             smoothing: positive(config.smoothing_tau_s),
@@ -351,7 +367,8 @@ impl Conditioning {
 
     /// Conditions a running sample's load `load` (N) and angle `phi` (rad) after a
     /// step of `dt_ms`: spikes replaced by their window's median (counted in `stats`),
-    /// then smoothed with the weight of the step, the load clamped at zero.
+    /// then smoothed with the weight of the step, the load clamped at zero. `None`
+    /// while the conditioning settles (see the module's documentation).
     #[inline(always)]
     pub(crate) fn condition(
         &mut self,
@@ -360,9 +377,12 @@ impl Conditioning {
         phi: f32,
         dt_ms: u32,
         stats: &mut Statistics,
-    ) -> Conditioned {
+    ) -> Option<Conditioned> {
         let (mut load, mut phi) = (load, phi);
         if let Some(filter) = &config.spikes {
+            // Settling: a window is not yet full, and takes the value untested.
+            let settling = self.filling(usize::from(filter.window));
+            self.settling = settling;
             // One loop over both channels: one copy of the window's code in the image.
             let mut values = [load, phi];
             let floors = [filter.load_floor, filter.angle_floor];
@@ -371,6 +391,11 @@ impl Conditioning {
                     *x = m;
                     stats.count_spike();
                 }
+            }
+            if settling {
+                // Nothing decided; the smoothing starts from the first tested value.
+                self.smoothed = None;
+                return None;
             }
             [load, phi] = values;
         }
@@ -384,20 +409,39 @@ impl Conditioning {
         }
         // A load cell reads a little below zero at rest; the contact has none.
         let load = if ge(load, 0.0) { load } else { 0.0 };
-        Conditioned {
+        Some(Conditioned {
             load,
             phi,
             dt_s: step.dt_s,
-        }
+        })
+    }
+
+    /// Whether a window holds fewer than `n` values (the spike window's length): the
+    /// next sample settles.
+    #[inline(always)]
+    fn filling(&self, n: usize) -> bool {
+        let [load, angle] = &self.windows;
+        usize::from(load.len.min(angle.len)) < n
+    }
+
+    /// After the windows were restored, with a spike window of `window` values (none:
+    /// spike rejection off): whether the last sample was settling, as far as the
+    /// windows tell (partly filled; a state taken just after the sample that filled
+    /// them reads as settled, and the next sample decides either way).
+    pub(crate) fn resumed(&mut self, window: Option<usize>) {
+        let started = self.windows.iter().any(|w| w.len() > 0);
+        self.settling = started && window.is_some_and(|n| self.filling(n));
     }
 
     /// Starts afresh after a sample that was not conditioned (a fault, a stop): the
-    /// values before it say nothing about the ones after.
+    /// values before it say nothing about the ones after. The next valid running
+    /// samples settle it again.
     pub(crate) fn restart(&mut self) {
         for w in &mut self.windows {
             w.clear();
         }
         self.smoothed = None;
+        self.settling = false;
     }
 }
 

@@ -10,6 +10,7 @@
 //!    range values, stuck values, gaps; whether the machine runs;
 //! 3. **conditioning** (`conditioning.rs`): spikes replaced by the Hampel window's
 //!    median, load and angle smoothed with a weight that follows the real time step;
+//!    after a restart it settles first ([`Monitor::settling`]);
 //! 4. **estimate** (`estimate.rs`): the [`Estimator`]'s d/b, F, phi0 and margin, the
 //!    [`Reading`];
 //! 5. **energy** (`energy.rs`): the dissipated power F phi V (section 7) over the step;
@@ -24,6 +25,14 @@
 //!    ([`Monitor::pop_event`]);
 //! 10. **statistics** (`statistics.rs`): the step's energy added to the state
 //!     reported after it.
+//!
+//! **Settling.** No single sample decides a state after the conditioning starts
+//! afresh (at the first sample, after a fault, a stop, a new configuration or scene,
+//! a restored state it cannot take): the first valid running samples, as many as the
+//! spike window holds, only fill its windows and ask for no change (the state is
+//! held, and any change pending ends: they are valid and running); the next, the
+//! first the spike test can test against them, decides. A start and its start-up
+//! inhibit wait for it.
 //!
 //! Conditioning, estimate, energy and trend see only a valid running sample. The
 //! stages count what they see into the [`Statistics`] (time per state, spikes,
@@ -173,6 +182,31 @@ const CONFIGURATION_BYTES: usize = core::mem::size_of::<Config>()
 /// angle (rad) and a measured axial force (N).
 type FrictionOf<E> = fn(&E, f32, f32, f32) -> Option<Inverse<f32>>;
 
+/// What a sample asks the risk stage for.
+enum Asked {
+    /// `SensorFault`, for this fault (of the checks, or the estimator's refusal).
+    Fault(FaultCause),
+    /// `Stopped`: the load or the speed is below its stop threshold.
+    Stopped,
+    /// No change: a valid running sample while the conditioning settles (it breaks
+    /// every pending run, the sample being valid and running, and decides no level).
+    Settling,
+    /// The risk level of a valid running sample's reading, conditioned as `at`.
+    Level {
+        level: RiskState,
+        at: conditioning::Conditioned,
+    },
+}
+
+impl Asked {
+    fn fault(&self) -> Option<FaultCause> {
+        match *self {
+            Asked::Fault(f) => Some(f),
+            _ => None,
+        }
+    }
+}
+
 impl<E: Estimator> Monitor<E> {
     /// A monitor at rest (`Stopped`) over `estimator`.
     ///
@@ -215,7 +249,8 @@ impl<E: Estimator> Monitor<E> {
 
     /// Replaces the configuration between two samples, checked first: on an error
     /// nothing changes. State, statistics and events go on; the conditioning and the
-    /// trend start afresh, their windows being formed under the old configuration.
+    /// trend start afresh, their windows being formed under the old configuration
+    /// (the conditioning settles again: [`settling`](Self::settling)).
     ///
     /// # Errors
     /// The [`ConfigError`] of an inconsistent configuration.
@@ -231,7 +266,7 @@ impl<E: Estimator> Monitor<E> {
 
     /// Replaces the scene between two samples. State, statistics and events go on; the
     /// conditioning and the trend start afresh (the trend's margins are the old
-    /// scene's).
+    /// scene's; the conditioning settles again: [`settling`](Self::settling)).
     pub fn set_estimator(&mut self, estimator: E) {
         self.estimator = estimator;
         self.conditioning.restart();
@@ -272,6 +307,16 @@ impl<E: Estimator> Monitor<E> {
     /// has not since risen above 1.5 horizons or gone.
     pub fn approaching(&self) -> bool {
         !self.events.approaching_armed
+    }
+
+    /// Whether the conditioning is settling: since it started afresh (a new monitor, a
+    /// fault, a stop, a new configuration or scene, a restored state it could not
+    /// take) valid running samples have come, and the last of them was still filling
+    /// the spike window (7 samples by default). Meanwhile no sample decides a state:
+    /// the reported state is held; the next sample after the window is full decides.
+    /// Never with spike rejection off.
+    pub fn settling(&self) -> bool {
+        self.conditioning.settling
     }
 
     /// Monotonic time since the first sample (ms).
@@ -354,96 +399,135 @@ impl<E: Estimator> Monitor<E> {
     fn pipeline(&mut self, sample: Sample, friction: Option<FrictionOf<E>>) -> RiskState {
         self.stats.count_sample();
         let held = self.alarm.state;
-        // Clock.
-        let (dt_ms, fault) = match self.clock.step(sample.time_ms) {
-            Step::Forward(d) => (d, None),
-            Step::First => (0, None),
-            Step::Repeated => {
-                self.stats.count_repeated();
-                return held;
-            }
-            Step::Backwards => (0, Some(FaultCause::TimeBackwards)),
+        let Some((dt_ms, clock_fault)) = self.clock_step(sample.time_ms) else {
+            return held; // a repeated timestamp, counted
         };
         let now = self.clock.elapsed_ms;
         // Each step counts for the state held during it.
         self.stats.add_time(held, dt_ms);
-        // Checks.
-        let checked = self.checks.check(&self.limits, &sample, dt_ms, now, fault);
-        let mut fault = checked.fault;
-        // A valid running sample goes through conditioning, estimate, energy and trend
-        // to the risk level its reading asks for; any other asks for `SensorFault` or
-        // `Stopped`.
-        let mut estimated = None;
-        let candidate = match fault {
-            Some(_) => RiskState::SensorFault,
-            None if !checked.running => RiskState::Stopped,
-            None => {
-                self.alarm.note_running(now);
-                // Conditioning.
-                let at = self.conditioning.condition(
-                    &self.config,
-                    sample.load,
-                    sample.phi,
-                    dt_ms,
-                    &mut self.stats,
-                );
-                // Estimate.
-                match estimate::estimate(&self.estimator, &at, sample.axial_force) {
-                    Ok(r) => {
-                        self.reading = Some(r);
-                        self.stats.note_reading(&r);
-                        // Energy over the step ending here (for the state reported
-                        // after it).
-                        self.energy
-                            .note(r.axial_force, r.phi, checked.speed, at.dt_s);
-                        // Trend.
-                        if let (Some(tc), Some(m)) = (self.config.trend, r.margin) {
-                            self.trend.add(tc, m, now);
-                        }
-                        estimated = Some(at);
-                        // Risk: the level of the reading.
-                        let margin = r.margin;
-                        self.alarm
-                            .level(&self.config, &self.levels, r.slip_ratio, margin, now)
-                    }
-                    Err(f) => {
-                        fault = Some(f);
-                        RiskState::SensorFault
-                    }
-                }
-            }
+        let checked = self
+            .checks
+            .check(&self.limits, &sample, dt_ms, now, clock_fault);
+        let asked = match checked.fault {
+            Some(f) => Asked::Fault(f),
+            None if !checked.running => Asked::Stopped,
+            None => self.running(&sample, checked.speed, dt_ms, now),
         };
-        // Risk: the state machine.
-        if let Some(f) = fault {
-            self.not_estimated(f);
-        } else if candidate == RiskState::Stopped {
-            self.conditioning.restart();
-        }
-        let changed = self.alarm.offer(&self.config, candidate, now);
-        let state = self.alarm.state;
-        // Friction.
-        let friction = match (
-            friction,
-            self.config.friction,
-            sample.axial_force,
-            estimated,
-        ) {
-            (Some(inverse), Some(config), Some(force), Some(at)) => {
-                let answer = inverse(&self.estimator, at.load, at.phi, force);
-                let started = self.alarm.started_ms;
-                let running_ms = started.map_or(0, |s| now.saturating_sub(s));
-                self.friction
-                    .offer(&config, answer, dt_ms, running_ms)
-                    .map(|changed| (self.friction.mu, changed))
+        let changed = self.risk(&asked, now);
+        let friction = match (friction, &asked) {
+            (Some(inverse), Asked::Level { at, .. }) => {
+                self.friction_step(inverse, at, sample.axial_force, dt_ms, now)
             }
             _ => None,
         };
-        // Events: the state change, the `Approaching` warning, the friction change.
+        self.events_step(changed, &asked, friction, sample.time_ms, now);
+        self.statistics_step()
+    }
+
+    /// Clock: the step (ms) since the previous sample and the clock's fault (time
+    /// backwards), or `None` for a repeated timestamp (counted, ignored).
+    #[inline(always)]
+    fn clock_step(&mut self, time_ms: u32) -> Option<(u32, Option<FaultCause>)> {
+        match self.clock.step(time_ms) {
+            Step::Forward(d) => Some((d, None)),
+            Step::First => Some((0, None)),
+            Step::Repeated => {
+                self.stats.count_repeated();
+                None
+            }
+            Step::Backwards => Some((0, Some(FaultCause::TimeBackwards))),
+        }
+    }
+
+    /// Conditioning, estimate, energy and trend of a valid running sample after a step
+    /// of `dt_ms` at speed `speed` (m/s), and the risk level its reading asks for (a
+    /// fault when the estimator refuses it; no change while the conditioning settles:
+    /// the machine's start and its start-up inhibit wait for the settled sample).
+    #[inline(always)]
+    fn running(&mut self, sample: &Sample, speed: f32, dt_ms: u32, now: u64) -> Asked {
+        let (config, stats) = (&self.config, &mut self.stats);
+        let Some(at) = self
+            .conditioning
+            .condition(config, sample.load, sample.phi, dt_ms, stats)
+        else {
+            return Asked::Settling;
+        };
+        self.alarm.note_running(now);
+        let r = match estimate::estimate(&self.estimator, &at, sample.axial_force) {
+            Ok(r) => r,
+            Err(f) => return Asked::Fault(f),
+        };
+        self.reading = Some(r);
+        self.stats.note_reading(&r);
+        // Energy over the step ending here (for the state reported after it).
+        self.energy.note(r.axial_force, r.phi, speed, at.dt_s);
+        if let (Some(tc), Some(m)) = (self.config.trend, r.margin) {
+            self.trend.add(tc, m, now);
+        }
+        let (config, levels) = (&self.config, &self.levels);
+        let level = self
+            .alarm
+            .level(config, levels, r.slip_ratio, r.margin, now);
+        Asked::Level { level, at }
+    }
+
+    /// Risk: the state machine offered what the sample asks for; returns the state
+    /// left when it changes. A sample that was not estimated restarts the
+    /// conditioning (a fault is counted).
+    #[inline(always)]
+    fn risk(&mut self, asked: &Asked, now: u64) -> Option<RiskState> {
+        let candidate = match *asked {
+            Asked::Fault(f) => {
+                self.not_estimated(f);
+                RiskState::SensorFault
+            }
+            Asked::Stopped => {
+                self.conditioning.restart();
+                RiskState::Stopped
+            }
+            Asked::Settling => self.alarm.state,
+            Asked::Level { level, .. } => level,
+        };
+        self.alarm.offer(&self.config, candidate, now)
+    }
+
+    /// Friction: mu from the measured axial force `force` (N) at the conditioned
+    /// sample `at` through `inverse`; `Some((mu, changed))` when a friction change is
+    /// raised or cleared.
+    #[inline(always)]
+    fn friction_step(
+        &mut self,
+        inverse: FrictionOf<E>,
+        at: &conditioning::Conditioned,
+        force: Option<f32>,
+        dt_ms: u32,
+        now: u64,
+    ) -> Option<(f32, bool)> {
+        let (config, force) = (self.config.friction?, force?);
+        let answer = inverse(&self.estimator, at.load, at.phi, force);
+        let running_ms = self.alarm.started_ms.map_or(0, |s| now.saturating_sub(s));
+        self.friction
+            .offer(&config, answer, dt_ms, running_ms)
+            .map(|changed| (self.friction.mu, changed))
+    }
+
+    /// Events: the state change (from `changed`), the `Approaching` warning, the
+    /// friction change, for the sample stamped `time_ms` at monotonic time `now`.
+    #[inline(always)]
+    fn events_step(
+        &mut self,
+        changed: Option<RiskState>,
+        asked: &Asked,
+        friction: Option<(f32, bool)>,
+        time_ms: u32,
+        now: u64,
+    ) {
         if let Some(from) = changed {
-            self.state_changed(from, fault, sample.time_ms);
+            self.state_changed(from, asked.fault(), time_ms);
         }
         let (trend, ttc) = (&self.trend, self.trend.time_to_critical_s);
         let fit_age_s = || trend.fit_age_s(now);
+        let state = self.alarm.state;
         if let Some(t) = self
             .events
             .approaching(self.config.trend, ttc, fit_age_s, state)
@@ -451,12 +535,18 @@ impl<E: Estimator> Monitor<E> {
             let kind = EventKind::Approaching {
                 time_to_critical_s: t,
             };
-            self.emit(kind, sample.time_ms);
+            self.emit(kind, time_ms);
         }
         if let Some((mu, changed)) = friction {
-            self.emit(EventKind::Friction { mu, changed }, sample.time_ms);
+            self.emit(EventKind::Friction { mu, changed }, time_ms);
         }
-        // Statistics: the step's energy for the state reported after it.
+    }
+
+    /// Statistics: the step's energy for the state reported after it, which is
+    /// returned.
+    #[inline(always)]
+    fn statistics_step(&mut self) -> RiskState {
+        let state = self.alarm.state;
         if let Some(j) = self.energy.take() {
             self.stats.add_energy(state, j);
         }
@@ -535,7 +625,10 @@ impl<E: Estimator> Monitor<E> {
     /// The conditioning holds only values this configuration accepts: a smoothed
     /// value, or a spike window holding a value, outside its load and angle ranges (a
     /// state of another configuration, or no monitor's) is left out, and the
-    /// conditioning starts afresh there, as after a fault.
+    /// conditioning starts afresh there, as after a fault (and settles again). A state
+    /// taken while the conditioning settled goes on settling (read from its windows:
+    /// taken just after the sample that filled them, `settling` reads false, and the
+    /// next sample decides either way).
     pub fn resume(&mut self, state: &MonitorState) {
         self.clock = state.clock;
         self.alarm = state.alarm;
@@ -563,6 +656,8 @@ impl<E: Estimator> Monitor<E> {
                 window.push_back(x, n);
             }
         }
+        let window = self.config.spikes.map(|s| usize::from(s.window));
+        self.conditioning.resumed(window);
         self.trend.points.clear();
         for p in state.trend.iter() {
             let _ = self.trend.points.push_back(p);

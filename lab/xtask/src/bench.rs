@@ -535,6 +535,111 @@ pub fn estimates(rows: &[BenchRow]) -> String {
     s
 }
 
+/// A target of the elliptic estimate on one core: its mean instructions per call in
+/// QEMU, its worst relative error and the bytes of table data it reads, at most these.
+pub struct Target {
+    pub cpu: &'static str,
+    /// The core's name in prose.
+    pub cpu_name: &'static str,
+    pub model: Model,
+    /// The model's name in prose.
+    pub model_name: &'static str,
+    pub instructions: u64,
+    pub error: f64,
+    pub table_bytes: Option<usize>,
+}
+
+/// The elliptic estimate's targets (the per-sample path at its limit): a full `cargo
+/// xtask bench` fails over one, and a test holds the committed docs/bench.csv to them.
+pub const TARGETS: [Target; 2] = [
+    Target {
+        cpu: "cortex-m4f",
+        cpu_name: "Cortex-M4F",
+        model: Model::F32,
+        model_name: "f32",
+        instructions: 100,
+        error: 5e-7,
+        table_bytes: Some(4096),
+    },
+    Target {
+        cpu: "cortex-m0",
+        cpu_name: "Cortex-M0",
+        model: Model::Fixed,
+        model_name: "fixed point",
+        instructions: 350,
+        error: 1e-5,
+        table_bytes: None,
+    },
+];
+
+/// The targets `rows` miss, one sentence each (a target without its row is missed).
+pub fn missed_targets(rows: &[BenchRow]) -> Vec<String> {
+    let mut missed = Vec::new();
+    for t in &TARGETS {
+        let what = format!("{} estimate on the {}", t.model_name, t.cpu_name);
+        let Some(r) = find(rows, t.cpu, t.model, Operation::Estimate) else {
+            missed.push(format!("{what}: not measured"));
+            continue;
+        };
+        if r.mean > t.instructions {
+            missed.push(format!(
+                "{what}: {} instructions, target {}",
+                r.mean, t.instructions
+            ));
+        }
+        if !r.error.is_some_and(|e| e <= t.error) {
+            missed.push(format!(
+                "{what}: error {}, target {:.0e}",
+                error(r),
+                t.error
+            ));
+        }
+        if let (Some(limit), Some(b)) = (t.table_bytes, table_bytes(t.model, Operation::Estimate))
+            && b > limit
+        {
+            missed.push(format!("{what}: {b} bytes of tables, target {limit}"));
+        }
+    }
+    missed
+}
+
+/// The targets and the figures `rows` give, as the measurements page states them below
+/// the estimates' table.
+pub fn targets_note(rows: &[BenchRow]) -> String {
+    let parts: Vec<String> = TARGETS
+        .iter()
+        .map(|t| {
+            let bytes = table_bytes(t.model, Operation::Estimate).unwrap_or(0);
+            let (target_bytes, measured_bytes) = match t.table_bytes {
+                Some(limit) => (
+                    format!(", {limit} bytes of tables"),
+                    format!(", {bytes} bytes"),
+                ),
+                None => (String::new(), String::new()),
+            };
+            let measured = find(rows, t.cpu, t.model, Operation::Estimate)
+                .map_or("not measured".to_string(), |r| {
+                    format!("{} at {}{measured_bytes}", r.mean, error(r))
+                });
+            format!(
+                "{} on the {}, at most {} instructions at {:.0e}{target_bytes} ({measured})",
+                t.model_name, t.cpu_name, t.instructions, t.error
+            )
+        })
+        .collect();
+    let missed = missed_targets(rows);
+    format!(
+        "Targets of the elliptic estimate (a full run fails over one; a test holds this \
+         table to them): {}.{}\n",
+        parts.join("; "),
+        if missed.is_empty() {
+            String::new()
+        } else {
+            format!(" **Missed**: {}.", missed.join("; "))
+        }
+    )
+}
+
 /// How many times fewer instructions `r` takes than the reference on its CPU.
 fn fewer_instructions(rows: &[BenchRow], r: &BenchRow) -> String {
     rows.iter()
@@ -719,9 +824,67 @@ pub fn run(csv: bool, short: bool, only: Option<&str>) -> ExitCode {
     }
     if only.is_some() && !short {
         eprintln!("xtask bench: a run on one cpu writes nothing");
-    } else if !short && let Err(e) = write_outputs(&rows) {
-        eprintln!("xtask bench: {e}");
-        return ExitCode::FAILURE;
+    } else if !short {
+        if let Err(e) = write_outputs(&rows) {
+            eprintln!("xtask bench: {e}");
+            return ExitCode::FAILURE;
+        }
+        // Written as measured, then held to the targets.
+        let missed = missed_targets(&rows);
+        if !missed.is_empty() {
+            for m in &missed {
+                eprintln!("xtask bench: target missed: {m}");
+            }
+            return ExitCode::FAILURE;
+        }
     }
     ExitCode::SUCCESS
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(cpu: &str, model: Model, mean: u64, error: f64) -> BenchRow {
+        BenchRow {
+            cpu: cpu.into(),
+            model: model.name().into(),
+            operation: Operation::Estimate.name().into(),
+            mean,
+            max: mean + 20,
+            error: Some(error),
+        }
+    }
+
+    /// The committed figures (docs/bench.csv, from a full run) meet the estimate's
+    /// targets.
+    #[test]
+    fn committed_estimates_meet_their_targets() {
+        let rows = records::read::<BenchRow>().unwrap();
+        assert_eq!(missed_targets(&rows), Vec::<String>::new());
+    }
+
+    /// One instruction or one error above a target, or a target's row missing, is a
+    /// miss; the figures at the targets are not.
+    #[test]
+    fn a_target_is_missed_by_one_instruction_or_a_larger_error() {
+        let at = [
+            row("cortex-m4f", Model::F32, 100, 5e-7),
+            row("cortex-m0", Model::Fixed, 350, 1e-5),
+        ];
+        assert_eq!(missed_targets(&at), Vec::<String>::new());
+        let over = [
+            row("cortex-m4f", Model::F32, 101, 5e-7),
+            row("cortex-m0", Model::Fixed, 350, 2e-5),
+        ];
+        let missed = missed_targets(&over);
+        assert_eq!(missed.len(), 2, "{missed:?}");
+        assert!(
+            missed[0].contains("101 instructions, target 100"),
+            "{missed:?}"
+        );
+        assert!(missed[1].contains("error 2.0e-5"), "{missed:?}");
+        assert_eq!(missed_targets(&at[..1]).len(), 1);
+        assert!(targets_note(&over).contains("**Missed**"));
+    }
 }

@@ -41,7 +41,15 @@ fn blocks() -> Result<Vec<Block>, String> {
     Ok(vec![
         block(README, "headline", headline(&bench, &accuracy)),
         block(PAGE, "accuracy", accuracy::table(&accuracy)),
-        block(PAGE, "bench", bench::estimates(&bench)),
+        block(
+            PAGE,
+            "bench",
+            format!(
+                "{}\n{}",
+                bench::estimates(&bench),
+                bench::targets_note(&bench)
+            ),
+        ),
         block(PAGE, "cost", bench::cost(&bench)),
         block(PAGE, "stages", bench::stages(&bench)),
         block(PAGE, "shapes", shapes::table(&shapes)),
