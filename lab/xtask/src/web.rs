@@ -10,7 +10,8 @@
 //!   headless, driven by playwright-core) against the page `--serve` serves: the
 //!   page's events and thresholds against the monitor example's files written here,
 //!   the Node view against the node in QEMU (`cargo xtask modbus --serve`) through
-//!   `tools/web/bridge.mjs`, a short pass of the replay with the page answering
+//!   `tools/web/bridge.mjs` (all three started by docs/web.md's `sh serve` commands,
+//!   as the page shows them, on free ports), a short pass of the replay with the page answering
 //!   meanwhile; screenshots of the three views in `target/web-console/screenshots/`.
 //! - `--measure [--rows N]`: what a browser downloads (gzip), the time to a usable page
 //!   from the loopback, and an N-row trace (default 1 000 000) replayed in the page
@@ -315,26 +316,31 @@ fn serve(port: u16) -> Result<(), String> {
     }
 }
 
-/// A child process (and, for the node, its QEMU) ended when dropped.
+/// A child process in its own process group, the group ended when dropped (a shell,
+/// cargo and the xtask it runs; the node's QEMU ends with that xtask).
 struct Running(Child);
 
 impl Drop for Running {
     fn drop(&mut self) {
+        let group = format!("-{}", self.0.id());
+        let _ = Command::new("kill").args(["-KILL", "--", &group]).status();
         let _ = self.0.kill();
         let _ = self.0.wait();
     }
 }
 
-/// Spawns `cmd` and waits until a line of its stdout contains `ready` (its lines go
-/// on to stderr, prefixed with `tag`).
+/// Spawns `cmd` in a process group of its own and waits until a line of its stdout
+/// contains one of `ready` (its lines go on to stderr, prefixed with `tag`).
 fn spawn_until(
     cmd: &mut Command,
-    ready: &str,
+    ready: &[&str],
     tag: &'static str,
     timeout: Duration,
 ) -> Result<Running, String> {
+    use std::os::unix::process::CommandExt;
     let mut child = cmd
         .stdout(Stdio::piped())
+        .process_group(0)
         .spawn()
         .map_err(|e| format!("{tag}: {e}"))?;
     let stdout = child.stdout.take().ok_or("no stdout")?;
@@ -349,7 +355,7 @@ fn spawn_until(
     let start = Instant::now();
     loop {
         match rx.recv_timeout(Duration::from_millis(200)) {
-            Ok(line) if line.contains(ready) => return Ok(running),
+            Ok(line) if ready.iter().any(|r| line.contains(r)) => return Ok(running),
             Ok(_) | Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
             Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
                 return Err(format!("{tag} stopped before it was ready"));
@@ -365,6 +371,62 @@ fn spawn_until(
 fn free_port() -> Result<u16, String> {
     let l = TcpListener::bind("127.0.0.1:0").map_err(|e| e.to_string())?;
     Ok(l.local_addr().map_err(|e| e.to_string())?.port())
+}
+
+/// The ports docs/web.md's commands use: the page's, the bridge's, the node's.
+const PAGE_PORTS: [u16; 3] = [8080, 8502, 5020];
+
+/// The commands of docs/web.md's `sh serve` blocks (each serves until stopped), one a
+/// line, comments dropped, in the page's order.
+fn page_commands() -> Result<Vec<String>, String> {
+    let path = crate::root().join("docs/web.md");
+    let page = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut commands = Vec::new();
+    let mut inside = None;
+    for line in page.lines() {
+        match (&mut inside, line.trim_start().strip_prefix("```")) {
+            (None, Some(info)) => inside = Some(info.split_whitespace().eq(["sh", "serve"])),
+            (Some(_), Some(_)) => inside = None,
+            (Some(true), None) => {
+                let command = line.split(" #").next().unwrap_or("").trim();
+                if !command.is_empty() && !command.starts_with('#') {
+                    commands.push(command.to_string());
+                }
+            }
+            _ => {}
+        }
+    }
+    for port in PAGE_PORTS {
+        if !commands.iter().any(|c| with_ports(c, &[(port, 0)]) != *c) {
+            return Err(format!("docs/web.md: no `sh serve` command on port {port}"));
+        }
+    }
+    Ok(commands)
+}
+
+/// `line` with each number that is one of `ports`' first members replaced by its
+/// second.
+fn with_ports(line: &str, ports: &[(u16, u16)]) -> String {
+    let mut out = String::new();
+    let mut digits = String::new();
+    let flush = |digits: &mut String, out: &mut String| {
+        let swapped = ports
+            .iter()
+            .find(|(from, _)| digits.parse() == Ok(*from))
+            .map(|(_, to)| to.to_string());
+        out.push_str(swapped.as_deref().unwrap_or(digits));
+        digits.clear();
+    };
+    for c in line.chars() {
+        if c.is_ascii_digit() {
+            digits.push(c);
+        } else {
+            flush(&mut digits, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut digits, &mut out);
+    out
 }
 
 /// The monitor example's binary (built here, release).
@@ -533,33 +595,27 @@ fn test() -> Result<(), String> {
     let start = Instant::now();
     let files = out().join("test");
     reference_files(&files)?;
-    // The page as `cargo xtask web --serve` builds and serves it, the node in QEMU as
-    // `cargo xtask modbus --serve` boots it, and the bridge.
-    let xtask = std::env::current_exe().map_err(|e| e.to_string())?;
-    let port = free_port()?;
-    let _page = spawn_until(
-        Command::new(&xtask).args(["web", "--serve", &port.to_string()]),
-        &format!("serving on 127.0.0.1:{port}"),
-        "page",
-        Duration::from_secs(3600),
-    )?;
-    let node_port = free_port()?;
-    let _node = spawn_until(
-        Command::new(&xtask).args(["modbus", "--serve", &node_port.to_string()]),
-        "serving on",
-        "node",
-        Duration::from_secs(900),
-    )?;
-    let ws_port = free_port()?;
-    let _bridge = spawn_until(
-        Command::new("node")
-            .arg(crate::root().join("tools/web/bridge.mjs"))
-            .arg(format!("127.0.0.1:{ws_port}"))
-            .arg(format!("127.0.0.1:{node_port}")),
-        "bridging",
-        "bridge",
-        Duration::from_secs(30),
-    )?;
+    // The page, the node in QEMU and the bridge, started by docs/web.md's own
+    // commands (its `sh serve` blocks), its ports standing for free ones.
+    let ports: Vec<(u16, u16)> = PAGE_PORTS
+        .iter()
+        .map(|&p| Ok((p, free_port()?)))
+        .collect::<Result<_, String>>()?;
+    let [(_, port), (_, ws_port), _] = ports[..] else {
+        unreachable!("three ports")
+    };
+    let mut served = Vec::new();
+    for command in page_commands()? {
+        let line = with_ports(&command, &ports);
+        served.push(spawn_until(
+            Command::new("bash")
+                .args(["-c", &line])
+                .current_dir(crate::root()),
+            &["serving on", "bridging"],
+            "docs/web.md",
+            Duration::from_secs(3600),
+        )?);
+    }
     let shots = out().join("screenshots");
     std::fs::create_dir_all(&shots).map_err(|e| e.to_string())?;
     let report = node_script(
