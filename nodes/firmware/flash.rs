@@ -7,16 +7,19 @@
 //! MPS2 boards (Cortex-M3, M4F, M7) RAM in cortex-m-rt's `.uninit`, kept across a
 //! system reset (`nodes/common/ram_flash.rs`, shared with the storage node).
 
-use crate::persist::{EVENTS_SIZE, STORE_SIZE};
-
 #[cfg(not(target_has_atomic = "ptr"))]
 pub use crate::nvmc_flash::{NvmcFlash as Board, PAGE as SECTOR};
 #[cfg(target_has_atomic = "ptr")]
 pub use crate::ram_flash::{RamFlash as Board, SECTOR};
 
+/// The store's region (the state's and the configuration's records).
+pub const STORE_SIZE: usize = 4 * SECTOR;
+/// The event queue's region.
+pub const EVENTS_SIZE: usize = 2 * SECTOR;
+
 /// The store's region and the event queue's, erased on the first power-on; taken once
 /// per boot (`Persist::open`). `None` if the memory layout does not reserve them as
-/// `persist.rs` sizes them.
+/// these sizes.
 #[cfg(not(target_has_atomic = "ptr"))]
 pub fn regions() -> Option<(Board, Board)> {
     unsafe extern "C" {

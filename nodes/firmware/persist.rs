@@ -14,7 +14,7 @@
 //! (numbering after the newest event stored), the event window fed from the queue, from
 //! its oldest unacknowledged event on.
 
-use crate::flash::{self, Board, SECTOR};
+use crate::flash::{self, Board, EVENTS_SIZE, STORE_SIZE};
 use misalign::Estimator;
 use misalign::modbus::{BootSource, IMAGE_LEN, Server, StorageStatus, Stored};
 use misalign::monitor::{Event, Monitor, MonitorState};
@@ -40,10 +40,6 @@ fn cut(_: Op) {}
 #[inline(always)]
 fn uncut() {}
 
-/// The store's region (the state's and the configuration's records).
-pub const STORE_SIZE: usize = 4 * SECTOR;
-/// The event queue's region.
-pub const EVENTS_SIZE: usize = 2 * SECTOR;
 /// The periodic checkpoint's interval (s of monitored time).
 const INTERVAL_S: u32 = 60;
 

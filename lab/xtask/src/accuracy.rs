@@ -10,24 +10,12 @@
 //! so that what is measured is the core's arithmetic, not a sensor's quantisation.
 
 use crate::bench::{Record, data, f32s, fixed3, num, read, rel, scene, signed};
+use crate::measurements::accuracy::table;
 use crate::records::{self, AccuracyRow};
 use misalign::fixed::{FixedEllipticScene, FixedLineScene, exact_lsb};
 use misalign::float::{EllipticScene, LineScene};
 use misalign::reference;
-use std::fmt::Write as _;
 use std::process::ExitCode;
-
-/// The quantities, in the table's order: `(CSV and reference column, table header)`.
-pub const QUANTITIES: [(&str, &str); 8] = [
-    ("s", "d/b"),
-    ("F", "F"),
-    ("phi0", "phi0"),
-    ("m", "m"),
-    ("n", "n"),
-    ("a", "a"),
-    ("b", "b"),
-    ("p0", "p0"),
-];
 
 /// The worst error per quantity of one model on one contact, over the rows compared.
 struct Worst {
@@ -164,37 +152,6 @@ pub fn measure() -> Result<Vec<AccuracyRow>, String> {
     .into_iter()
     .flat_map(Worst::rows)
     .collect())
-}
-
-/// The table: a row per model and contact, a column per quantity.
-pub fn table(rows: &[AccuracyRow]) -> String {
-    let mut s = String::from("| model | contact | rows |");
-    for (_, header) in QUANTITIES {
-        write!(s, " {header} |").unwrap();
-    }
-    s.push_str("\n|---|---|--:|");
-    s.push_str(&"--:|".repeat(QUANTITIES.len()));
-    s.push('\n');
-    let mut seen: Vec<(&str, &str)> = Vec::new();
-    for r in rows {
-        let key = (r.model.as_str(), r.contact.as_str());
-        if seen.contains(&key) {
-            continue;
-        }
-        seen.push(key);
-        write!(s, "| {} | {} | {} |", r.model, r.contact, r.rows).unwrap();
-        for (q, _) in QUANTITIES {
-            let e = rows
-                .iter()
-                .find(|x| (x.model.as_str(), x.contact.as_str()) == key && x.quantity == q);
-            match e {
-                Some(x) => write!(s, " {:.1e} |", x.max_rel).unwrap(),
-                None => s.push_str(" |"),
-            }
-        }
-        s.push('\n');
-    }
-    s
 }
 
 /// `cargo xtask accuracy`: measures, prints the table, writes docs/accuracy.csv and

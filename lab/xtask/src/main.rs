@@ -169,7 +169,7 @@ fn main() -> ExitCode {
 fn sweep_task(quick: bool, write: bool) -> ExitCode {
     let start = std::time::Instant::now();
     let rows = sweep::run(quick);
-    print!("{}", sweep::markdown(&rows, quick));
+    print!("{}", measurements::sweep::markdown(&rows, quick));
     eprintln!("swept in {:.0} s", start.elapsed().as_secs_f64());
     if write && let Err(e) = records::write(&rows).and_then(|()| measurements::update()) {
         eprintln!("xtask sweep: {e}");

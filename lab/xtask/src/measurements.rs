@@ -1,17 +1,24 @@
 //! `cargo xtask measurements [--check]`: every table of docs/measurements.md, and the
 //! README's headline, drawn from the committed CSVs under `docs/` (each measuring
-//! command writes its CSV and then calls [`update`]). `--check` fails if a committed
+//! command writes its CSV and then calls [`update`]; the tables are drawn here, from
+//! the CSVs alone, never by the commands' modules). `--check` fails if a committed
 //! table differs from what the CSVs draw, as `cargo xtask figures --check` does for the
 //! SVGs; a unit test does the same under `cargo test`.
 //!
 //! Each table sits between `<!-- NAME:begin -->` and `<!-- NAME:end -->`; the prose
 //! around it is the page's own and carries no measured number.
 
-use crate::bench::{self, find};
+pub mod accuracy;
+pub mod bench;
+pub mod firmware;
+pub mod shapes;
+pub mod sweep;
+pub mod web;
+
 use crate::records::{
     self, AccuracyRow, BenchRow, NodeRow, PicoRow, ShapeRow, SizeRow, SweepRow, WebRow,
 };
-use crate::{accuracy, firmware, shapes, sweep};
+use bench::find;
 use misalign_workload::{Model, Operation};
 use std::fmt::Write as _;
 use std::process::ExitCode;
@@ -57,7 +64,7 @@ fn blocks() -> Result<Vec<Block>, String> {
         block(PAGE, "firmware", sizes_block(&sizes)),
         block(PAGE, "node", node(&nodes)),
         block(PAGE, "pico", pico_table(&pico)),
-        block(PAGE, "web", web_table(&web)?),
+        block(PAGE, "web", web::table(&web)?),
     ])
 }
 
@@ -146,72 +153,6 @@ fn pico_table(rows: &[PicoRow]) -> String {
         .unwrap();
     }
     s
-}
-
-/// The web console's table (docs/web.csv, `cargo xtask web --measure`), with its
-/// targets (`web.rs`).
-fn web_table(rows: &[WebRow]) -> Result<String, String> {
-    use crate::web::{DOWNLOAD_TARGET, RATE_TARGET, READY_TARGET_MS};
-    let get = |q: &str| {
-        rows.iter()
-            .find(|r| r.quantity == q)
-            .map(|r| r.value)
-            .ok_or_else(|| format!("docs/web.csv: no {q}"))
-    };
-    let (wasm, script) = (get("download_wasm_gzip")?, get("download_script_gzip")?);
-    let (ready, n) = (get("ready")?, get("replay_rows")?);
-    let (page, example) = (get("replay_page")?, get("replay_example")?);
-    let (pause, idle) = (get("replay_longest_pause")?, get("idle_longest_pause")?);
-    let kib = |b: f64| format!("{:.0} KiB", b / 1024.0);
-    let met = |ok: bool| if ok { "met" } else { "**missed**" };
-    let total = wasm + script;
-    let ratio = page / example;
-    let mut s = String::from("| quantity | measured | target |\n|---|--:|---|\n");
-    writeln!(s, "| download, gzip: the WebAssembly | {} | |", kib(wasm)).unwrap();
-    writeln!(
-        s,
-        "| download, gzip: script, style and page | {} | |",
-        kib(script)
-    )
-    .unwrap();
-    writeln!(
-        s,
-        "| download, gzip: in all | {} | at most {}: {} |",
-        kib(total),
-        kib(DOWNLOAD_TARGET as f64),
-        met(total <= DOWNLOAD_TARGET as f64)
-    )
-    .unwrap();
-    writeln!(
-        s,
-        "| time to a usable page from the loopback (median of 5 cold loads) | {ready:.0} ms | under {READY_TARGET_MS:.0} ms: {} |",
-        met(ready < READY_TARGET_MS)
-    )
-    .unwrap();
-    writeln!(
-        s,
-        "| a {n:.0}-row trace replayed in the page (its worker, both passes) | {:.2} M rows/s | |",
-        page / 1e6
-    )
-    .unwrap();
-    writeln!(
-        s,
-        "| the same trace through the monitor example, same run | {:.2} M rows/s | |",
-        example / 1e6
-    )
-    .unwrap();
-    writeln!(
-        s,
-        "| the page's rate over the example's | {ratio:.2} | at least {RATE_TARGET}: {} |",
-        met(ratio >= RATE_TARGET)
-    )
-    .unwrap();
-    writeln!(
-        s,
-        "| the page's longest pause meanwhile (its own thread; idle for as long: {idle:.0} ms) | {pause:.0} ms | |"
-    )
-    .unwrap();
-    Ok(s)
 }
 
 /// `text` with the block between the markers `<!-- NAME:begin -->` and

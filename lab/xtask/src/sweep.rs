@@ -13,7 +13,6 @@ use misalign::float::kernels::sqrt::inv_sqrt;
 use misalign::float::kernels::theta_top::theta_of_g_top;
 use misalign::float::tables::{G_OF_THETA, INV_M_OF_THETA, THETA_OF_G};
 use misalign::reference::{normal, tangential};
-use std::fmt::Write;
 
 /// Distance in f32 ulps of `got` from the exact `want` (ulp of the f32 nearest want).
 fn ulps(got: f32, want: f64) -> f64 {
@@ -212,28 +211,4 @@ pub fn run(quick: bool) -> Vec<Row> {
         at,
     });
     rows
-}
-
-/// The table as Markdown (docs/measurements.md); `quick` says the f32 kernels were
-/// strided.
-pub fn markdown(rows: &[Row], quick: bool) -> String {
-    let mut out = String::new();
-    writeln!(
-        out,
-        "| kernel | domain | points | max error (ulps) | max relative error | worst at |"
-    )
-    .unwrap();
-    writeln!(out, "|---|---|---|---|---|---|").unwrap();
-    for r in rows {
-        writeln!(
-            out,
-            "| `{}` | {} | {} | {:.2} | {:.2e} | {:.4e} |",
-            r.kernel, r.domain, r.points, r.max_ulps, r.max_rel, r.at
-        )
-        .unwrap();
-    }
-    if quick {
-        writeln!(out, "\n(quick pass: the f32 kernels strided)").unwrap();
-    }
-    out
 }

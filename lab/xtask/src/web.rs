@@ -17,6 +17,7 @@
 //!   from the loopback, and an N-row trace (default 1 000 000) replayed in the page
 //!   against the monitor example in the same run; writes `docs/web.csv` and its table.
 
+use crate::measurements::web::{DOWNLOAD_TARGET, RATE_TARGET, READY_TARGET_MS};
 use crate::records::{self, WebRow};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{TcpListener, TcpStream};
@@ -29,13 +30,6 @@ const OUT: &str = "target/web-console";
 
 /// Chromium, Debian's (`apt-get install -y chromium`); `MISALIGN_CHROMIUM` another.
 const CHROMIUM: &str = "/usr/bin/chromium";
-
-/// The largest compressed download the page may take (B): wasm and script.
-pub const DOWNLOAD_TARGET: u64 = 1 << 20;
-/// The time to a usable page from the loopback the page must beat (ms).
-pub const READY_TARGET_MS: f64 = 1000.0;
-/// The share of the monitor example's rate the page's replay must reach.
-pub const RATE_TARGET: f64 = 0.5;
 
 /// `cargo xtask web`'s arguments.
 #[derive(clap::Args)]
