@@ -94,3 +94,16 @@ const _: () = {
 #[cfg(doctest)]
 #[doc = include_str!("../docs/firmware.md")]
 struct FirmwareGuideDoctests;
+
+/// The integrator's page's Rust snippets (the application's storage loop, its boot,
+/// the byte loop) compile against the server's and the storage's API
+/// (`cargo test --features modbus,_mock-flash --doc ModbusGuideDoctests`).
+#[cfg(all(doctest, feature = "modbus", feature = "_mock-flash"))]
+#[doc = include_str!("../docs/modbus.md")]
+struct ModbusGuideDoctests;
+
+/// The technician's page's firmware outline compiles against the sensors' API
+/// (`cargo test --features sensors,_sim,ads1x1x --doc SensorsGuideDoctests`).
+#[cfg(all(doctest, feature = "sensors", feature = "ads1x1x"))]
+#[doc = include_str!("../docs/SENSORS.md")]
+struct SensorsGuideDoctests;

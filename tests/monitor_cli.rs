@@ -436,6 +436,74 @@ fn replay_child() {
     );
 }
 
+/// The texts of an SVG's `<text>` elements, in document order.
+fn svg_texts(svg: &str) -> Vec<String> {
+    svg.split("<text ")
+        .skip(1)
+        .filter_map(|t| Some(t[t.find('>')? + 1..t.find("</text>")?].trim().to_string()))
+        .collect()
+}
+
+/// The monitor's figures read as a figure should: a title, a legend for every kind of
+/// line, horizontal axis titles (no rotated text), tick labels with the decimals their
+/// step needs and no `-0`; on the planner's figure phi0 drawn over the "alarm raised"
+/// curve it coincides with at the default alarm (d/b = 1).
+#[test]
+fn the_figures_have_titles_legends_and_clean_ticks() {
+    let plot = trace_file("figure.svg", b"");
+    let table = trace_file("figure-thresholds.csv", b"");
+    let (code, _, err) = monitor(&[
+        "--plot",
+        plot.to_str().unwrap(),
+        "--thresholds",
+        table.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let timeline = std::fs::read_to_string(&plot).unwrap();
+    let planner = std::fs::read_to_string(plot.with_file_name("figure-thresholds.svg")).unwrap();
+    for (svg, title, legend) in [
+        (
+            &timeline,
+            "Condition monitor over the built-in 8 h scenario",
+            &["a state change", "warning and alarm thresholds"][..],
+        ),
+        (
+            &planner,
+            "Where each state is raised and cleared, over the load range",
+            &["alarm raised", "phi0: gross slip (d/b = 1)"][..],
+        ),
+    ] {
+        let texts = svg_texts(svg);
+        assert!(texts.iter().any(|t| t == title), "no title {title}");
+        for entry in legend {
+            assert!(
+                texts.iter().any(|t| t.starts_with(entry)),
+                "no legend entry {entry}"
+            );
+        }
+        assert!(!svg.contains("rotate("), "rotated text");
+        for t in &texts {
+            let number = t.parse::<f64>();
+            assert!(
+                !(number.is_ok() && t.starts_with("-0") && number == Ok(0.0)),
+                "tick `{t}`"
+            );
+            // 300, 1100: no decimals where the step is whole.
+            assert!(
+                !(number.is_ok() && t.trim_end_matches('0').ends_with('.') && t.len() > 4),
+                "tick `{t}` carries decimals its step does not need"
+            );
+        }
+    }
+    let alarm = planner
+        .find(r##"stroke="#D55E00""##)
+        .expect("the alarm raised curve");
+    let phi0 = planner
+        .find(r##"stroke="#000000" stroke-width="2""##)
+        .unwrap();
+    assert!(phi0 > alarm, "phi0 is drawn under the alarm raised curve");
+}
+
 /// `--thresholds` over a trace whose loads never reach above the stop load (100 N) is
 /// refused with a message, not a table for a range the trace never saw; a trace whose
 /// loads pass the configuration's `load_max` gets a table up to it, and says so.

@@ -18,11 +18,12 @@ use misalign_harness::support::{counter::Counter, stack};
 const LOAD_LSB: f64 = 1e-3;
 const ANGLE_LSB: f64 = 1e-11;
 
-/// "f32" with an FPU, "f32-soft" without (thumbv6m, thumbv7m: soft float).
-const F32: &str = if cfg!(target_abi = "eabihf") {
+/// The core this target's self-test runs, as the log and `cargo xtask firmware` name
+/// it: the f32 core with an FPU, the fixed-point core without one (thumbv6m, thumbv7m).
+const CORE: &str = if cfg!(target_abi = "eabihf") {
     "f32"
 } else {
-    "f32-soft"
+    "fixed"
 };
 
 /// How the firmware runs one prepared core: its name in the log and in `cargo xtask
@@ -31,7 +32,7 @@ struct Run<'a, E> {
     core: &'a E,
     /// Contact model ("elliptic", "line").
     model: &'static str,
-    /// Number format ("f32", "f32-soft", "fixed").
+    /// Number format ("f32", "fixed").
     number: &'static str,
     /// Relative tolerance against the reference: the core's bound on the reference
     /// data (f32 2e-6, fixed point 1e-4).
@@ -46,7 +47,7 @@ fn f32_run<'a, E>(core: &'a E, model: &'static str) -> Run<'a, E> {
     Run {
         core,
         model,
-        number: F32,
+        number: "f32",
         tolerance: 2e-6,
         lsb: None,
     }
@@ -99,7 +100,7 @@ pub fn run_all(counter: &Counter) -> Result<usize, Error> {
         "self-test: demo scene, {=usize} elliptic and {=usize} line samples, {=str} core; SysTick ticks per 1000 instructions {=u32}",
         trace::ELLIPTIC.len(),
         trace::LINE.len(),
-        F32,
+        CORE,
         counter.ticks_per_1000()
     );
     let scene = Scene::DEMO;

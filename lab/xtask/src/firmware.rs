@@ -382,6 +382,7 @@ fn run_firmware(core: &Cpu, elf: &Path) -> Result<(Vec<(String, Run)>, String), 
             results.len()
         ));
     }
+    cores_named(&log)?;
     for (model, r) in &results {
         println!(
             "  firmware self-test {model}: answers match the reference (worst relative error {:.1e}); \
@@ -390,6 +391,33 @@ fn run_firmware(core: &Cpu, elf: &Path) -> Result<(Vec<(String, Run)>, String), 
         );
     }
     Ok((results, log))
+}
+
+/// The log says which core ran: the core the self-test's first line names
+/// (`self-test: demo scene, ..., fixed core; ...`) and the node's (`node: monitoring ...,
+/// fixed core, ...`) are the one every `result` line reports (`core=fixed`).
+fn cores_named(log: &str) -> Result<(), String> {
+    let named = |start: &str| -> Result<&str, String> {
+        let line = log
+            .lines()
+            .find(|l| l.starts_with(start))
+            .ok_or_else(|| format!("no `{start}` line in the log"))?;
+        line.split([',', ';'])
+            .find_map(|part| part.trim().strip_suffix(" core"))
+            .ok_or_else(|| format!("`{line}` names no core"))
+    };
+    let ran: Vec<&str> = Fields::all(log, "result model=")
+        .filter_map(|f| f.get("core").ok())
+        .collect();
+    for start in ["self-test: demo scene", "node: monitoring"] {
+        let name = named(start)?;
+        if let Some(other) = ran.iter().find(|&&c| c != name) {
+            return Err(format!(
+                "the log's `{start}` line names the {name} core, the self-test ran the {other} core"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `result model=elliptic core=f32 samples=36 failures=0 worst_relative_error=... stack_bytes=...`.
@@ -536,5 +564,28 @@ fn board(llvm_size: &Path) -> Result<String, String> {
             sections.flash()
         )),
         (status, log) => Err(format!("netduinoplus2 exit {status:?}:\n{log}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const RESULT: &str = "result model=elliptic core=fixed samples=36 failures=0";
+
+    #[test]
+    fn the_log_must_name_the_core_that_ran() {
+        let log = |selftest: &str, node: &str| {
+            format!(
+                "self-test: demo scene, 36 elliptic and 20 line samples, {selftest} core; SysTick ticks per 1000 instructions 1599\n\
+                 {RESULT}\n\
+                 node: monitoring the built-in scenario (8 h, one sample a second), {node} core, from the scenario's values\n"
+            )
+        };
+        assert_eq!(cores_named(&log("fixed", "fixed")), Ok(()));
+        // The Cortex-M0's log once named the f32 core it does not run.
+        assert!(cores_named(&log("f32-soft", "fixed")).is_err());
+        assert!(cores_named(&log("fixed", "f32")).is_err());
+        assert!(cores_named(RESULT).is_err());
     }
 }

@@ -4,6 +4,7 @@
 mod accuracy;
 mod bench;
 mod cross;
+mod docs;
 mod figures;
 mod firmware;
 mod fit;
@@ -22,6 +23,8 @@ mod sweep;
 mod tables;
 mod tools;
 mod trace;
+#[cfg(test)]
+mod tracked;
 mod web;
 
 use clap::{Parser, Subcommand};
@@ -74,6 +77,10 @@ enum Task {
         /// Fail if a committed SVG differs instead of writing it.
         #[arg(long)]
         check: bool,
+        /// Instead: render every SVG under docs/ and the monitor example's figures in
+        /// Chromium, librsvg and ImageMagick and fail where two renderings differ.
+        #[arg(long, conflicts_with = "check")]
+        renderers: bool,
     },
     /// Speed against error: the benchmark image on the Cortex-M0, M3, M4F, M7 in QEMU
     /// (instructions) and the same code on the host against the reference data
@@ -123,6 +130,9 @@ enum Task {
     /// compared with the host's replay; or serve, feed a trace, write the register map,
     /// measure the server's cost.
     Modbus(modbus::Args),
+    /// Run every block of README.md and the pages under docs/ as a reader would, and
+    /// write the text blocks that show a command's output from what it prints.
+    Docs(docs::Args),
     /// The Raspberry Pi Pico node in an emulator of its chip (rp2040js, lab/pico), its
     /// sensors simulated at the pins: the checks, --serve, --trace, --uf2, --measure.
     Pico(pico::Args),
@@ -152,7 +162,17 @@ fn main() -> ExitCode {
             )
         }
         Task::Sweep { quick, write } => sweep_task(quick, write),
-        Task::Figures { check } => figures::run(&root().join("docs"), check),
+        Task::Figures {
+            renderers: true, ..
+        } => match figures::render::check(&root()) {
+            Ok(true) => ExitCode::SUCCESS,
+            Ok(false) => ExitCode::FAILURE,
+            Err(e) => {
+                eprintln!("xtask figures --renderers: {e}");
+                ExitCode::FAILURE
+            }
+        },
+        Task::Figures { check, .. } => figures::run(&root().join("docs"), check),
         Task::Bench { csv, short, cpu } => bench::run(csv, short, cpu.as_deref()),
         Task::Shapes { short, csv } => shapes::run(short, csv),
         Task::Firmware { write } => firmware::run(write),
@@ -160,6 +180,7 @@ fn main() -> ExitCode {
         Task::Nopanic => nopanic::run(),
         Task::Measurements { check } => measurements::run(check),
         Task::Modbus(args) => modbus::run(&args),
+        Task::Docs(args) => docs::run(&args),
         Task::Pico(args) => pico::run(&args),
         Task::Web(args) => web::run(&args),
     }

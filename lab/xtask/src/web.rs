@@ -59,7 +59,7 @@ pub fn run(args: &Args) -> ExitCode {
     let result = if let Some(port) = args.serve {
         serve(port)
     } else if args.test {
-        test()
+        browser_tests()
     } else if args.measure {
         measure(args.rows)
     } else {
@@ -585,7 +585,7 @@ fn node_script(script: &str, env: &[(&str, String)]) -> Result<String, String> {
 }
 
 /// `--test`.
-fn test() -> Result<(), String> {
+fn browser_tests() -> Result<(), String> {
     let start = Instant::now();
     let files = out().join("test");
     reference_files(&files)?;

@@ -287,6 +287,11 @@ impl Replay {
         each!(self, m => m.monitor.friction_status())
     }
 
+    /// The monitor's configuration (its thresholds, as a plot draws them).
+    pub fn config(&self) -> &Config {
+        each!(self, m => &m.config)
+    }
+
     /// The planner's table (the monitor example's `--thresholds`) over loads up to
     /// 1.2 times the trace's 99.9th percentile (`PlanRange::Trace`), on the replay's
     /// core and configuration; `None` unless the survey counted the loads.

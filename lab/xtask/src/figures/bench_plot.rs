@@ -4,8 +4,8 @@
 
 use super::labels::{LabelReport, Labels};
 use super::{
-    Area, BLUE_, FONT, GREEN_, GREY, LIGHT, NOTE, ORANGE, PURPLE, Res, SKY, VERMILION, log_axis,
-    power_of_ten, render_sized, ten_to, text,
+    Area, BLUE_, FONT, GREEN_, GREY, LIGHT, NOTE, ORANGE, PURPLE, Res, SKY, VERMILION, captioned,
+    log_axis, power_of_ten, render_sized, ten_to, text, y_title,
 };
 use crate::records::{self, BenchRow};
 use plotters::prelude::*;
@@ -227,9 +227,10 @@ fn draw_panel(
     numbered: &[(String, String)],
 ) -> Res<Labels> {
     let y_of = |r: &BenchRow| err(r).max(axes.floor);
-    let mut chart = ChartBuilder::on(cell)
-        .caption(&panel.title, (FONT, PANEL_TITLE))
+    let body = captioned(cell, &panel.title, PANEL_TITLE, 12)?;
+    let mut chart = ChartBuilder::on(&body)
         .margin(12)
+        .margin_top(0)
         .margin_right(20)
         .x_label_area_size(52)
         .y_label_area_size(82)
@@ -240,7 +241,6 @@ fn draw_panel(
     chart
         .configure_mesh()
         .x_desc("instructions per call (mean; QEMU -icount)")
-        .y_desc("max. relative error")
         .x_label_formatter(&power_of_ten)
         .y_label_formatter(&|v| {
             // Every other decade: the axis is long.
@@ -253,9 +253,10 @@ fn draw_panel(
         })
         .axis_desc_style((FONT, AXIS))
         .label_style((FONT, TICKS))
-        .light_line_style(WHITE)
+        .max_light_lines(0)
         .bold_line_style(LIGHT)
         .draw()?;
+    y_title(&chart, "max. relative error", AXIS)?;
     if axes.has_zero {
         chart.draw_series(DashedLineSeries::new(
             [

@@ -11,6 +11,7 @@
 mod bench_plot;
 mod labels;
 mod paper;
+pub mod render;
 mod shapes_plot;
 
 pub use bench_plot::speed_vs_error;
@@ -33,7 +34,8 @@ type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
 /// Every figure is drawn at this size (px).
 pub const SIZE: (u32, u32) = (800, 600);
-const FONT: &str = "sans-serif";
+/// The one font every renderer here has ([`misalign_cli::svg`]).
+const FONT: &str = misalign_cli::svg::FONT;
 /// Font sizes as plotters takes them (it writes `size / 1.24` px into the SVG).
 const TITLE: u32 = 25;
 const DESC: u32 = 21;
@@ -119,7 +121,8 @@ fn render(draw: impl FnOnce(&Area) -> Res<()>) -> Res<String> {
     render_sized(SIZE, draw)
 }
 
-/// Draws into an SVG of `size` px held in memory and returns it.
+/// Draws into an SVG of `size` px held in memory and returns it, as a browser, librsvg
+/// and ImageMagick draw alike ([`misalign_cli::svg::portable`]).
 fn render_sized(size: (u32, u32), draw: impl FnOnce(&Area) -> Res<()>) -> Res<String> {
     let mut buf = String::new();
     {
@@ -128,7 +131,39 @@ fn render_sized(size: (u32, u32), draw: impl FnOnce(&Area) -> Res<()>) -> Res<St
         draw(&root)?;
         root.present()?;
     }
-    Ok(buf)
+    Ok(misalign_cli::svg::portable(&buf)?)
+}
+
+/// Room between a caption and its plot for the y axis's title (px).
+const Y_TITLE_ROOM: i32 = 24;
+
+/// Draws `caption` centred at the top of `area`, `margin` px down, and returns the area
+/// under it, with room above the plot for the y axis's title ([`y_title`]).
+fn captioned<'a>(area: &Area<'a>, caption: &str, size: u32, margin: i32) -> Res<Area<'a>> {
+    let (w, _) = area.dim_in_pixel();
+    area.draw_text(
+        caption,
+        &text(size, BLACK, HPos::Center, VPos::Top),
+        (w as i32 / 2, margin),
+    )?;
+    // plotters writes a font size of `size / 1.24` px; a line is about 1.2 of it.
+    let caption_px = (f64::from(size) / 1.24 * 1.2).ceil() as i32;
+    Ok(area.margin(margin + caption_px + Y_TITLE_ROOM, 0, 0, 0))
+}
+
+/// The y axis's title, horizontal, above the plot's top left corner: ImageMagick draws
+/// rotated text the other way round.
+fn y_title<CT: CoordTranslate>(
+    chart: &ChartContext<'_, SVGBackend<'_>, CT>,
+    title: &str,
+    size: u32,
+) -> Res<()> {
+    chart.plotting_area().strip_coord_spec().draw_text(
+        title,
+        &text(size, BLACK, HPos::Left, VPos::Bottom),
+        (0, -8),
+    )?;
+    Ok(())
 }
 
 /// Legend entry: a short line in `style`.

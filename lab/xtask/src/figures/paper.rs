@@ -2,7 +2,8 @@
 
 use super::{
     Area, BLUE_, DESC, FONT, GREY, LABEL, LIGHT, NOTE, Res, SLIP_FILL, STICK_FILL, TITLE,
-    VERMILION, legend_dashed, legend_line, log_axis, one_decimal, power_of_ten, render, sig3, text,
+    VERMILION, captioned, legend_dashed, legend_line, log_axis, one_decimal, power_of_ten, render,
+    sig3, text, y_title,
 };
 use misalign::Scene;
 use misalign::reference::{self, Elliptic, line, normal, tangential};
@@ -203,15 +204,14 @@ where
     chart
         .configure_mesh()
         .x_desc(x.0)
-        .y_desc(y.0)
         .x_label_formatter(x.1)
         .y_label_formatter(y.1)
         .axis_desc_style((FONT, DESC))
         .label_style((FONT, LABEL))
-        .light_line_style(WHITE)
+        .max_light_lines(0)
         .bold_line_style(LIGHT)
         .draw()?;
-    Ok(())
+    y_title(chart, y.0, DESC)
 }
 
 /// The legend box at `at`, `margin` px from the plot's edge.
@@ -236,12 +236,15 @@ fn legend<'a, 'b: 'a, CT: CoordTranslate>(
 pub fn fig1() -> Res<String> {
     let data = fig1_data(&theta_grid(THETA_POINTS));
     render(|root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                "Fig. 1 (paper, eqs 5-6): ellipse coefficients m, n at small θ",
-                (FONT, TITLE),
-            )
+        let body = captioned(
+            root,
+            "Fig. 1 (paper, eqs 5-6): ellipse coefficients m, n at small θ",
+            TITLE,
+            18,
+        )?;
+        let mut chart = ChartBuilder::on(&body)
             .margin(18)
+            .margin_top(0)
             .x_label_area_size(62)
             .y_label_area_size(90)
             .build_cartesian_2d(log_axis(-6, -1), log_axis(-3, 5))?;
@@ -310,16 +313,16 @@ pub fn fig2() -> Res<String> {
 }
 
 fn stick_slip_panel(area: &Area, s: f64, zone: &[(f64, f64, f64)]) -> Res<()> {
-    let mut chart = ChartBuilder::on(area)
-        .caption("(a) stick and slip zones", (FONT, DESC))
+    let body = captioned(area, "(a) stick and slip zones", DESC, 10)?;
+    let mut chart = ChartBuilder::on(&body)
         .margin(10)
+        .margin_top(0)
         .x_label_area_size(56)
         .y_label_area_size(62)
         .build_cartesian_2d(-1.3..1.3, -1.3..1.3)?;
     chart
         .configure_mesh()
         .x_desc("x/a (along the rollers; dimensionless)")
-        .y_desc("y/b (rolling direction; dimensionless)")
         .x_label_formatter(&one_decimal)
         .y_label_formatter(&one_decimal)
         .x_labels(6)
@@ -327,6 +330,7 @@ fn stick_slip_panel(area: &Area, s: f64, zone: &[(f64, f64, f64)]) -> Res<()> {
         .label_style((FONT, NOTE))
         .disable_mesh()
         .draw()?;
+    y_title(&chart, "y/b (rolling direction; dimensionless)", LABEL)?;
     // The ellipse x^2/a^2 + y^2/b^2 = 1, all slipping but for the stick zone.
     let outline: Vec<(f64, f64)> = (0..=360)
         .map(|i| {
@@ -377,24 +381,25 @@ fn stick_slip_panel(area: &Area, s: f64, zone: &[(f64, f64, f64)]) -> Res<()> {
 }
 
 fn traction_panel(area: &Area, s: f64, traction: &[(f64, f64, f64)]) -> Res<()> {
-    let mut chart = ChartBuilder::on(area)
-        .caption("(b) axial traction X at x = 0", (FONT, DESC))
+    let body = captioned(area, "(b) axial traction X at x = 0", DESC, 10)?;
+    let mut chart = ChartBuilder::on(&body)
         .margin(10)
+        .margin_top(0)
         .x_label_area_size(56)
         .y_label_area_size(62)
         .build_cartesian_2d(-1.05..1.05, 0.0..1.15)?;
     chart
         .configure_mesh()
         .x_desc("y/b (rolling direction; dimensionless)")
-        .y_desc("X / (μ p₀) (dimensionless)")
         .x_label_formatter(&one_decimal)
         .y_label_formatter(&one_decimal)
         .x_labels(6)
         .axis_desc_style((FONT, LABEL))
         .label_style((FONT, NOTE))
-        .light_line_style(WHITE)
+        .max_light_lines(0)
         .bold_line_style(LIGHT)
         .draw()?;
+    y_title(&chart, "X / (μ p₀) (dimensionless)", LABEL)?;
     // Stick zone at x = 0: y from 2d - b to b.
     chart.draw_series(std::iter::once(Rectangle::new(
         [(2.0 * s - 1.0, 0.0), (1.0, 1.15)],
@@ -444,12 +449,15 @@ fn traction_panel(area: &Area, s: f64, traction: &[(f64, f64, f64)]) -> Res<()> 
 pub fn fig3() -> Res<String> {
     let data = fig3_data(&theta_grid(THETA_POINTS));
     render(|root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                "Fig. 3 (paper, eq 18): critical load μ³P₀* = (π m n θ)³/48",
-                (FONT, TITLE),
-            )
+        let body = captioned(
+            root,
+            "Fig. 3 (paper, eq 18): critical load μ³P₀* = (π m n θ)³/48",
+            TITLE,
+            18,
+        )?;
+        let mut chart = ChartBuilder::on(&body)
             .margin(18)
+            .margin_top(0)
             .x_label_area_size(62)
             .y_label_area_size(90)
             .build_cartesian_2d(log_axis(-6, -1), log_axis(-13, -1))?;
@@ -487,12 +495,15 @@ pub fn fig3() -> Res<String> {
 pub fn fig4() -> Res<String> {
     let data = fig4_data(50);
     render(|root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                "Fig. 4 (paper, eq 21): axial force F/(μP) versus slip ratio d/b",
-                (FONT, TITLE),
-            )
+        let body = captioned(
+            root,
+            "Fig. 4 (paper, eq 21): axial force F/(μP) versus slip ratio d/b",
+            TITLE,
+            18,
+        )?;
+        let mut chart = ChartBuilder::on(&body)
             .margin(18)
+            .margin_top(0)
             .x_label_area_size(62)
             .y_label_area_size(80)
             .build_cartesian_2d(0.0..1.2, 0.0..1.1)?;

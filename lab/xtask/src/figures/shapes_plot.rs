@@ -3,8 +3,8 @@
 
 use super::labels::{LabelReport, Labels, text_width};
 use super::{
-    Area, BLUE_, FONT, GREEN_, GREY, LIGHT, ORANGE, Res, VERMILION, log_axis, power_of_ten,
-    render_sized, text,
+    Area, BLUE_, FONT, GREEN_, GREY, LIGHT, ORANGE, Res, VERMILION, captioned, log_axis,
+    power_of_ten, render_sized, text, y_title,
 };
 use crate::records::ShapeRow;
 use plotters::prelude::*;
@@ -285,9 +285,10 @@ fn panel(root: &Area, area: &Area, rows: &[&ShapeRow]) -> Res<Labels> {
         .floor() as i32;
     let y_hi = ((finite().fold(0.0, f64::max) * 2.0).log10().ceil() as i32).max(y_lo + 1);
 
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, (FONT, PANEL_TITLE))
+    let body = captioned(area, &title, PANEL_TITLE, 12)?;
+    let mut chart = ChartBuilder::on(&body)
         .margin(12)
+        .margin_top(0)
         .margin_right(22)
         .x_label_area_size(48)
         .y_label_area_size(78)
@@ -296,15 +297,15 @@ fn panel(root: &Area, area: &Area, rows: &[&ShapeRow]) -> Res<Labels> {
     chart
         .configure_mesh()
         .x_desc("instructions per evaluation (mean)")
-        .y_desc("max. relative error")
         .x_labels(ticks)
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&power_of_ten)
         .axis_desc_style((FONT, AXIS))
         .label_style((FONT, TICKS))
-        .light_line_style(WHITE)
+        .max_light_lines(0)
         .bold_line_style(LIGHT)
         .draw()?;
+    y_title(&chart, "max. relative error", AXIS)?;
     let (xs, ys) = chart.plotting_area().get_pixel_range();
     let mut labels = Labels::new([xs.start, ys.start, xs.end, ys.end]);
     let on = |front: &[&ShapeRow], r: &ShapeRow| front.iter().any(|f| std::ptr::eq(*f, r));

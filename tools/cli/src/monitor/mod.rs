@@ -361,7 +361,14 @@ fn run_replay(mut replay: Replay, args: &Args, total: u64, io: &mut Io<'_>) -> R
         let _ = writeln!(io.err, "wrote {}", path.display());
     }
     if let Some(path) = &args.plot {
-        plot::timeline(path, &timeline)?;
+        let source = match &args.trace {
+            Some(trace) => trace.file_name().map_or_else(
+                || trace.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            ),
+            None => "the built-in 8 h scenario".to_string(),
+        };
+        plot::timeline(path, &timeline, &replay.config().thresholds, &source)?;
         let _ = writeln!(io.err, "wrote {}", path.display());
     }
     if let Some(path) = &args.thresholds {
