@@ -95,6 +95,37 @@ impl Scene {
         Ok(scene)
     }
 
+    /// Whether [`Scene::new`] accepts two rollers of radii `r1`, `r2` (both finite: no
+    /// plane), G, nu and mu, and [`Scene::with_length`] then `length` (if any): the same
+    /// rules without a branch, for a scene per row in SIMD lanes (the batch's); the
+    /// row's error, where not, comes from [`Scene::new`].
+    #[inline(always)]
+    pub(crate) fn accepts_rollers(
+        r1: f64,
+        r2: f64,
+        shear_modulus: f64,
+        poisson_ratio: f64,
+        friction: f64,
+        length: Option<f64>,
+    ) -> bool {
+        let positive_finite = |x: f64| (x > 0.0) & (x < f64::INFINITY);
+        let (small, large) = (r1.min(r2), r1.max(r2));
+        let radius = small / (1.0 + small / large);
+        let rollers = positive_finite(r1)
+            & positive_finite(r2)
+            & (radius != 0.0)
+            & positive_finite(shear_modulus)
+            & (0.0..=0.5).contains(&poisson_ratio)
+            & positive_finite(friction);
+        match length {
+            None => rollers,
+            Some(l) => {
+                let shortest = 2.0 * (1.0 - poisson_ratio) * radius * SHORT_ROLLER_PRESSURE;
+                rollers & positive_finite(l) & (l >= shortest)
+            }
+        }
+    }
+
     /// The same scene with the rollers' contact length (m), which lets the model
     /// choice of section 9 switch to line contact when the ellipse is longer.
     ///

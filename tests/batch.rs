@@ -613,3 +613,61 @@ fn an_adc_lsb_the_core_cannot_take_is_named() {
         None
     );
 }
+
+/// The AVX2 build of the batch answers every column as the baseline build, bit for bit:
+/// one scene for all (the reference's lanes, the f32 core's blocks) and a scene per row
+/// (the 50-digit file's scenes, and scenes varied row by row over the sweep), every
+/// model, without and with details.
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn avx2_build_gives_the_same_bits() {
+    if !std::arch::is_x86_feature_detected!("avx2") {
+        eprintln!("no AVX2 on this CPU: nothing to compare");
+        return;
+    }
+    let (load, phi) = sweep();
+    let n = load.len();
+    // Scenes varied row by row: radii, modulus and friction over their practical ranges.
+    let vary = |i: usize, lo: f64, hi: f64, k: usize| lo + (hi - lo) * ((i * k) % 97) as f64 / 96.0;
+    let varied: [Vec<f64>; 7] = [
+        (0..n).map(|i| vary(i, 0.01, 0.1, 7)).collect(),
+        (0..n).map(|i| vary(i, 0.01, 0.1, 13)).collect(),
+        (0..n).map(|i| vary(i, 70e9, 85e9, 29)).collect(),
+        vec![0.3; n],
+        (0..n).map(|i| vary(i, 0.05, 0.6, 41)).collect(),
+        load.clone(),
+        phi.clone(),
+    ];
+    let file = read_inputs(&read_rows("vectors_scene.csv"));
+    let scene = Scene::DEMO;
+    let one = Inputs::one_scene(&scene, Column::Each(&load), Column::Each(&phi));
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    for input in [
+        one,
+        inputs(&varied, ModelChoice::Section9),
+        inputs(&file, ModelChoice::Section9),
+    ] {
+        let rows = match input.load {
+            Column::Each(x) => x.len(),
+            Column::One(_) => 1,
+        };
+        for model in [Model::Reference, Model::F32, Model::Fixed(Counts::Exact)] {
+            for details in [false, true] {
+                let (mut a, mut b) = (Owned::new(rows), Owned::new(rows));
+                let bad_a = batch::estimate(&input, &mut a.outputs(details), model).unwrap();
+                // SAFETY: the CPU has AVX2 (checked above), the only feature it needs.
+                let bad_b = unsafe { batch::estimate_avx2(&input, &mut b.outputs(details), model) }
+                    .unwrap();
+                assert_eq!(bad_a, bad_b);
+                assert_eq!(bits(&a.s), bits(&b.s), "{model:?}");
+                assert_eq!(bits(&a.f), bits(&b.f), "{model:?}");
+                assert_eq!(bits(&a.phi0), bits(&b.phi0), "{model:?}");
+                assert_eq!((&a.regime, &a.model), (&b.regime, &b.model));
+                assert_eq!((&a.flags, &a.status), (&b.flags, &b.status));
+                for (x, y) in a.details.iter().zip(&b.details) {
+                    assert_eq!(bits(x), bits(y));
+                }
+            }
+        }
+    }
+}

@@ -229,7 +229,15 @@ fn exceptions_as_the_specification_orders_them() {
     let end = TableMap::of(misalign::modbus::map::Table::Input).end();
     assert_eq!(read(&mut s, 4, end - 1, 1).len(), 1);
     assert_eq!(exception(&request(&mut s, 4, &be(&[end - 1, 2])), 4), 2);
-    assert_eq!(exception(&request(&mut s, 2, &be(&[0, 11])), 2), 2);
+    let discretes = TableMap::of(misalign::modbus::map::Table::Discrete).end();
+    assert_eq!(
+        read_bits(&mut s, 2, 0, discretes).len(),
+        usize::from(discretes)
+    );
+    assert_eq!(
+        exception(&request(&mut s, 2, &be(&[0, discretes + 1])), 2),
+        2
+    );
     // Writes to read-only or partial values: 02; values out of domain: 03.
     assert_eq!(
         exception(&request(&mut s, 6, &be(&[0, 5])), 6),

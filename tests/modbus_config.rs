@@ -574,7 +574,7 @@ fn the_committed_image_restores_at_boot() {
     bad[0] = 3; // a newer image version
     cases.push(bad.to_vec());
     let mut bad = image;
-    bad[1] |= 4; // a flag no version has
+    bad[1] |= 8; // a flag no version has
     cases.push(bad.to_vec());
     let mut bad = image;
     bad[4 + 2 * 31] = 0; // spike_window 9: the configuration fails validate
@@ -1233,4 +1233,113 @@ fn every_register_refuses_what_its_domain_leaves_out() {
         }
     }
     assert!(checked > 40, "{checked}");
+}
+
+/// `status`'s NE 107 category (bits 8-11) and the discrete input `scene_commissioned`.
+fn commissioning_state<E: Estimator>(s: &mut Server<E>) -> (u16, bool) {
+    let status = request(s, 4, &words_be(&[0, 1]));
+    assert_eq!(&status[..2], &[4, 2], "{status:?}");
+    let category = u16::from_be_bytes([status[2], status[3]]) >> 8 & 0xF;
+    let address = TableMap::of(Table::Discrete)
+        .entries
+        .iter()
+        .find(|e| e.name == "scene_commissioned")
+        .expect("the discrete input scene_commissioned")
+        .address;
+    let bits = request(s, 2, &words_be(&[address, 1]));
+    assert_eq!(&bits[..2], &[2, 1], "{bits:?}");
+    (category, bits[2] & 1 == 1)
+}
+
+const FUNCTION_CHECK: u16 = 3;
+
+/// A node that needs its site's scene (`scene_required`: the Pico with its own
+/// sensors) reports "not commissioned" until a scene is committed over the bus: NE 107
+/// function check whatever it is fed, `scene_commissioned` 0. A commit of the
+/// configuration alone does not commission it; a scene's commit does, and that is kept
+/// in the committed image through a restart (an image claiming it without a scene is
+/// refused). A node that needs none reports its state as before.
+#[test]
+fn a_node_needing_its_scene_reports_not_commissioned_until_one_is_committed() {
+    let needing = || {
+        let monitor = Monitor::new(core(&Scene::DEMO), Config::default()).unwrap();
+        let config = ServerConfig {
+            scene_required: true,
+            ..ServerConfig::default()
+        };
+        let mut s = Server::new(monitor, config).unwrap();
+        s.accept_scenes();
+        s.tick(0);
+        s
+    };
+    let feed = |s: &mut Server<Auto>, from: u32| {
+        for i in from..from + 20 {
+            s.process(Sample::new(i * 1000, 2e3, 1e-5).with_speed(2.0));
+        }
+    };
+    // Without the need: the build's scene is not a commissioned one, yet the state is
+    // reported once it settles.
+    let mut plain = server();
+    feed(&mut plain, 0);
+    let (category, commissioned) = commissioning_state(&mut plain);
+    assert!(!commissioned);
+    assert_ne!(category, FUNCTION_CHECK);
+
+    let mut s = needing();
+    assert!(!s.scene_commissioned());
+    assert_eq!(commissioning_state(&mut s), (FUNCTION_CHECK, false));
+    feed(&mut s, 0);
+    assert_eq!(commissioning_state(&mut s), (FUNCTION_CHECK, false));
+    // The configuration alone.
+    unlock(&mut s);
+    put(&mut s, "config_on_delay", 3000).unwrap();
+    cmd(&mut s, command::COMMIT).unwrap();
+    assert_eq!(s.config_source(), BootSource::Committed);
+    assert!(!s.scene_commissioned());
+    feed(&mut s, 20);
+    assert_eq!(commissioning_state(&mut s), (FUNCTION_CHECK, false));
+    let mut image = [0; IMAGE_LEN];
+    assert!(s.take_committed(&mut image));
+    let mut booted = needing();
+    assert_eq!(booted.restore(Stored::Image(&image)), BootSource::Committed);
+    assert!(!booted.scene_commissioned());
+
+    // The site's scene.
+    let (_, bytes) = other_scene();
+    unlock(&mut s);
+    write(&mut s, SCENE_ADDRESS, &scene_words(&bytes)).unwrap();
+    cmd(&mut s, command::COMMIT).unwrap();
+    assert!(s.scene_commissioned());
+    assert!(commissioning_state(&mut s).1);
+    feed(&mut s, 40);
+    let (category, commissioned) = commissioning_state(&mut s);
+    assert!(commissioned);
+    assert_ne!(category, FUNCTION_CHECK);
+    assert!(s.take_committed(&mut image));
+    let mut booted = needing();
+    assert_eq!(booted.restore(Stored::Image(&image)), BootSource::Committed);
+    assert!(booted.scene_commissioned());
+    assert_eq!(booted.monitor().estimator().to_bytes().to_vec(), bytes);
+    feed(&mut booted, 0);
+    assert_ne!(commissioning_state(&mut booted).0, FUNCTION_CHECK);
+    // A later commit of the configuration alone keeps the scene commissioned.
+    unlock(&mut booted);
+    put(&mut booted, "config_on_delay", 4000).unwrap();
+    cmd(&mut booted, command::COMMIT).unwrap();
+    assert!(booted.scene_commissioned());
+    assert!(booted.take_committed(&mut image));
+    let mut again = needing();
+    assert_eq!(again.restore(Stored::Image(&image)), BootSource::Committed);
+    assert!(again.scene_commissioned());
+
+    // An image claiming a committed scene but holding none is not one.
+    let mut bad = image;
+    bad[1] &= !1;
+    let mut b = needing();
+    assert_eq!(b.restore(Stored::Image(&bad)), BootSource::DefaultsDamaged);
+    assert!(!b.scene_commissioned());
+    // Nothing stored: not commissioned.
+    let mut b = needing();
+    assert_eq!(b.restore(Stored::Nothing), BootSource::Defaults);
+    assert_eq!(commissioning_state(&mut b), (FUNCTION_CHECK, false));
 }

@@ -61,10 +61,12 @@ fn flash_of(q: Q) -> Flash {
     q.into_flash().0
 }
 
-/// The unacknowledged events, read back in order, each equal to what was pushed.
+/// The unacknowledged events, read back in order from the oldest (numbers wrap), each
+/// equal to what was pushed.
 fn unacked(q: &mut Q) -> Vec<u32> {
     let mut out = Vec::new();
-    block_on(q.read(0, |seq, e| {
+    let from = q.state().first.unwrap_or(0);
+    block_on(q.read(from, |seq, e| {
         assert_eq!(e, event(seq));
         out.push(seq);
         true
@@ -142,6 +144,68 @@ fn numbers_wrap_modulo_2_pow_32() {
     assert_eq!(block_on(q.acknowledge(u32::MAX)), Ok(true));
     let mut q = boot(flash_of(q));
     assert_eq!(unacked(&mut q), [0, 1]);
+}
+
+/// Only a number of a record held and not yet acknowledged acknowledges: after
+/// records 0 to 8, a number never given (ahead of the newest, or half the number space
+/// away, where a comparison modulo 2^32 alone reads it as an old one) writes nothing
+/// and acknowledges nothing, at a fresh start and after an acknowledgement alike; so
+/// do a number acknowledged already and any number on an empty queue. Around the wrap
+/// of the numbers likewise.
+#[test]
+fn only_a_number_of_a_record_held_acknowledges() {
+    let never = |newest: u32| {
+        [
+            1,
+            2,
+            0x7FFF_FFFF,
+            0x8000_0000,
+            0x8000_0001,
+            0x9000_0000,
+            0xFFFF_FFF0,
+        ]
+        .map(|d: u32| newest.wrapping_add(d))
+    };
+    let refused = |q: Q, through: u32| -> Q {
+        let flash = flash_of(q);
+        let points = flash.points();
+        let mut q = boot(flash);
+        let before = q.state();
+        assert_eq!(block_on(q.acknowledge(through)), Ok(false), "{through:#x}");
+        assert_eq!(q.state(), before, "{through:#x}");
+        let flash = flash_of(q);
+        assert_eq!(flash.points(), points, "{through:#x}: written");
+        boot(flash)
+    };
+    let mut q = boot(Flash::new());
+    for n in [0, 1, 0x9000_0000, u32::MAX] {
+        q = refused(q, n);
+    }
+    for start in [0, u32::MAX - 3] {
+        let mut q = boot(Flash::new());
+        for k in 0..9u32 {
+            push(&mut q, start.wrapping_add(k));
+        }
+        let newest = start.wrapping_add(8);
+        for n in never(newest) {
+            q = refused(q, n);
+        }
+        assert_eq!(q.acknowledged(), None);
+        assert_eq!(unacked(&mut q).len(), 9);
+        let through = start.wrapping_add(3);
+        assert_eq!(block_on(q.acknowledge(through)), Ok(true));
+        for n in never(newest)
+            .into_iter()
+            .chain([through, start, start.wrapping_sub(1)])
+        {
+            q = refused(q, n);
+        }
+        assert_eq!(q.acknowledged(), Some(through));
+        assert_eq!(block_on(q.acknowledge(newest)), Ok(true));
+        assert_eq!(unacked(&mut q), Vec::<u32>::new());
+        q = refused(q, newest);
+        let _ = q;
+    }
 }
 
 #[test]

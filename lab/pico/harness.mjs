@@ -418,6 +418,7 @@ class Harness {
       ads1115_conversions: this.ads.conversions,
       pulses: this.tach.pulses,
       stack: this.stackUsed(),
+      stack_reserved: this.stackBounds() ? this.stackBounds().top - this.stackBounds().bottom : null,
     };
   }
 

@@ -7,7 +7,6 @@
 
 use embedded_io::{ErrorType, Read, ReadReady, Write};
 use misalign::Estimator;
-use misalign::modbus::BootSource;
 use misalign::modbus::{Identification, PreparedScene, Server, ServerConfig};
 use misalign::monitor::scenario::Scenario;
 use misalign::monitor::{Config, Monitor, Sample};
@@ -65,9 +64,10 @@ impl Board for Bare {
 /// (the default) it first monitors the whole built-in scenario, so that every register
 /// holds the end of the shift, the state a host replay of the same samples reaches;
 /// with external samples it starts fresh and monitors what a master writes. On a board
-/// with sensors ([`Board::SENSORS`]) it monitors the board's samples once a
-/// configuration was committed over the bus (the scene of the site; before that it
-/// serves only, to be commissioned), each monitored sample logged as a `sample` line.
+/// with sensors ([`Board::SENSORS`]) it monitors the board's samples once the site's
+/// scene was committed over the bus (before that it serves only, to be commissioned,
+/// and reports "not commissioned": `ServerConfig::scene_required`), each monitored
+/// sample logged as a `sample` line.
 /// `None` if the monitor refuses its configuration.
 pub fn node<
     E: Estimator + PreparedScene,
@@ -95,6 +95,7 @@ pub fn node<
     };
     let config = ServerConfig {
         external_samples: EXTERNAL_SAMPLES,
+        scene_required: B::SENSORS && !EXTERNAL_SAMPLES,
         ident: Identification {
             model_name: model,
             ..Identification::default()
@@ -138,7 +139,7 @@ pub fn node<
         if EXTERNAL_SAMPLES {
             "the master"
         } else if B::SENSORS {
-            "the board's sensors, once commissioned"
+            "the board's sensors, once the site's scene is committed"
         } else {
             "the built-in scenario"
         },
@@ -156,7 +157,7 @@ pub fn node<
         board.alive();
         if let Some(sample) = board.sample()
             && !server.external_samples()
-            && server.config_source() == BootSource::Committed
+            && server.scene_commissioned()
         {
             server.process(sample);
             log_sample(&sample);

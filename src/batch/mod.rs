@@ -40,7 +40,7 @@ mod rows;
 mod threads;
 
 #[cfg(feature = "rayon")]
-pub use threads::par_estimate;
+pub use threads::{par_estimate, par_estimate_with};
 
 use crate::reference::ModelChoice;
 use crate::{Error, Scene};
@@ -552,6 +552,37 @@ pub fn rows(inputs: &Inputs<'_>, outputs: &mut Outputs<'_>) -> Result<usize, Mis
 /// [`Mismatch`] when a per-row column or an output slice is not the outputs' length;
 /// nothing is written then.
 pub fn estimate(
+    inputs: &Inputs<'_>,
+    outputs: &mut Outputs<'_>,
+    model: Model,
+) -> Result<usize, Mismatch> {
+    estimate_inline(inputs, outputs, model)
+}
+
+/// [`estimate`] compiled for x86-64 with AVX2: the reference's SIMD lanes four f64
+/// wide instead of SSE2's two, the same numbers bit for bit (no fused multiply-add is
+/// enabled, so every operation rounds as in [`estimate`]; tests/batch.rs compares
+/// them).
+///
+/// # Safety
+/// The CPU must have AVX2 (`is_x86_feature_detected!("avx2")`): calling it from code
+/// compiled without AVX2 takes `unsafe` for that reason alone.
+///
+/// # Errors
+/// As [`estimate`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+pub fn estimate_avx2(
+    inputs: &Inputs<'_>,
+    outputs: &mut Outputs<'_>,
+    model: Model,
+) -> Result<usize, Mismatch> {
+    estimate_inline(inputs, outputs, model)
+}
+
+/// [`estimate`]'s body, inlined into each build of it.
+#[inline(always)]
+fn estimate_inline(
     inputs: &Inputs<'_>,
     outputs: &mut Outputs<'_>,
     model: Model,

@@ -3,8 +3,8 @@
 
 use super::{Column, Counts, Inputs, NONE, OK, Outputs, flags, status_of};
 use crate::fixed::{FixedAuto, FixedEllipticScene, exact_lsb};
-use crate::float::block::{BLOCK, Block};
-use crate::float::{Auto, AutoEstimate};
+use crate::float::block::{BLOCK, Block, HotPerSample, hot_of};
+use crate::float::{Auto, AutoEstimate, EllipticScene};
 use crate::reference::{self, ANGLE_LIMIT, ContactModel, ModelChoice, Regime, Validity};
 use crate::{Error, Scene};
 
@@ -200,22 +200,6 @@ fn fast_row(e: &reference::fast::Elliptic) -> Row {
     }
 }
 
-/// A row the fast path left to the reference (or answered with line contact), out of
-/// the eight-row loop.
-#[cold]
-#[inline(never)]
-fn other_row(
-    out: &mut Outputs<'_>,
-    i: usize,
-    scene: &Scene,
-    answer: Option<reference::fast::Answer>,
-    load: f64,
-    phi: f64,
-    choice: ModelChoice,
-) -> usize {
-    put_reference(out, i, reference_row(scene, answer, load, phi, choice))
-}
-
 /// The reference's answer for one row, and its further numbers: the fast path's
 /// `answer` where it has one, else the reference's.
 #[inline]
@@ -285,8 +269,8 @@ fn reference_row(
     })
 }
 
-/// Rows the reference's fast path takes at a time (their latency chains side by side).
-const LANES: usize = 8;
+/// Rows the reference's fast path takes at a time, in SIMD lanes.
+const LANES: usize = 16;
 
 /// Writes a reference row; returns 1 for a refused row.
 fn put_reference(
@@ -300,9 +284,18 @@ fn put_reference(
     }
 }
 
-pub(super) fn reference(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) -> usize {
+/// A row's scene and its fast path (`None` with details: every row the reference's).
+type Prepared = (Scene, Option<reference::fast::Prepared>);
+
+/// Row `i` one at a time: its scene prepared (once per run of equal constants), the fast
+/// path's answer where it has one, else the reference's.
+fn reference_one(
+    inputs: &Inputs<'_>,
+    out: &mut Outputs<'_>,
+    i: usize,
+    cache: &mut Cache<Prepared>,
+) -> usize {
     let details = out.details.is_some();
-    // With details every row is the reference's: no fast path to prepare.
     let prepare = |s: &Scene| {
         let fast = if details {
             None
@@ -311,49 +304,223 @@ pub(super) fn reference(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) ->
         };
         Ok((*s, fast))
     };
+    let (load, phi) = (inputs.load.at(i), inputs.phi.at(i));
+    let answer = match cache.get(inputs, i, prepare) {
+        Ok((scene, fast)) => {
+            let answer = fast.and_then(|f| f.estimate(load, phi));
+            reference_row(scene, answer, load, phi, inputs.choice)
+        }
+        Err(e) => Err(*e),
+    };
+    put_reference(out, i, answer)
+}
+
+/// [`reference_one`] out of line: the rows the lanes leave (refused, outside the fast
+/// path's domain, line contact).
+#[cold]
+#[inline(never)]
+fn reference_cold(
+    inputs: &Inputs<'_>,
+    out: &mut Outputs<'_>,
+    i: usize,
+    cache: &mut Cache<Prepared>,
+) -> usize {
+    reference_one(inputs, out, i, cache)
+}
+
+#[inline(always)]
+pub(super) fn reference(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) -> usize {
     let mut cache = Cache::new();
-    let mut bad = 0;
-    let mut start = 0;
-    // One scene for every row and no details: the fast path LANES rows at a time.
-    if !details
-        && inputs.one_scene_for_all()
-        && let Ok((scene, Some(fast))) = cache.get(inputs, 0, prepare)
-    {
-        let (scene, fast) = (*scene, *fast);
-        while start + LANES <= n {
-            let load: [f64; LANES] = core::array::from_fn(|k| inputs.load.at(start + k));
-            let phi: [f64; LANES] = core::array::from_fn(|k| inputs.phi.at(start + k));
-            let answers = fast.estimate_rows(&load, &phi);
-            for (k, answer) in answers.into_iter().enumerate() {
-                bad += match answer {
-                    // The ellipse's rows (most) straight into the columns.
-                    Some(reference::fast::Answer::Elliptic(e)) => {
-                        put(out, start + k, Ok(fast_row(&e)), &NO_DETAILS)
-                    }
-                    _ => other_row(
-                        out,
-                        start + k,
-                        &scene,
-                        answer,
-                        load[k],
-                        phi[k],
-                        inputs.choice,
-                    ),
-                };
+    if out.details.is_some() || inputs.choice == ModelChoice::Line {
+        // Every row the reference's: with its further numbers, or forced line contact
+        // (which the fast path never takes).
+        return (0..n)
+            .map(|i| reference_one(inputs, out, i, &mut cache))
+            .sum();
+    }
+    if !inputs.one_scene_for_all() {
+        return reference_lanes(inputs, out, n, &mut cache, PerRowScenes(inputs));
+    }
+    let fast = inputs
+        .scene(0)
+        .ok()
+        .and_then(|s| reference::fast::Prepared::new(&s, inputs.choice));
+    match fast {
+        Some(fast) => reference_lanes(inputs, out, n, &mut cache, *fast.constants()),
+        // A refused scene, or one outside the fast path: row by row.
+        None => (0..n)
+            .map(|i| reference_one(inputs, out, i, &mut cache))
+            .sum(),
+    }
+}
+
+/// The scenes of a block of LANES rows from `start` (`lanes` of them in the batch): their
+/// constants for the fast path, and which lanes may take it. A method, not a closure,
+/// so that it inlines into each build of the batch (a closure is compiled where it is
+/// written, without the features of `estimate_avx2`).
+trait LaneScenes {
+    type Lanes: reference::fast::SceneLanes;
+    fn scenes(&mut self, start: usize, lanes: usize) -> (Self::Lanes, [bool; LANES]);
+}
+
+/// One scene for every row, prepared once.
+impl LaneScenes for reference::fast::Constants {
+    type Lanes = reference::fast::Constants;
+    #[inline(always)]
+    fn scenes(&mut self, _: usize, _: usize) -> (Self::Lanes, [bool; LANES]) {
+        (*self, [true; LANES])
+    }
+}
+
+/// A scene per row ([`per_lane_scenes`]).
+struct PerRowScenes<'i, 'a>(&'i Inputs<'a>);
+
+impl LaneScenes for PerRowScenes<'_, '_> {
+    type Lanes = reference::fast::PerLane<LANES>;
+    #[inline(always)]
+    fn scenes(&mut self, start: usize, lanes: usize) -> (Self::Lanes, [bool; LANES]) {
+        per_lane_scenes(self.0, start, lanes)
+    }
+}
+
+/// The fast path's constants of the scenes of rows `start..start + LANES` (as many as
+/// there are), and which lanes have a scene that [`Scene::new`] accepts and the fast
+/// path takes.
+#[inline(always)]
+fn per_lane_scenes(
+    inputs: &Inputs<'_>,
+    start: usize,
+    lanes: usize,
+) -> (reference::fast::PerLane<LANES>, [bool; LANES]) {
+    let [r1, r2, g, nu, mu, length] = scene_lanes::<LANES>(inputs, start);
+    let mut k = reference::fast::PerLane {
+        c: [0.0; LANES],
+        inverse_c: [0.0; LANES],
+        friction: [0.0; LANES],
+        pressure_per_slip: [0.0; LANES],
+        slip_cubed: [0.0; LANES],
+        g_cubed_per_load: [0.0; LANES],
+        ratio_cubed_per_load: [0.0; LANES],
+    };
+    let mut valid = [false; LANES];
+    let has_length = inputs.length.is_some();
+    for i in 0..LANES {
+        let l = if has_length { Some(length[i]) } else { None };
+        let (c, normal) = reference::fast::Constants::of(r1[i], r2[i], g[i], nu[i], mu[i], l);
+        valid[i] =
+            normal & (i < lanes) & Scene::accepts_rollers(r1[i], r2[i], g[i], nu[i], mu[i], l);
+        k.c[i] = c.c;
+        k.inverse_c[i] = c.inverse_c;
+        k.friction[i] = c.friction;
+        k.pressure_per_slip[i] = c.pressure_per_slip;
+        k.slip_cubed[i] = c.slip_cubed;
+        k.g_cubed_per_load[i] = c.g_cubed_per_load;
+        k.ratio_cubed_per_load[i] = c.ratio_cubed_per_load;
+    }
+    (k, valid)
+}
+
+/// The scene columns R1, R2, G, nu, mu, length of rows `start..start + N` (NaN past the
+/// end; the length 0 without one).
+#[inline(always)]
+fn scene_lanes<const N: usize>(inputs: &Inputs<'_>, start: usize) -> [[f64; N]; 6] {
+    let length = inputs.length.unwrap_or(Column::One(0.0));
+    // Each column by name, not by `map` over them: a closure would not inline into the
+    // AVX2 build (and `map` copies the arrays once more).
+    [
+        lanes_of(inputs.r1, start),
+        lanes_of(inputs.r2, start),
+        lanes_of(inputs.shear_modulus, start),
+        lanes_of(inputs.poisson_ratio, start),
+        lanes_of(inputs.friction, start),
+        lanes_of(length, start),
+    ]
+}
+
+/// Rows `start..start + N` of a column (NaN past its end).
+#[inline(always)]
+fn lanes_of<const N: usize>(column: Column<'_>, start: usize) -> [f64; N] {
+    match column {
+        Column::One(x) => [x; N],
+        Column::Each(x) => {
+            let mut out = [f64::NAN; N];
+            for (y, x) in out.iter_mut().zip(x.get(start..).unwrap_or_default()) {
+                *y = *x;
             }
-            start += LANES;
+            out
         }
     }
-    for i in start..n {
-        let (load, phi) = (inputs.load.at(i), inputs.phi.at(i));
-        let answer = match cache.get(inputs, i, prepare) {
-            Ok((scene, fast)) => {
-                let answer = fast.and_then(|f| f.estimate(load, phi));
-                reference_row(scene, answer, load, phi, inputs.choice)
-            }
-            Err(e) => Err(*e),
+}
+
+/// The reference's rows LANES at a time through the fast path ([`reference::fast::rows`]),
+/// the scenes of each block from `scenes` (its lanes' constants and which lanes may
+/// take the fast path); its elliptic answers written column by column, every other row
+/// then one at a time ([`reference_cold`]).
+#[inline(always)]
+fn reference_lanes(
+    inputs: &Inputs<'_>,
+    out: &mut Outputs<'_>,
+    n: usize,
+    cache: &mut Cache<Prepared>,
+    mut scenes: impl LaneScenes,
+) -> usize {
+    let length = inputs.length.is_some();
+    let mut bad = 0;
+    let mut start = 0;
+    while start < n {
+        let lanes = LANES.min(n - start);
+        let (k, valid) = scenes.scenes(start, lanes);
+        let load = lanes_of::<LANES>(inputs.load, start);
+        let phi = lanes_of::<LANES>(inputs.phi, start);
+        let r = reference::fast::rows(&k, inputs.choice, length, &load, &phi);
+        let Some((s, f, c, g, m, fl, t)) = columns(out, n) else {
+            return 0; // not reached: `rows` checked every length
         };
-        bad += put_reference(out, i, answer);
+        let end = start + lanes;
+        let (Some(s), Some(f), Some(c), Some(g), Some(m), Some(fl), Some(t)) = (
+            s.get_mut(start..end),
+            f.get_mut(start..end),
+            c.get_mut(start..end),
+            g.get_mut(start..end),
+            m.get_mut(start..end),
+            fl.get_mut(start..end),
+            t.get_mut(start..end),
+        ) else {
+            return 0; // not reached: end <= n
+        };
+        // Every row as if answered, a column at a time.
+        for (y, x) in s.iter_mut().zip(&r.slip_ratio) {
+            *y = *x;
+        }
+        for (y, x) in f.iter_mut().zip(&r.axial_force) {
+            *y = *x;
+        }
+        for (y, x) in c.iter_mut().zip(&r.critical_angle) {
+            *y = *x;
+        }
+        for (y, x) in g.iter_mut().zip(&r.slip_ratio) {
+            *y = u8::from(*x >= 1.0);
+        }
+        m.fill(model_code(ContactModel::Elliptic));
+        t.fill(OK);
+        for (j, y) in fl.iter_mut().enumerate() {
+            *y = (u8::from(r.large_angle[j]) * flags::LARGE_ANGLE)
+                | (u8::from(r.high_pressure[j]) * flags::HIGH_PRESSURE)
+                | (u8::from(r.longer_than_rollers[j]) * flags::LONGER_THAN_ROLLERS)
+                | (u8::from(r.near_model_switch[j]) * flags::NEAR_MODEL_SWITCH)
+                | (u8::from(r.round_ellipse[j]) * flags::ROUND_ELLIPSE);
+        }
+        // The rows the lanes did not answer, over what was written for them.
+        let answered = (0..lanes).fold(true, |all, j| all & valid[j] & r.elliptic[j]);
+        if !answered {
+            let lanes_answered = valid.iter().zip(&r.elliptic).map(|(&v, &e)| v & e);
+            for (j, answered) in lanes_answered.enumerate().take(lanes) {
+                if !answered {
+                    bad += reference_cold(inputs, out, start + j, cache);
+                }
+            }
+        }
+        start = end;
     }
     bad
 }
@@ -403,8 +570,96 @@ fn float_answer(e: AutoEstimate, phi: f64) -> Row {
     }
 }
 
+#[inline(always)]
 pub(super) fn float(inputs: &Inputs<'_>, out: &mut Outputs<'_>, n: usize) -> usize {
+    // A scene per row without a length: the hot path's constants of each row's scene
+    // formed in lanes (float::block::hot_of), not a whole preparation a row.
+    if !inputs.one_scene_for_all()
+        && inputs.length.is_none()
+        && inputs.choice != ModelChoice::Line
+        && let Ok(tables) = EllipticScene::new(&Scene::DEMO)
+    {
+        return float_per_row(inputs, out, n, &tables);
+    }
     by_scene(inputs, out, n, |s| Auto::with_choice(s, inputs.choice))
+}
+
+/// The f32 core's rows with a scene per row and no length, in blocks: each row's hot
+/// constants from its scene ([`hot_of`]), the hot path over the block with `tables`'
+/// tables ([`EllipticScene::estimate_block_per_sample`]); the rows off it, or whose
+/// constants [`hot_of`] is not sure of, through their scene's [`Auto`] as prepared for
+/// one row.
+#[inline(always)]
+fn float_per_row(
+    inputs: &Inputs<'_>,
+    out: &mut Outputs<'_>,
+    n: usize,
+    tables: &EllipticScene<'static>,
+) -> usize {
+    let mut cache = Cache::new();
+    let choice = inputs.choice;
+    let per_row = PerRowBlocks {
+        inputs,
+        tables,
+        hot: HotPerSample {
+            radius_factor: [0.0; BLOCK],
+            inv_radius_factor: [0.0; BLOCK],
+            friction: [0.0; BLOCK],
+            cubed_critical_gain: [0.0; BLOCK],
+        },
+        sure: [false; BLOCK],
+    };
+    float_blocks(out, n, inputs.load, inputs.phi, per_row, |i| {
+        match cache.get(inputs, i, |s| Auto::with_choice(s, choice)) {
+            Ok(core) => float_row_cold(core, inputs.load.at(i), inputs.phi.at(i)),
+            Err(e) => Err(*e),
+        }
+    })
+}
+
+/// The hot path of a block of the f32 core's rows ([`float_blocks`]): answers the
+/// block's rows from `start` where it can. A method, not a closure, so that it inlines
+/// into each build of the batch (a closure is compiled where it is written, without
+/// the features of `estimate_avx2`).
+trait BlockHotPath {
+    fn answer(&mut self, start: usize, b: &mut Block);
+}
+
+/// One scene for every row.
+impl BlockHotPath for &Auto {
+    #[inline(always)]
+    fn answer(&mut self, _: usize, b: &mut Block) {
+        self.estimate_block(b);
+    }
+}
+
+/// A scene per row: each row's hot constants from its scene ([`hot_of`]), the tables
+/// and risk threshold of `tables`.
+struct PerRowBlocks<'i, 'a> {
+    inputs: &'i Inputs<'a>,
+    tables: &'i EllipticScene<'static>,
+    hot: HotPerSample,
+    sure: [bool; BLOCK],
+}
+
+impl BlockHotPath for PerRowBlocks<'_, '_> {
+    #[inline(always)]
+    fn answer(&mut self, start: usize, b: &mut Block) {
+        let [r1, r2, g, nu, mu, _] = scene_lanes::<BLOCK>(self.inputs, start);
+        for i in 0..BLOCK {
+            let (h, ok) = hot_of(r1[i], r2[i], g[i], nu[i], mu[i]);
+            self.hot.radius_factor[i] = h.radius_factor;
+            self.hot.inv_radius_factor[i] = h.inv_radius_factor;
+            self.hot.friction[i] = h.friction;
+            self.hot.cubed_critical_gain[i] = h.cubed_critical_gain;
+            self.sure[i] = ok;
+        }
+        self.tables
+            .estimate_block_per_sample(&self.hot, self.inputs.choice, b);
+        for (h, s) in b.hot.iter_mut().zip(&self.sure) {
+            *h &= *s;
+        }
+    }
 }
 
 /// A prepared scene of a core, over rows.
@@ -502,6 +757,27 @@ impl At for &[f64] {
     }
 }
 
+impl At for Column<'_> {
+    #[inline(always)]
+    fn at(self, i: usize) -> f64 {
+        Column::at(&self, i)
+    }
+    #[inline(always)]
+    fn narrow_into(self, start: usize, out: &mut [f32]) {
+        match self {
+            Column::One(x) => Repeat(x).narrow_into(start, out),
+            Column::Each(x) => x.narrow_into(start, out),
+        }
+    }
+    #[inline(always)]
+    fn large_angle_into(self, start: usize, out: &mut [u8]) {
+        match self {
+            Column::One(x) => Repeat(x).large_angle_into(start, out),
+            Column::Each(x) => x.large_angle_into(start, out),
+        }
+    }
+}
+
 /// One value for every row.
 #[derive(Clone, Copy)]
 struct Repeat(f64);
@@ -521,14 +797,31 @@ impl At for Repeat {
     }
 }
 
-/// The f32 core's rows in blocks: the ellipse's hot path over each block
-/// ([`Auto::estimate_block`]), its answers written column by column; the rows off it
-/// (refused, zero, asymptotic, line contact) then one by one through [`float_row`].
-/// A row on the hot path took P and phi as f32 without a refusal of [`narrow`] (both
-/// finite, not rounded to 0 or inf, |phi| <= 1 < pi/2): it needs no other check, and
-/// its flags are [`core_flags`]' with a critical angle.
+/// The f32 core's rows of one scene in blocks: the ellipse's hot path over each block
+/// ([`Auto::estimate_block`]); the rows off it (refused, zero, asymptotic, line contact)
+/// then one by one through [`float_row`].
 #[inline(always)]
 fn float_rows(core: &Auto, out: &mut Outputs<'_>, n: usize, load: impl At, phi: impl At) -> usize {
+    float_blocks(out, n, load, phi, core, |i| {
+        float_row_cold(core, load.at(i), phi.at(i))
+    })
+}
+
+/// The f32 core's rows in blocks: `hot_path.answer(start, block)` answers the block's rows
+/// from `start` where it can (P and phi given as f32), its answers written column by
+/// column; the rows it leaves, `row(i)` one by one. A row on the hot path took P and
+/// phi as f32 without a refusal of [`narrow`] (both finite, not rounded to 0 or inf,
+/// |phi| <= 1 < pi/2): it needs no other check, and its flags are [`core_flags`]' with
+/// a critical angle.
+#[inline(always)]
+fn float_blocks(
+    out: &mut Outputs<'_>,
+    n: usize,
+    load: impl At,
+    phi: impl At,
+    mut hot_path: impl BlockHotPath,
+    mut row: impl FnMut(usize) -> Result<Row, Error>,
+) -> usize {
     let Some((s, f, c, r, m, g, t)) = columns(out, n) else {
         return 0; // not reached: `rows` checked every length
     };
@@ -548,7 +841,7 @@ fn float_rows(core: &Auto, out: &mut Outputs<'_>, n: usize, load: impl At, phi: 
         load.narrow_into(start, &mut b.load);
         phi.narrow_into(start, &mut b.phi);
         phi.large_angle_into(start, &mut large);
-        core.estimate_block(&mut b);
+        hot_path.answer(start, &mut b);
         // Every row as if on the hot path, a column at a time.
         for (y, x) in s.iter_mut().zip(&b.slip_ratio) {
             *y = f64::from(*x);
@@ -576,8 +869,7 @@ fn float_rows(core: &Auto, out: &mut Outputs<'_>, n: usize, load: impl At, phi: 
             continue;
         }
         for (j, _) in b.hot.iter().enumerate().take(len).filter(|(_, hot)| !**hot) {
-            let i = start + j;
-            let (refused, cells) = cells(float_row_cold(core, load.at(i), phi.at(i)));
+            let (refused, cells) = cells(row(start + j));
             bad += refused;
             let row = (
                 s.get_mut(j),

@@ -16,6 +16,23 @@ pub fn par_estimate(
     outputs: &mut Outputs<'_>,
     model: Model,
 ) -> Result<usize, Mismatch> {
+    par_estimate_with(inputs, outputs, model, &estimate)
+}
+
+/// One chunk's rows on one thread: [`estimate`] or a build of it for the CPU at hand
+/// (`estimate_avx2`, where the CPU has AVX2).
+pub type Leaf = dyn Fn(&Inputs<'_>, &mut Outputs<'_>, Model) -> Result<usize, Mismatch> + Sync;
+
+/// [`par_estimate`] with each chunk computed by `leaf`.
+///
+/// # Errors
+/// As [`estimate`].
+pub fn par_estimate_with(
+    inputs: &Inputs<'_>,
+    outputs: &mut Outputs<'_>,
+    model: Model,
+    leaf: &Leaf,
+) -> Result<usize, Mismatch> {
     let n = rows(inputs, outputs)?;
     let whole = Outputs {
         slip_ratio: &mut *outputs.slip_ratio,
@@ -40,20 +57,26 @@ pub fn par_estimate(
             radius: &mut *d.radius,
         }),
     };
-    Ok(split(*inputs, whole, n, model))
+    Ok(split(*inputs, whole, n, model, leaf))
 }
 
-fn split(inputs: Inputs<'_>, mut outputs: Outputs<'_>, n: usize, model: Model) -> usize {
+fn split(
+    inputs: Inputs<'_>,
+    mut outputs: Outputs<'_>,
+    n: usize,
+    model: Model,
+    leaf: &Leaf,
+) -> usize {
     if n <= CHUNK {
         // The lengths were checked once for the whole batch.
-        return estimate(&inputs, &mut outputs, model).unwrap_or(0);
+        return leaf(&inputs, &mut outputs, model).unwrap_or(0);
     }
     let mid = n / 2;
     let (ia, ib) = inputs.split_at(mid);
     let (oa, ob) = outputs.split_at_mut(mid);
     let (a, b) = rayon::join(
-        || split(ia, oa, mid, model),
-        || split(ib, ob, n - mid, model),
+        || split(ia, oa, mid, model, leaf),
+        || split(ib, ob, n - mid, model, leaf),
     );
     a + b
 }

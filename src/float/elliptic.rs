@@ -23,7 +23,7 @@ const SMALL_THETA_INV_M: f32 = 9.094_947e-13; // 2^-40, the 1/m table's
 const SMALL_G: f32 = 7.450_581e-9; // 2^-27
 /// c below this: the radii differ by more than 1e24, theta never leaves the asymptotic
 /// range and theta0 would underflow f32 while phi0 does not.
-const MIN_RADIUS_FACTOR: f32 = 9.094_947e-13; // 2^-40
+pub(super) const MIN_RADIUS_FACTOR: f32 = 9.094_947e-13; // 2^-40
 /// Loads outside [2^-120, 2^120) N take the cold path: zero, or a cube root that must
 /// scale. As bits: the lower end and the width of the range (both immediates of one
 /// Thumb-2 instruction).
@@ -36,8 +36,8 @@ const HOT_CUBE_LOW_BITS: u32 = 0x1700_0000; // 2^-81
 const HOT_CUBE_SPAN: u32 = 0x3f00_0000 - 0x1700_0000; // up to 1/2
 /// B^3 of the hot path: from 2^-120 (B^3 P < 1/2 means P < 2^119) to 2^39 (B^3 P >= 2^-81
 /// means P >= 2^-120).
-const HOT_GAIN_MIN: f32 = 7.523_164e-37; // 2^-120
-const HOT_GAIN_MAX: f32 = 549_755_813_888.0; // 2^39
+pub(super) const HOT_GAIN_MIN: f32 = 7.523_164e-37; // 2^-120
+pub(super) const HOT_GAIN_MAX: f32 = 549_755_813_888.0; // 2^39
 
 /// The smallest c (eq 4) whose scene takes the hot path, rounded up to f32 (a test
 /// holds it to `theta(cbrt(1/2)) / (pi/2)` of the reference, plus 1e-4 for the
@@ -45,7 +45,7 @@ const HOT_GAIN_MAX: f32 = 549_755_813_888.0; // 2^39
 /// so its phi0 = theta0 / c stays at most pi/2 from this c up. Scenes of smaller c
 /// (radii more than 22 times apart) take the general path, which says `None` where
 /// phi0 would pass pi/2; so the hot path needs no check of its own.
-const HOT_MIN_RADIUS_FACTOR: f32 = 0.402_505_9;
+pub(super) const HOT_MIN_RADIUS_FACTOR: f32 = 0.402_505_9;
 
 /// `2^31 - bits(threshold)` for a positive finite threshold.
 fn risk_offset(threshold: f32) -> u32 {
@@ -62,7 +62,7 @@ fn hot_gain(cubed: f32) -> f32 {
 }
 /// mu at and above which F = mu P could overflow f32 at a load of 2^120 N (the hot
 /// path's heaviest): mu P < 2^127 below it.
-const FRICTION_LIMIT: f64 = 128.0;
+pub(super) const FRICTION_LIMIT: f64 = 128.0;
 /// The largest slip gain A that preparing accepts, rounded up to f32 (a test holds it
 /// to `f32::MAX / 2 x cbrt(2^-149) / (pi/2)`): d/b at the lightest load fits f32.
 const SLIP_GAIN_LIMIT: f32 = 1.212_09e23;

@@ -44,13 +44,15 @@ pub const IMAGE_LEN: usize = 4 + 2 * CONFIG_WORDS + 2 + SCENE_BYTES_MAX;
 /// latching and samples' source stay the build's.
 pub const IMAGE_VERSION: u8 = 2;
 
-/// The image's byte 1: bit 0 a scene follows, bit 1 external samples are taken,
-/// bits 4-7 the alarms that latch ([`AlarmSet`]'s bits).
+/// The image's byte 1: bit 0 a scene follows, bit 1 external samples are taken, bit 2
+/// the scene was committed over the bus (not the build's), bits 4-7 the alarms that
+/// latch ([`AlarmSet`]'s bits).
 mod flags {
     pub const SCENE: u8 = 1;
     pub const EXTERNAL: u8 = 2;
-    /// Bits 2-3: 0 in every image.
-    pub const RESERVED: u8 = 0x0C;
+    pub const SCENE_COMMISSIONED: u8 = 4;
+    /// Bit 3: 0 in every image.
+    pub const RESERVED: u8 = 0x08;
     pub const LATCHING_SHIFT: u8 = 4;
 }
 
@@ -512,6 +514,9 @@ pub(crate) struct Commissioning<E> {
     last_tick: Option<u32>,
     commit_error: u16,
     source: BootSource,
+    /// The active scene was committed over the bus (now or before a restart): not the
+    /// build's.
+    scene_commissioned: bool,
     /// A commit the application has not taken to persist.
     unsaved: bool,
     counts: CommissioningCounts,
@@ -534,6 +539,7 @@ impl<E: Estimator> Commissioning<E> {
             last_tick: None,
             commit_error: reason::NONE,
             source: BootSource::Defaults,
+            scene_commissioned: false,
             unsaved: false,
             counts: CommissioningCounts {
                 unlock_failures: 0,
@@ -555,6 +561,10 @@ impl<E: Estimator> Commissioning<E> {
 
     pub(crate) fn source(&self) -> BootSource {
         self.source
+    }
+
+    pub(crate) fn scene_commissioned(&self) -> bool {
+        self.scene_commissioned
     }
 
     pub(crate) fn unlocked(&self) -> bool {
@@ -733,6 +743,7 @@ impl<E: Estimator> Commissioning<E> {
         }
         if let Some(scene) = scene {
             monitor.set_estimator(scene);
+            self.scene_commissioned = true;
         }
         if self.pending & staged::CODE != 0 {
             self.code = self.new_code;
@@ -779,6 +790,9 @@ impl<E: Estimator> Commissioning<E> {
         }
         if let Some(io) = self.io {
             out[1] |= flags::SCENE;
+            if self.scene_commissioned {
+                out[1] |= flags::SCENE_COMMISSIONED;
+            }
             let at = 4 + 2 * CONFIG_WORDS;
             out[at..at + 2].copy_from_slice(&(io.bytes as u16).to_le_bytes());
             (io.save)(monitor.estimator(), &mut out[at + 2..]);
@@ -794,6 +808,7 @@ impl<E: Estimator> Commissioning<E> {
         monitor: &mut Monitor<E>,
     ) -> (BootSource, Option<Switches>) {
         let mut switches = None;
+        self.scene_commissioned = false;
         self.source = match stored {
             Stored::Nothing => BootSource::Defaults,
             Stored::Damaged => BootSource::DefaultsDamaged,
@@ -817,10 +832,15 @@ impl<E: Estimator> Commissioning<E> {
         let (&[version, flags], rest) = image.split_first_chunk::<2>()?;
         let switches = match version {
             1 if flags <= flags::SCENE => None,
-            IMAGE_VERSION if flags & flags::RESERVED == 0 => Some(Switches {
-                latching: AlarmSet::from_bits(flags >> flags::LATCHING_SHIFT),
-                external: flags & flags::EXTERNAL != 0,
-            }),
+            IMAGE_VERSION
+                if flags & flags::RESERVED == 0
+                    && (flags & flags::SCENE_COMMISSIONED == 0 || flags & flags::SCENE != 0) =>
+            {
+                Some(Switches {
+                    latching: AlarmSet::from_bits(flags >> flags::LATCHING_SHIFT),
+                    external: flags & flags::EXTERNAL != 0,
+                })
+            }
             _ => return None,
         };
         let (code, rest) = rest.split_first_chunk::<2>()?;
@@ -842,6 +862,7 @@ impl<E: Estimator> Commissioning<E> {
         if let Some(e) = estimator {
             monitor.set_estimator(e);
         }
+        self.scene_commissioned = flags & flags::SCENE_COMMISSIONED != 0;
         self.code = u16::from_le_bytes(*code);
         Some(switches)
     }

@@ -172,6 +172,7 @@ pub(crate) enum Field {
     Unacknowledged(AlarmSet),
     Running,
     EventAvailable,
+    SceneCommissioned,
     // Input registers.
     Status,
     Alarms,
@@ -445,13 +446,15 @@ pub static DISCRETES: TableMap = TableMap {
             "the state is not stopped"),
         e!(Discrete, 9, "event_available", U16, "", R, F::EventAvailable,
             "the event window holds an event at or after event_from"),
+        e!(Discrete, 10, "scene_commissioned", U16, "", R, F::SceneCommissioned,
+            "the scene the monitor runs was committed over the bus, kept across resets (0: the build's scene; a node with its own sensors then monitors nothing and status reads NE 107 function check)"),
     ],
     blocks: &[],
 };
 
 /// The register map's version (holding register `map_version`): a change of an
 /// address, a type or a meaning increments it.
-pub const MAP_VERSION: u16 = 2;
+pub const MAP_VERSION: u16 = 3;
 
 /// Where the event window's header starts (input registers).
 pub const EVENT_WINDOW_ADDRESS: u16 = 82;

@@ -162,6 +162,12 @@ pub struct ServerConfig {
     /// The site's code that `unlock` takes before any commissioning write, until a
     /// committed `new_code` replaces it (default [`DEFAULT_UNLOCK_CODE`]).
     pub unlock_code: u16,
+    /// Whether the node monitors only a scene committed over the bus (a node with its
+    /// own sensors on a site's rollers): until one is, `status` reports NE 107
+    /// function check and the discrete input `scene_commissioned` reads 0, and the
+    /// application processes no sample ([`Server::scene_commissioned`]). Default
+    /// false: the build's scene is a site's (a demonstrator, a test).
+    pub scene_required: bool,
 }
 
 impl Default for ServerConfig {
@@ -172,6 +178,7 @@ impl Default for ServerConfig {
             external_samples: false,
             latching: AlarmSet::NONE,
             unlock_code: DEFAULT_UNLOCK_CODE,
+            scene_required: false,
         }
     }
 }
@@ -240,6 +247,7 @@ impl<E: Estimator> Server<E> {
                 annunciator: Annunciator::new(config.latching),
                 events: EventWindow::new(from, monitor_next),
                 external: config.external_samples,
+                scene_required: config.scene_required,
                 last_time_ms: 0,
                 counters: Counters::default(),
                 ack: None,
@@ -385,6 +393,14 @@ impl<E: Estimator> Server<E> {
     /// `config_source`).
     pub fn config_source(&self) -> BootSource {
         self.core.commissioning.source()
+    }
+
+    /// Whether the scene the monitor runs was committed over the bus (now, or before
+    /// a restart: kept in the committed image), not the build's (the discrete input
+    /// `scene_commissioned`). A node with [`ServerConfig::scene_required`] monitors
+    /// nothing until it is.
+    pub fn scene_commissioned(&self) -> bool {
+        self.core.commissioning.scene_commissioned()
     }
 
     /// The image of the configuration committed over the bus ([`IMAGE_LEN`] bytes: its

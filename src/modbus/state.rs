@@ -49,6 +49,8 @@ pub(super) struct Core<E> {
     pub(super) annunciator: Annunciator,
     pub(super) events: EventWindow,
     pub(super) external: bool,
+    /// [`ServerConfig::scene_required`](super::ServerConfig::scene_required).
+    pub(super) scene_required: bool,
     /// The last sample's own timestamp.
     pub(super) last_time_ms: u32,
     pub(super) counters: Counters,

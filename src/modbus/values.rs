@@ -263,7 +263,10 @@ impl<E: Estimator> Core<E> {
         // Function check before the first sample and while the conditioning settles
         // (the state is held, no sample decides it); a failure before it.
         let checking = self.monitor.statistics().samples == 0 || self.monitor.settling();
+        // Function check, too, while a node that needs its site's scene has none.
+        let uncommissioned = self.scene_required && !self.commissioning.scene_commissioned();
         let category = match state {
+            _ if uncommissioned => ne107::FUNCTION_CHECK,
             RiskState::SensorFault => ne107::FAILURE,
             _ if checking => ne107::FUNCTION_CHECK,
             RiskState::GrossSlip => ne107::OUT_OF_SPECIFICATION,
@@ -332,6 +335,7 @@ impl<E: Estimator> Core<E> {
             Field::Unacknowledged(w) => bit(a.unacknowledged(), w),
             Field::Running => u32::from(m.state() != RiskState::Stopped),
             Field::EventAvailable => u32::from(self.events.slot(0, m.next_event_seq()).is_some()),
+            Field::SceneCommissioned => u32::from(self.commissioning.scene_commissioned()),
             Field::Status => self.status(),
             Field::Alarms => {
                 u32::from(a.indicated().bits())

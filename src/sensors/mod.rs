@@ -22,8 +22,8 @@
 //! never a measurement).
 //!
 //! Calibrations are plain `Copy` values ([`LoadCalibration`], [`ProbeCalibration`],
-//! [`MisalignmentCalibration`], [`SpeedCalibration`]) so that they can be stored and
-//! put back.
+//! [`MisalignmentCalibration`], [`SpeedCalibration`], the whole node's
+//! [`SensorCalibration`]) so that they can be stored and put back.
 //!
 //! # Crates weighed, and what was chosen
 //!
@@ -54,6 +54,7 @@
 
 #[cfg(feature = "ads1x1x")]
 pub mod ads1x1x;
+mod calibration;
 mod fault;
 mod hx711;
 mod load;
@@ -62,6 +63,7 @@ mod probes;
 pub mod sim;
 mod speed;
 
+pub use calibration::SensorCalibration;
 pub use fault::{FaultDetector, FaultKind, RawLimits, SensorFault, SensorFaultCounts, SensorId};
 pub use hx711::{Hx711, Hx711Channel, PinError};
 pub use load::{LoadCalibration, LoadCell, STANDARD_GRAVITY, weight_newtons};

@@ -1,25 +1,14 @@
-//! The sensors' calibration as one stored record (features `sequential-storage` and
-//! `sensors`): the load cell on its HX711, the two misalignment probes, the tachometer.
-//! A record is put back only if every part passes its own `validate`.
+//! The sensors' calibration ([`SensorCalibration`], the node's sensors' whole
+//! calibration) as one stored record under [`kind::CALIBRATION`] (features
+//! `sequential-storage` and `sensors`): the load cell on its HX711, the two
+//! misalignment probes, the tachometer. A record is put back only if every part passes
+//! its own `validate`.
 
 use super::{Checkpoint, CodecError, Reader, Writer, kind};
 use crate::sensors::{
     Hx711Channel, LoadCalibration, MisalignmentCalibration, ProbeCalibration, ProbeSpec,
-    SpeedCalibration,
+    SensorCalibration, SpeedCalibration,
 };
-
-/// A node's sensor calibration, stored under [`kind::CALIBRATION`]: what a technician
-/// measured on site, kept across resets and firmware updates.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct SensorCalibration {
-    /// The load cell.
-    pub load: LoadCalibration<Hx711Channel>,
-    /// The two displacement probes and their span.
-    pub misalignment: MisalignmentCalibration,
-    /// The tachometer, if the node has one.
-    pub speed: Option<SpeedCalibration>,
-}
 
 const LOAD_SIZE: usize = 1 + 4 * 4;
 const PROBE_SIZE: usize = 2 * 4 + 3 * 4;

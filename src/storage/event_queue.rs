@@ -266,16 +266,13 @@ impl<F: NorFlash, T: Checkpoint, const BUF: usize> EventQueue<F, T, BUF> {
     }
 
     /// Acknowledges every record through `through`: appends an acknowledgement, which
-    /// is durable when this returns `Ok(true)`. `Ok(false)`, nothing written, when
-    /// `through` is not after the acknowledgement held or is after the newest record
-    /// (a number not yet given must not be acknowledged).
+    /// is durable when this returns `Ok(true)`. `Ok(false)`, nothing written, unless
+    /// `through` acknowledges a record held: a number from the oldest record not
+    /// acknowledged ([`Recovered::first`]) to the newest. A number not yet given (after
+    /// the newest), one acknowledged already, and one that modulo 2^32 alone would
+    /// pass for either (half the number space away) acknowledge nothing.
     pub async fn acknowledge(&mut self, through: u32) -> Result<bool, StorageError<F::Error>> {
-        let newest_ok = self.state.newest.is_some_and(|n| at_or_after(n, through));
-        let advances = self
-            .state
-            .acknowledged
-            .is_none_or(|k| k != through && at_or_after(through, k));
-        if !newest_ok || !advances {
+        if !self.acknowledges_a_record(through) {
             return Ok(false);
         }
         // The records left after this acknowledgement, if nothing is erased for it.
@@ -293,6 +290,20 @@ impl<F: NorFlash, T: Checkpoint, const BUF: usize> EventQueue<F, T, BUF> {
         self.state = self.scan().await?;
         self.count_dropped(left);
         Ok(true)
+    }
+
+    /// Whether `through` lies from the oldest unacknowledged record to the newest: its
+    /// distance back from the newest no more than the oldest's. Every comparison is a
+    /// distance back from the newest number given (within the records held), never
+    /// two numbers compared modulo 2^32 alone, which reads a number half the number
+    /// space ahead as an old one.
+    fn acknowledges_a_record(&self, through: u32) -> bool {
+        match (self.state.first, self.state.newest) {
+            (Some(first), Some(newest)) => {
+                newest.wrapping_sub(through) <= newest.wrapping_sub(first)
+            }
+            _ => false,
+        }
     }
 
     /// Calls `f` with every record not acknowledged whose number is at or after

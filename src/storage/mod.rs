@@ -79,9 +79,9 @@ mod event_queue;
 mod mock_flash;
 mod store;
 
-pub use blocking::{BlockingFlash, block_on};
 #[cfg(feature = "sensors")]
-pub use calibration::SensorCalibration;
+pub use crate::sensors::SensorCalibration;
+pub use blocking::{BlockingFlash, block_on};
 pub use codec::{CodecError, Reader, Writer};
 pub use config::ConfigImage;
 pub use event_queue::{EventQueue, Pushed, QueueStats, Recovered};

@@ -51,6 +51,19 @@ def state(client):
     return get_input(client, "status") & 0xFF
 
 
+FUNCTION_CHECK = 3
+
+
+def category(client):
+    """`status`'s NAMUR NE 107 category."""
+    return get_input(client, "status") >> 8 & 0xF
+
+
+def scene_commissioned(client):
+    r = next(r for r in register_map() if r["table"] == "discrete" and r["name"] == "scene_commissioned")
+    return read_table(client, "discrete", r["address"], 1)[0]
+
+
 def wait_until(what, timeout_s=120):
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
@@ -87,13 +100,25 @@ def commissioned(client):
 def test_commissioning_over_the_bus_survives_a_reset(client):
     assert get(client, "config_source") == 0, "a fresh node runs the build's defaults"
     assert get_input(client, "samples") == 0, "an uncommissioned node monitors nothing"
+    assert (category(client), scene_commissioned(client)) == (FUNCTION_CHECK, 0), "not commissioned"
+    # The configuration alone does not commission it: the build's scene is no site's.
+    status, out = commission(client, "--code", str(code()), "--config", os.environ["PICO_CONFIG"])
+    assert status == 0, out
+    assert get(client, "config_source") == 1
+    at = harness("status")["ns"]
+    wait_until(lambda: harness("status")["ns"] > at + 2e9)
+    assert get_input(client, "samples") == 0, "no site's scene: nothing monitored"
+    assert (category(client), scene_commissioned(client)) == (FUNCTION_CHECK, 0)
     scene = commissioned(client)
+    assert scene_commissioned(client) == 1
     wait_until(lambda: get_input(client, "samples") > 20)
+    assert category(client) != FUNCTION_CHECK, "commissioned and settled"
     before = boots()
     harness("reset")
     restarted(client, before)
     assert get(client, "config_source") == 1
     assert get(client, "scene_active_crc") == int.from_bytes(scene[-4:], "little")
+    assert scene_commissioned(client) == 1, "kept through the reset"
     samples = get_input(client, "samples")
     assert samples > 0, "the monitor's checkpoint restored"
     wait_until(lambda: get_input(client, "samples") > samples + 10)

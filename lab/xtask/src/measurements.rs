@@ -135,23 +135,32 @@ fn node(rows: &[NodeRow]) -> String {
 /// The Pico node's table (docs/pico.csv).
 fn pico_table(rows: &[PicoRow]) -> String {
     let mut s = String::from(
-        "| board | flash | RAM: statics + deepest stack | of the board's RAM | samples monitored |\n\
-         |---|--:|--:|--:|--:|\n",
+        "| board | flash | RAM: statics + deepest stack | stack reserved | of the board's RAM | samples monitored |\n\
+         |---|--:|--:|--:|--:|--:|\n",
     );
     for r in rows {
         writeln!(
             s,
-            "| {} | {} | {} + {} = {} | {} | {} |",
+            "| {} | {} | {} + {} = {} | {} | {} | {} |",
             r.board,
             r.flash,
             r.ram,
             r.stack,
             r.ram + r.stack,
+            r.stack_reserved,
             r.board_ram,
             r.samples
         )
         .unwrap();
     }
+    write!(
+        s,
+        "\nThe stack's reservation (nodes/pico/memory.x, below the statics: an overflow \
+         faults instead of writing over them) keeps at least {} B above the deepest stack \
+         (`cargo xtask pico --measure` fails otherwise).\n",
+        crate::pico::STACK_HEADROOM
+    )
+    .unwrap();
     s
 }
 

@@ -764,6 +764,11 @@ fn read_holding(port: u16, address: u16) -> Result<u16, String> {
     Err(format!("reading holding register {address}: {last}"))
 }
 
+/// The stack's reservation (nodes/pico/memory.x) keeps at least this much (bytes) above
+/// the deepest stack `--measure` finds: for the paths its run does not take (a power
+/// cut's recovery, a sensor's fault, every exception answer).
+pub const STACK_HEADROOM: u64 = 4096;
+
 /// `--measure`: the image's flash and statics (llvm-size), the deepest stack of a
 /// commissioned node over 60 s of its sensors and a burst of requests, the board's
 /// RAM; into docs/pico.csv and its table.
@@ -799,11 +804,20 @@ fn measure() -> Result<(), String> {
     let st = h.command("status")?;
     drop(h);
     let stack = json_num(&st, "stack").ok_or("the harness measured no stack")? as u64;
+    let stack_reserved =
+        json_num(&st, "stack_reserved").ok_or("the image reserves no stack")? as u64;
+    if stack + STACK_HEADROOM > stack_reserved {
+        return Err(format!(
+            "the deepest stack, {stack} B, leaves less than {STACK_HEADROOM} B of its \
+             {stack_reserved} B reservation (nodes/pico/memory.x): make it larger"
+        ));
+    }
     let row = crate::records::PicoRow {
         board: "Raspberry Pi Pico (RP2040, Cortex-M0+)".into(),
         flash: sections.flash(),
         ram: sections.ram(),
         stack,
+        stack_reserved,
         board_ram: 256 * 1024,
         samples: json_num(&st, "samples").unwrap_or(0.0) as u64,
     };

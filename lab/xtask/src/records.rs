@@ -319,10 +319,12 @@ record! {
     PicoRow in "pico.csv" {
         /// The board.
         board: String = "board",
-        /// Bytes: the image's flash, its statics, the deepest stack, the board's RAM.
+        /// Bytes: the image's flash, its statics, the deepest stack, the stack's
+        /// reservation (memory.x), the board's RAM.
         flash: u64 = "flash",
         ram: u64 = "ram_statics",
         stack: u64 = "stack",
+        stack_reserved: u64 = "stack_reserved",
         board_ram: u64 = "board_ram",
         /// Samples the node monitored in the run.
         samples: u64 = "samples",

@@ -4,7 +4,6 @@
 //! masked), in the regions memory.x reserves at the end of the flash, outside the
 //! program's.
 
-use crate::persist::{EVENTS_SIZE, STORE_SIZE};
 use embassy_rp::flash::{Blocking, ERASE_SIZE, Flash};
 use embassy_rp::peripherals::FLASH;
 use embedded_storage::nor_flash::{
@@ -14,6 +13,10 @@ use embedded_storage::nor_flash::{
 
 /// The erase unit (bytes): a 4 KiB sector.
 pub const SECTOR: usize = ERASE_SIZE;
+/// The store's region (the state's and the configuration's records): memory.x's STORE.
+pub const STORE_SIZE: usize = 4 * SECTOR;
+/// The event queue's region: memory.x's EVENTS.
+pub const EVENTS_SIZE: usize = 2 * SECTOR;
 /// The Pico's flash (W25Q16JV, 2 MiB).
 const FLASH_SIZE: usize = 2 * 1024 * 1024;
 /// The flash's address in the memory map (XIP).
@@ -77,8 +80,7 @@ impl NorFlash for Board {
 }
 
 /// The store's region and the event queue's; taken once per boot
-/// (`Persist::open`). `None` if memory.x does not reserve them as `persist.rs` sizes
-/// them.
+/// (`Persist::open`). `None` if memory.x does not reserve them as these sizes.
 pub fn regions() -> Option<(Board, Board)> {
     unsafe extern "C" {
         // The regions' bounds, from memory.x (only their addresses are taken).

@@ -12,8 +12,8 @@
 //! The node is the QEMU images' (`nodes/firmware`), compiled in unchanged: the same
 //! estimator built the same way (`node.rs`: the fixed-point core, as on every core
 //! without an FPU), the same Modbus loop (`serve.rs`), the same storage (`persist.rs`).
-//! Until a configuration is committed over the bus (the site's scene, docs/modbus.md)
-//! it serves only; from then on it monitors its sensors, across resets. Built with
+//! Until the site's scene is committed over the bus (docs/modbus.md) it serves only and
+//! reports "not commissioned"; from then on it monitors its sensors, across resets. Built with
 //! `MISALIGN_MODBUS_EXTERNAL=1` (tests only) it monitors the samples a master writes.
 #![no_std]
 #![no_main]

@@ -15,13 +15,14 @@
 //! (`m^3` is eq 5 with `sin^2(theta/2) = pA / (pA + B)`.) The slopes are kept as
 //! fractions, so that a Newton step and what it carries cost one division.
 //! Error: theta and `(m n)^3` a few roundings from exact given the point (the series,
-//! one logarithm (ln.rs), a square root and a few products); the slopes to 1e-15, far
-//! more than a step of 1e-9 needs. Cost: one logarithm (a table read, no division), the
-//! series, one square root, two divisions.
+//! one logarithm (ln.rs), a square root (sqrt.rs) and a few products); the slopes to
+//! 1e-15, far more than a step of 1e-9 needs. Cost: one logarithm (a table read, no
+//! division), the series, one square root, two divisions; no branch.
 
 use super::atan::atan_ratio;
 use super::ln::ln;
 use super::series::differences;
+use super::sqrt::sqrt;
 use core::f64::consts::PI;
 
 /// The quantities at one k'.
@@ -56,7 +57,7 @@ impl Point {
         let pa = p * a;
         let t2 = pa / b;
         let r = atan_ratio(t2);
-        let theta = 2.0 * libm::sqrt(t2) * r;
+        let theta = 2.0 * sqrt(t2) * r;
         let sum = pa + b;
         let kab = k2 * a * b;
         // (m n)^3 = q sum^2, and its slope 3 (m n)^3 (pA - B)/(3 sum) = q sum (pA - B).

@@ -12,11 +12,10 @@
 //! time, below), so neither cancels: `A ~ ln(4/k') - 1`, `B ~ 1`.
 //!
 //! Error: for `k' <= KPRIME_MAX` (p <= 1.03e-3) the first term left out is below 2e-21 of
-//! either sum; below `p = SHORT_BELOW` (k' < 0.0039) the series stops after `k'^6`,
-//! its first term left out below 2e-19 of either sum; the evaluation rounds each to
-//! within 6 ulps of Carlson's R_D given `ln(1/k')` (asserted below; R_D's own error is
-//! a few ulps). Cost: four Horner chains of degree 6 (3 below `SHORT_BELOW`) run side
-//! by side, no division.
+//! either sum; the evaluation rounds each to within 6 ulps of Carlson's R_D given
+//! `ln(1/k')` (asserted below; R_D's own error is a few ulps). Cost: four Horner chains
+//! of degree 6 run side by side, no division and no branch (rows in SIMD lanes take
+//! the same terms).
 
 /// Largest `k'` the truncated series is exact for (to below 2e-21 relative).
 #[cfg(test)]
@@ -68,28 +67,12 @@ const fn coefficients() -> [[f64; TERMS]; 4] {
     out
 }
 
-/// Below this p (2^-16) four terms are enough.
-pub const SHORT_BELOW: f64 = 1.52587890625e-5;
-
-/// Terms below [`SHORT_BELOW`].
-const SHORT_TERMS: usize = 4;
-
 /// `(K - E, E - k'^2 K)` at `p = k'^2` with `log_inv = ln(1/k')`, for `k' <= KPRIME_MAX`.
 #[inline(always)]
 pub fn differences(p: f64, log_inv: f64) -> (f64, f64) {
-    if p < SHORT_BELOW {
-        sums::<SHORT_TERMS>(p, log_inv)
-    } else {
-        sums::<TERMS>(p, log_inv)
-    }
-}
-
-/// The sums through `p^(N-1)`.
-#[inline(always)]
-fn sums<const N: usize>(p: f64, log_inv: f64) -> (f64, f64) {
     let [al, a0, bl, b0] = &COEFFICIENTS;
     let (mut xal, mut xa0, mut xbl, mut xb0) = (0.0, 0.0, 0.0, 0.0);
-    let mut j = N;
+    let mut j = TERMS;
     while j > 0 {
         j -= 1;
         xal = xal * p + al[j];
@@ -127,7 +110,7 @@ mod tests {
     /// The first coefficient left out, times `p^7 ln(1/k')`, is below 2e-21 of the sums
     /// at `KPRIME_MAX` (where it is largest relative to them).
     #[test]
-    fn truncation_is_below_2e_21_and_2e_19() {
+    fn truncation_is_below_2e_21() {
         // a_6 and b_6 bound every coefficient of p^7 left out (A's is a_7 - b_6, B's
         // b_6 - a_6), each later one is smaller by p; |d_j| <= 2 ln 2.
         let (mut a, mut b) = (1.0f64, 0.5f64);
@@ -141,17 +124,5 @@ mod tests {
         let left = 2.0 * (a + b) * libm::pow(p, TERMS as f64) * (l + 2.5);
         let (aa, bb) = differences(p, l);
         assert!(left < 2e-21 * aa.min(bb), "{left:e}");
-        // The short sums: a_3 and b_3 bound the coefficients of p^4 left out.
-        let (mut a, mut b) = (1.0f64, 0.5f64);
-        for j in 0..SHORT_TERMS - 1 {
-            let jf = j as f64;
-            a *= ((jf + 0.5) / (jf + 1.0)) * ((jf + 0.5) / (jf + 1.0));
-            b *= (jf + 0.5) * (jf + 1.5) / ((jf + 2.0) * (jf + 1.0));
-        }
-        let p = SHORT_BELOW;
-        let l = -0.5 * libm::log(p);
-        let left = 2.0 * (a + b) * libm::pow(p, SHORT_TERMS as f64) * (l + 2.5);
-        let (aa, bb) = differences(p * (1.0 - f64::EPSILON), l);
-        assert!(left < 2e-19 * aa.min(bb), "{left:e}");
     }
 }

@@ -7,9 +7,8 @@
 //! and `m n` within 1.5e-15 of the 50-digit values (asserted by tests/reference_fast.rs
 //! over tests/data/vectors_mn.csv); the step's own error is below 1e-18 (`None` where a seed
 //! misses by more than [`STEP_MAX`](super::point::STEP_MAX), which the tables never do).
-//! Cost: one seed (a table segment, degree 6), one point, one division.
+//! Cost: one seed (a table segment, degree 6), one point, one division; no branch.
 
-use super::each;
 use super::point::{Point, STEP_MAX, U_MAX, ln_near_one};
 use super::seeds::KPRIME_OF_THETA;
 
@@ -37,33 +36,26 @@ impl Shape {
 #[cfg(any(test, feature = "_internals"))]
 #[inline(always)]
 pub fn shape(theta: f64) -> Option<Shape> {
-    let [s] = shapes(&[theta]);
-    s
+    let (s, inside) = shape_lane(theta);
+    inside.then_some(s)
 }
 
-/// [`shape`] of N angles, each stage for all of them before the next (their latency
-/// chains side by side).
+/// The shape at theta and whether theta is in the domain, without a branch (a SIMD
+/// lane's form of [`shape`]; outside the domain, numbers to be ignored).
 #[inline(always)]
-pub fn shapes<const N: usize>(theta: &[f64; N]) -> [Option<Shape>; N] {
-    let seeds: [Option<f64>; N] = each(|i| KPRIME_OF_THETA.eval(theta[i]));
-    let points: [Option<Point>; N] = each(|i| seeds[i].map(|k| Point::at(k, k * k)));
-    each(|i| step(theta[i], seeds[i]?, points[i]?))
-}
-
-/// The Newton step from the seed's point.
-#[inline(always)]
-fn step(theta: f64, seed: f64, at: Point) -> Option<Shape> {
+pub fn shape_lane(theta: f64) -> (Shape, bool) {
+    let (seed, inside) = KPRIME_OF_THETA.eval_lane(theta);
+    let at = Point::at(seed, seed * seed);
     // u = theta(k')/theta - 1 and the step -ln(1 + u) / (d ln theta / dw) by one division.
     let z = 1.0 / (theta * at.theta_num);
     let u = (at.theta - theta) * at.theta_num * z;
     let dw = -ln_near_one(u) * at.theta_den * theta * z;
-    if !(libm::fabs(u) < U_MAX && libm::fabs(dw) < STEP_MAX) {
-        return None;
-    }
-    Some(Shape {
+    let converged = u.abs() < U_MAX && dw.abs() < STEP_MAX;
+    let shape = Shape {
         kprime: seed + seed * (dw + 0.5 * dw * dw),
         mn_cubed: at.mn_cubed + at.mn_cubed_slope * dw,
         at,
         dw,
-    })
+    };
+    (shape, inside & converged)
 }

@@ -39,9 +39,22 @@ impl<'a, const S: u32> Table<'a, S> {
     /// infinite: their bits fall outside the segments).
     #[inline(always)]
     pub fn eval(&self, x: f64) -> Option<f64> {
+        let (value, inside) = self.eval_lane(x);
+        inside.then_some(value)
+    }
+
+    /// The value at x and whether x is inside the table, without a branch (a SIMD
+    /// lane's form of [`Table::eval`]): outside it, the first segment's polynomial
+    /// at some tau, a number to be ignored.
+    #[inline(always)]
+    pub fn eval_lane(&self, x: f64) -> (f64, bool) {
         let bits = x.to_bits();
         let index = (bits >> (52 - S)).wrapping_sub(self.first_segment);
-        let c = self.segments.get(usize::try_from(index).ok()?)?;
+        let inside = index < self.segments.len() as u64;
+        let c = self
+            .segments
+            .get(if inside { index as usize } else { 0 })
+            .unwrap_or(&[0.0; WIDTH]);
         // The mantissa's bits below the segment's, as u in [1, 2): tau = 2u - 3.
         let low = (bits << S) & 0x000f_ffff_ffff_ffff;
         let tau = 2.0 * f64::from_bits(low | ONE_BITS) - 3.0;
@@ -51,7 +64,7 @@ impl<'a, const S: u32> Table<'a, S> {
             j -= 1;
             acc = acc * tau + c[j];
         }
-        Some(acc)
+        (acc, inside)
     }
 }
 

@@ -71,6 +71,16 @@ def peer_floor(P, phi, repeat):
     return t * 1e9 / len(P)
 
 
+def _cpu_flags():
+    """The CPU's feature flags (Linux), empty elsewhere."""
+    try:
+        text = pathlib.Path("/proc/cpuinfo").read_text()
+    except OSError:
+        return set()
+    return {f for line in text.splitlines() if line.startswith("flags")
+            for f in line.split(":", 1)[1].split()}
+
+
 def best(f, repeat):
     times, out = [], None
     for _ in range(repeat):
@@ -168,6 +178,7 @@ def main():
     costs = [misalign._misalign.reference_cost(P[:k], phi[:k]) for _ in range(args.repeat)]
     cost = {key: min(c[key] for c in costs) for key in costs[0]}  # each the best of repeat
     cost["peer_pair"] = floor
+    cost["avx2"] = "avx2" in _cpu_flags()
     samples, fleet_s, startup, summary = fleet_speed(args.fleet_rollers, args.fleet_hours,
                                                      max(1, args.repeat - 1))
     fleet_rate = samples / fleet_s
@@ -253,12 +264,15 @@ def page(args, load, speed, err_digits, digit_rows, err_rows, samples, fleet_s, 
         f"(phi0 at the load, eqs 18, 30) {cost['critical_angle']:.0f}, its whole elliptic "
         f"solution {cost['elliptic']:.0f}; `reference::fast`, which answers the batch's rows "
         f"where it can to the same digits, {cost['fast_estimate']:.0f} a row called row by "
-        f"row and {cost['batch']:.0f} in the batch with its columns, eight rows at a time; "
-        f"the f32 core {cost['f32_core']:.0f} called row by row, {cost['f32_batch']:.0f} in "
-        "the batch with its columns. A scene per row adds its preparation to each row: "
-        f"`reference::fast::Prepared::new` {cost['prepare_fast']:.0f}, the f32 core's "
-        f"`Auto::new` {cost['prepare_f32']:.0f}, and the row is then answered on its own (no "
-        "eight-row or block path). A target of N x the peer on two cores asks for at most "
+        f"row and {cost['batch']:.0f} in the batch with its columns, sixteen rows at a time "
+        f"({'AVX2' if cost['avx2'] else 'SSE2'} lanes: the package takes its AVX2 build where "
+        f"the CPU has it, the same bits); the f32 core {cost['f32_core']:.0f} called row by "
+        f"row, {cost['f32_batch']:.0f} in the batch with its columns. A scene per row forms "
+        "each row's constants in the same lanes instead of a preparation a row (which would "
+        f"cost `reference::fast::Prepared::new` {cost['prepare_fast']:.0f}, the f32 core's "
+        f"`Auto::new` {cost['prepare_f32']:.0f}): the batch with the scene given on every row "
+        f"{cost['batch_rows']:.0f} (reference), {cost['f32_batch_rows']:.0f} (f32). "
+        "A target of N x the peer on two cores asks for at most "
         f"2 x {peer_ns:.0f} / N ns a row on each: {2 * peer_ns / 20:.0f} ns for 20x, "
         f"{2 * peer_ns / 50:.0f} for 50x, {2 * peer_ns / 10:.0f} for 10x.",
         "",

@@ -56,6 +56,21 @@ fn empty<'py, T: numpy::Element>(py: Python<'py>, n: usize) -> PyResult<Bound<'p
     Ok(array.cast_into::<PyArray1<T>>()?)
 }
 
+/// [`batch::estimate`] on this thread, through its AVX2 build where the CPU has AVX2
+/// (the same numbers bit for bit; the reference's SIMD lanes twice as wide).
+fn rows_here(
+    inputs: &Inputs<'_>,
+    out: &mut Outputs<'_>,
+    model: Model,
+) -> Result<usize, batch::Mismatch> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: `estimate_avx2` is compiled for AVX2 alone, which this CPU has.
+        return unsafe { batch::estimate_avx2(inputs, out, model) };
+    }
+    batch::estimate(inputs, out, model)
+}
+
 /// The ADC's load LSB where none is given (N): 10 mN, as the nodes.
 const ADC_LOAD_LSB: f64 = 1e-2;
 
@@ -261,9 +276,9 @@ fn estimate<'py>(
             details,
         };
         if threads {
-            batch::par_estimate(&inputs, &mut out, model)
+            batch::par_estimate_with(&inputs, &mut out, model, &rows_here)
         } else {
-            batch::estimate(&inputs, &mut out, model)
+            rows_here(&inputs, &mut out, model)
         }
     })
     .map_err(value_error)?;
@@ -978,7 +993,9 @@ fn thresholds(
 /// (k', m, n from theta, eqs 4-6), its critical angle (phi0 at the load, eqs 18, 30),
 /// its whole elliptic solution; of the fast path called row by row
 /// (`reference::fast::Prepared::estimate`: d/b, F, phi0, flags; the batch takes it
-/// eight rows at a time); and the batch (the fast path plus writing the columns).
+/// sixteen rows at a time); and the batch as the package runs it on one thread (the
+/// fast path plus writing the columns, through the AVX2 build where the CPU has it),
+/// for one scene and for the same scene given on every row (a table of installations).
 #[pyfunction]
 fn reference_cost<'py>(
     py: Python<'py>,
@@ -1030,10 +1047,31 @@ fn reference_cost<'py>(
         let (mut s, mut f, mut c) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
         let (mut r, mut mo, mut fl, mut st) =
             (vec![0u8; m], vec![0u8; m], vec![0u8; m], vec![0u8; m]);
-        let mut timed_batch = |model: Model| {
+        // The demo scene on every row, as a table of installations gives it.
+        let each = [
+            scene.r1(),
+            scene.r2(),
+            scene.shear_modulus(),
+            scene.poisson_ratio(),
+            scene.friction(),
+        ]
+        .map(|x| vec![x; m]);
+        let per_row_scene = Inputs {
+            r1: Column::Each(&each[0]),
+            r2: Column::Each(&each[1]),
+            shear_modulus: Column::Each(&each[2]),
+            poisson_ratio: Column::Each(&each[3]),
+            friction: Column::Each(&each[4]),
+            length: None,
+            load: Column::Each(p),
+            phi: Column::Each(a),
+            choice: reference::ModelChoice::Section9,
+        };
+        let one_scene = Inputs::one_scene(&scene, Column::Each(p), Column::Each(a));
+        let mut timed_batch = |model: Model, inputs: &Inputs<'_>| {
             let t = Instant::now();
-            let _ = batch::estimate(
-                &Inputs::one_scene(&scene, Column::Each(p), Column::Each(a)),
+            let _ = rows_here(
+                inputs,
                 &mut Outputs {
                     slip_ratio: &mut s,
                     axial_force: &mut f,
@@ -1048,8 +1086,10 @@ fn reference_cost<'py>(
             );
             t.elapsed().as_secs_f64() * 1e9 / n
         };
-        let batch = timed_batch(Model::Reference);
-        let f32_batch = timed_batch(Model::F32);
+        let batch = timed_batch(Model::Reference, &one_scene);
+        let f32_batch = timed_batch(Model::F32, &one_scene);
+        let batch_rows = timed_batch(Model::Reference, &per_row_scene);
+        let f32_batch_rows = timed_batch(Model::F32, &per_row_scene);
         let core = Auto::new(&scene);
         let f32_core = per_row(&|| {
             if let Ok(core) = &core {
@@ -1082,6 +1122,8 @@ fn reference_cost<'py>(
             f32_batch,
             prepare_fast,
             prepare_f32,
+            batch_rows,
+            f32_batch_rows,
         ]
     });
     let d = PyDict::new(py);
@@ -1095,6 +1137,8 @@ fn reference_cost<'py>(
         "f32_batch",
         "prepare_fast",
         "prepare_f32",
+        "batch_rows",
+        "f32_batch_rows",
     ]
     .into_iter()
     .zip(figures)
