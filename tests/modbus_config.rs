@@ -571,7 +571,7 @@ fn the_committed_image_restores_at_boot() {
     let demo = fresh.monitor().estimator().to_bytes();
     let mut cases: Vec<Vec<u8>> = vec![image[..IMAGE_LEN - 1].to_vec(), vec![0; IMAGE_LEN]];
     let mut bad = image;
-    bad[0] = 3; // a newer image version
+    bad[0] = 4; // a newer image version
     cases.push(bad.to_vec());
     let mut bad = image;
     bad[1] |= 8; // a flag no version has
@@ -640,7 +640,8 @@ fn latching_and_the_samples_source_are_kept_through_a_reset() {
     assert!(!again.external_samples());
 
     // Version 1: the configuration, and the build's switches.
-    let mut v1 = image;
+    // Versions 1 and 2 are 10 bytes shorter: no line settings.
+    let mut v1 = image[..IMAGE_LEN - 10].to_vec();
     v1[0] = 1;
     v1[1] &= 1;
     let monitor = Monitor::new(core(&Scene::DEMO), Config::default()).unwrap();
@@ -655,7 +656,7 @@ fn latching_and_the_samples_source_are_kept_through_a_reset() {
     assert_eq!(old.monitor().config().on_delay_ms, 4000);
     assert_eq!(old.annunciator().latching(), AlarmSet::SENSOR_FAULT);
     assert!(old.external_samples());
-    let mut bad = v1;
+    let mut bad = v1.clone();
     bad[1] = 0x11; // switches in a version 1 image
     assert_eq!(
         server().restore(Stored::Image(&bad)),
@@ -757,7 +758,7 @@ mod power_loss {
     };
 
     type Flash = MockFlash<4, 1024, 4>;
-    type S = Store<BlockingFlash<Flash>, 288>;
+    type S = Store<BlockingFlash<Flash>, 296>;
     type Image = ConfigImage<IMAGE_LEN>;
 
     fn open(flash: Flash) -> S {
@@ -821,7 +822,8 @@ mod power_loss {
         let mut image = ConfigImage::new();
         assert!(s.take_committed(&mut image.0));
         let i = &image.0;
-        assert_eq!(i[..4], [misalign::modbus::IMAGE_VERSION, 1, 0xEF, 0xBE]);
+        // Flags: a scene follows (bit 0), committed over the bus (bit 2).
+        assert_eq!(i[..4], [misalign::modbus::IMAGE_VERSION, 1 | 4, 0xEF, 0xBE]);
         let version = format!(
             "| 0 | 1 | image version: {} |",
             misalign::modbus::IMAGE_VERSION
@@ -836,7 +838,11 @@ mod power_loss {
         );
         assert_eq!(i[132..134], (Auto::BYTES as u16).to_le_bytes());
         assert_eq!(i[134..134 + bytes.len()], bytes[..]);
-        assert!(i[134 + bytes.len()..].iter().all(|&b| b == 0));
+        assert!(i[134 + bytes.len()..262].iter().all(|&b| b == 0));
+        // The line settings: the defaults (unit 1, even parity, 19200 baud, no answer
+        // delay, no bus timeout).
+        assert_eq!(i[262..], [1, 2, 0x00, 0x4B, 0, 0, 0, 0, 0, 0]);
+        assert!(spec.contains("| 262 | 1 | the unit id"));
         // In its record: the frame of every checkpoint record, this payload.
         let mut record = vec![0; codec::record_len(IMAGE_LEN)];
         codec::encode(&image, 9, &mut record).unwrap();

@@ -689,3 +689,38 @@ proptest::proptest! {
         }
     }
 }
+
+/// The fieldbus link's events (raised by a Modbus server through the monitor) are
+/// numbered with the monitor's own and kept in its checkpoint like them; a byte that
+/// names no link event is refused.
+#[test]
+fn the_links_events_are_kept_in_the_checkpoint() {
+    use misalign::monitor::FieldbusEvent as B;
+    let (mut m, _) = mid_scenario();
+    while m.pop_event().is_some() {}
+    let next = m.next_event_seq();
+    for e in [B::MasterLost, B::MasterBack, B::LineReverted] {
+        m.raise_fieldbus(e);
+    }
+    let state = m.snapshot();
+    let kinds: Vec<(u32, EventKind)> = state.events().iter().map(|e| (e.seq, e.kind)).collect();
+    assert_eq!(
+        kinds,
+        [
+            (next, EventKind::Fieldbus(B::MasterLost)),
+            (next + 1, EventKind::Fieldbus(B::MasterBack)),
+            (next + 2, EventKind::Fieldbus(B::LineReverted)),
+        ]
+    );
+    let bytes = payload(&state);
+    assert_eq!(decode::<MonitorState>(&bytes).unwrap(), state);
+    // The kind's tag (3) and its byte, in the first event of the queue (after its
+    // number, time and elapsed time).
+    let queue = MonitorState::SIZE - EVENT_CAPACITY * EVENT - 1;
+    let at = (queue..queue + 2)
+        .find(|&q| bytes[q + 16..q + 18] == [3, 1])
+        .expect("the tag of a link event and master lost");
+    let mut bad = bytes.clone();
+    bad[at + 17] = 3;
+    assert!(decode::<MonitorState>(&bad).is_err());
+}

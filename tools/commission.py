@@ -35,6 +35,18 @@ the node's status.
 - `--reset-statistics`: the node's statistics (counts, time and energy per state,
   extremes, events dropped) start afresh, after a roller change say (the command 4),
   once everything else is in force: a refused run resets nothing.
+- Line settings (`config_unit_id`, `config_baud`, `config_parity`,
+  `config_answer_delay`, `config_bus_timeout`) are committed like the rest; the node
+  answers the commit at its old settings and keeps the new ones only when a request
+  reaches it at them within its `line_confirm_window`: the tool asks it at its new unit
+  id (and, on `--serial`, at the new baud rate and parity) at once, and says whether
+  it was confirmed. A node it cannot reach there goes back to its old settings by
+  itself.
+- `--scan`: every unit id from 1 to 247 (`--units FIRST-LAST` narrows it) asked once,
+  with `--scan-timeout` seconds (default 0.1) for each answer: one line per node found
+  (unit id, model name, map version, status, line settings in force); an answer that
+  is not the node asked (another unit id in `unit_id`, or bytes that fail their CRC,
+  as two nodes at one unit id make) is reported as a clash, not taken as a node.
 - Without `--code`, nothing is written: the node's status and events only.
 
 Register names, types and domains come from the register map (`--registers`, default
@@ -148,12 +160,22 @@ class Map:
 
 
 class Node:
-    def __init__(self, client, regs, unit):
+    def __init__(self, client, regs, unit, reconnect=None):
         self.c = client
         self.unit = unit
         self.map = regs
         self.rows = regs.rows
         self.row = regs.row
+        # A new client at (baud, parity) on a serial line; None over TCP, where the
+        # bridge carries the bytes whatever the node's UART runs.
+        self.reconnect = reconnect
+
+    def move(self, unit, baud, parity):
+        """The node answers at these settings now: ask it there."""
+        self.unit = unit
+        if self.reconnect is not None:
+            self.c.close()
+            self.c = self.reconnect(baud, parity)
 
     def read(self, name, table="holding"):
         r = self.row(name, table)
@@ -191,6 +213,40 @@ def u32(words):
 SWITCHES = ("latching", "external_mode")
 # The register `command`'s values.
 COMMIT, REVERT, LOCK, RESET_STATISTICS = 1, 2, 3, 4
+# The line settings a master must follow to reach the node after their commit.
+MOVES = ("config_unit_id", "config_baud", "config_parity")
+BAUD_RATES = (9600, 19200, 38400, 57600, 115200)
+PARITY = {0: "N", 1: "O", 2: "E"}
+
+
+def line_in_force(node, staged):
+    """Before a commit that moves the node (a new unit id, baud rate or parity): its
+    unit id, baud rate and parity in force, read while it answers there; None when the
+    commit moves nothing."""
+    if not any(n in MOVES for n, _, _ in staged):
+        return None
+    return {n: node.read("active_" + n[len("config_"):]) for n in MOVES}
+
+
+def confirm_line(node, staged, was):
+    """After a commit that moved the node from `was` (`line_in_force`): asks it at its
+    new settings, which confirms them (`line_status` bit 1 clears)."""
+    if was is None:
+        return
+    moved = {n: w for n, w, _ in staged if n in MOVES}
+    now = {**was, **moved}
+    unit, baud, parity = now["config_unit_id"][0], u32(now["config_baud"]), now["config_parity"][0]
+    node.move(unit, baud, PARITY[parity])
+    for _ in range(3):
+        try:
+            status = node.read("line_status", "input")[0]
+        except Exception:  # noqa: BLE001 (no answer yet: asked again)
+            continue
+        if status & 2 == 0:
+            return
+    raise Failed(f"the node did not confirm its new line settings (unit {unit}, {baud} baud, "
+                 f"parity {PARITY[parity]}): it goes back to the old ones within "
+                 f"line_confirm_window")
 
 
 def unlock(node, code):
@@ -255,11 +311,20 @@ def commission(node, code, settings, scene, reset_statistics=False):
             if u32(node.read("scene_staged_crc")) != crc:
                 raise Failed("the staged scene's CRC differs from the file's: bytes lost on the way")
         if staged or scene is not None:
+            line_was = line_in_force(node, staged)
             x = node.write("command", [COMMIT])
             if x is not None:
                 why = node.read("commit_error")[0]
                 raise Failed(f"commit refused: {REASONS.get(why, why)} (commit_error {why:#x})")
             committed, unlocked = True, False
+            # Line settings: the node answers at the new ones now; asked there, it
+            # keeps them.
+            was = node.unit
+            try:
+                confirm_line(node, staged, line_was)
+            except Failed as e:
+                node.unit = was
+                raise e
             # What the node runs now.
             for name, words, _ in staged:
                 active = "active_" + name[len("config_"):]
@@ -557,6 +622,55 @@ def status(node, events_out, events_from):
     return lines
 
 
+def scan(client, regs, units):
+    """Each unit id in `units` asked once (`unit_id` and `map_version`): the nodes
+    found as lines, and the clashes (an answer that is not the node asked)."""
+    from pymodbus.exceptions import ModbusIOException
+    found, clashes = [], []
+    at = int(regs.row("unit_id")["address"])
+    for unit in units:
+        try:
+            r = client.read_holding_registers(at, count=2, device_id=unit)
+        except ModbusIOException:
+            continue
+        except Exception as e:  # noqa: BLE001 (garbled bytes: two nodes answering)
+            clashes.append(f"unit {unit}: clash: {type(e).__name__} (two nodes at one unit id?)")
+            continue
+        if r.isError():
+            if getattr(r, "exception_code", None):
+                clashes.append(f"unit {unit}: exception {r.exception_code} to a read every node "
+                               f"answers: not this map's node")
+            continue
+        if r.registers[0] != unit:
+            clashes.append(f"unit {unit}: answered with unit_id {r.registers[0]} (a clash)")
+            continue
+        node = Node(client, regs, unit)
+        try:
+            found.append(describe(node, r.registers[1]))
+        except Exception as e:  # noqa: BLE001 (garbled mid-way: a clash)
+            clashes.append(f"unit {unit}: clash while reading it: {e}")
+    return found, clashes
+
+
+def describe(node, map_version):
+    """One line of --scan: unit id, model name, map version, status, line settings."""
+    model = "?"
+    info = node.c.read_device_information(read_code=1, device_id=node.unit)
+    if not info.isError():
+        model = info.information.get(1, b"?").decode(errors="replace")
+    s = node.read("status", "input")[0]
+    line = ""
+    if map_version >= 3 and ("holding", "active_baud") in node.rows:
+        baud = u32(node.read("active_baud"))
+        parity = PARITY.get(node.read("active_parity")[0], "?")
+        delay = node.read("active_answer_delay")[0]
+        timeout = node.read("active_bus_timeout")[0]
+        line = (f", {baud} baud 8{parity}{2 if parity == 'N' else 1}, answer delay {delay} ms, "
+                f"bus timeout {timeout} s")
+    return (f"unit {node.unit}: {model}, map_version {map_version}, "
+            f"state {STATES.get(s & 0xFF, s & 0xFF)}, NE 107 {s >> 8 & 15}{line}")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--tcp", metavar="HOST:PORT", help="a TCP bridge (RTU frames over TCP)")
@@ -584,6 +698,13 @@ def main():
                    help="the events the node holds, as the monitor example's --events")
     p.add_argument("--events-from", type=int, metavar="SEQ",
                    help="read the events from this sequence number (default: event_from)")
+    p.add_argument("--scan", action="store_true",
+                   help="list every node on the line (unit id, model, map version, status, "
+                        "line settings)")
+    p.add_argument("--units", default="1-247", metavar="FIRST-LAST",
+                   help="the unit ids --scan asks (default 1-247)")
+    p.add_argument("--scan-timeout", type=float, default=0.1, metavar="S",
+                   help="seconds --scan waits for each answer (default 0.1)")
     args = p.parse_args()
     if args.scene and args.prepared:
         p.error("--scene or --prepared, not both")
@@ -623,20 +744,53 @@ def main():
     except (Failed, OSError) as e:
         print(f"commission: {e}", file=sys.stderr)
         return 1
+    for name, words, text in settings:
+        if name == "config_baud" and u32(words) not in BAUD_RATES:
+            print(f"commission: config_baud = {text}: one of {', '.join(map(str, BAUD_RATES))}",
+                  file=sys.stderr)
+            return 1
     from pymodbus import FramerType
-    if args.serial:
-        from pymodbus.client import ModbusSerialClient
-        client = ModbusSerialClient(args.serial, framer=FramerType.RTU, baudrate=args.baud,
-                                    parity=args.parity, stopbits=2 if args.parity == "N" else 1,
-                                    timeout=2)
-    else:
-        from pymodbus.client import ModbusTcpClient
-        client = ModbusTcpClient(host, port=int(port), framer=FramerType.RTU, timeout=2, retries=0)
-    if not client.connect():
+
+    def connect(baud, parity, timeout=2):
+        if args.serial:
+            from pymodbus.client import ModbusSerialClient
+            c = ModbusSerialClient(args.serial, framer=FramerType.RTU, baudrate=baud,
+                                   parity=parity, stopbits=2 if parity == "N" else 1,
+                                   timeout=timeout, retries=0)
+        else:
+            from pymodbus.client import ModbusTcpClient
+            c = ModbusTcpClient(host, port=int(port), framer=FramerType.RTU, timeout=timeout,
+                                retries=0)
+        if not c.connect():
+            raise Failed("cannot connect")
+        return c
+
+    if args.scan:
+        try:
+            first, _, last = args.units.partition("-")
+            units = range(int(first), int(last or first) + 1)
+            client = connect(args.baud, args.parity, args.scan_timeout)
+        except (ValueError, Failed) as e:
+            print(f"commission: --scan: {e}", file=sys.stderr)
+            return 1
+        try:
+            found, clashes = scan(client, regs, units)
+        finally:
+            client.close()
+        for line in found:
+            print(line)
+        for line in clashes:
+            print(line)
+        print(f"{len(found)} nodes found, {len(clashes)} clashes, units {units.start}-{units.stop - 1}")
+        return 1 if clashes else 0
+    try:
+        client = connect(args.baud, args.parity)
+    except Failed:
         print("commission: cannot connect", file=sys.stderr)
         return 1
     try:
-        node = Node(client, regs, args.unit)
+        node = Node(client, regs, args.unit,
+                    (lambda b, par: connect(b, par)) if args.serial else None)
         planned = check_thresholds(node, args.thresholds, table, settings) if table else None
         if code is not None:
             source = commission(node, code, settings, scene, args.reset_statistics)
@@ -646,7 +800,7 @@ def main():
         print("commission: " + "; ".join([why, *getattr(e, "__notes__", [])]), file=sys.stderr)
         return 1
     finally:
-        client.close()
+        node.c.close() if 'node' in locals() else client.close()
     if args.reset_statistics:
         print("statistics reset")
     switched = [n for n, _, _ in settings if n in SWITCHES]

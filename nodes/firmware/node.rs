@@ -116,6 +116,8 @@ fn log_event(e: &Event) {
             None,
             None,
         ),
+        // Raised by the Modbus server only (`serve.rs`): never on this log.
+        EventKind::Fieldbus(f) => (f.as_str(), "-", "-", None, None),
     };
     let r = &e.reading;
     defmt::println!(

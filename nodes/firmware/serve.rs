@@ -153,6 +153,11 @@ pub fn node<
     // The commissioning's milliseconds, from the line's ticks.
     let (mut ms, mut ticked) = (0u32, last_byte);
     let per_ms = clock.per_ms.max(1);
+    // The line settings the UART runs: set again when the server's change (a commit
+    // after its answer, a revert). The QEMU UARTs carry bytes at any rate (the TCP
+    // bridge): the settings are logged, the unit id is the server's own.
+    let mut line = server.line();
+    log_line(&line);
     loop {
         board.alive();
         if let Some(sample) = board.sample()
@@ -169,6 +174,10 @@ pub fn node<
         }
         #[cfg(feature = "modbus-flash")]
         persist.service(&mut server);
+        if server.line() != line {
+            line = server.line();
+            log_line(&line);
+        }
         let now = (clock.ticks)();
         let step = now.wrapping_sub(ticked);
         if step >= per_ms {
@@ -196,6 +205,18 @@ pub fn node<
             board.idle(wait, &mut || uart.uart.read_ready().unwrap_or(true));
         }
     }
+}
+
+/// The line settings in force, as a log line.
+fn log_line(l: &misalign::modbus::LineSettings) {
+    defmt::println!(
+        "modbus: unit {=u8}, {=u32} baud, parity {=u8} (0 none, 1 odd, 2 even), answer delay {=u16} ms, bus timeout {=u16} s",
+        l.unit_id,
+        l.baud,
+        l.parity as u8,
+        l.answer_delay_ms,
+        l.bus_timeout_s
+    );
 }
 
 /// One `sample` line: what the board's sensors delivered and the monitor took, every

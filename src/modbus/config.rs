@@ -17,6 +17,7 @@
 
 use super::div::div1000;
 use super::exception::Exception;
+use super::line::{LINE_BYTES, Line, LineSettings};
 use crate::monitor::annunciation::AlarmSet;
 use crate::monitor::{
     Config, ConfigError, FrictionConfig, Monitor, SpikeFilter, Thresholds, TrendConfig,
@@ -39,10 +40,13 @@ pub const WRONG_CODES_MAX: u8 = 3;
 /// The lock-out's length (s).
 pub const LOCKOUT_S: u32 = 300;
 /// Bytes of the committed configuration's image ([`Server::take_committed`](super::Server::take_committed)).
-pub const IMAGE_LEN: usize = 4 + 2 * CONFIG_WORDS + 2 + SCENE_BYTES_MAX;
+pub const IMAGE_LEN: usize = IMAGE_V2_LEN + LINE_BYTES;
+/// Bytes of an image of version 1 or 2 (without the line settings).
+const IMAGE_V2_LEN: usize = 4 + 2 * CONFIG_WORDS + 2 + SCENE_BYTES_MAX;
 /// The image's format version (its byte 0). Version 1 held no switches: its
-/// latching and samples' source stay the build's.
-pub const IMAGE_VERSION: u8 = 2;
+/// latching and samples' source stay the build's; versions 1 and 2 (10 bytes
+/// shorter) held no line settings: the build's stay.
+pub const IMAGE_VERSION: u8 = 3;
 
 /// The image's byte 1: bit 0 a scene follows, bit 1 external samples are taken, bit 2
 /// the scene was committed over the bus (not the build's), bits 4-7 the alarms that
@@ -462,6 +466,8 @@ pub mod staged {
     pub const SCENE: u16 = 2;
     /// A new site code was written.
     pub const CODE: u16 = 4;
+    /// The line settings were written.
+    pub const LINE: u16 = 8;
 }
 
 /// The commissioning registers that are not the configuration's.
@@ -646,6 +652,13 @@ impl<E: Estimator> Commissioning<E> {
         self.touched(staged::CONFIG);
     }
 
+    /// A line setting written (the guard passed, the value in its domain).
+    pub(crate) fn write_line(&mut self, line: &mut Line, f: super::line::LineField, v: u32) {
+        if line.write_staged(f, v) {
+            self.touched(staged::LINE);
+        }
+    }
+
     pub(crate) fn write_new_code(&mut self, v: u16) {
         self.new_code = v;
         self.touched(staged::CODE);
@@ -696,15 +709,24 @@ impl<E: Estimator> Commissioning<E> {
     /// A value written to `command` (the guard passed). Out of line: the commit's
     /// configuration and scene are on the stack only while a command runs.
     #[inline(never)]
-    pub(crate) fn command(&mut self, v: u16, monitor: &mut Monitor<E>) -> Result<(), Exception> {
+    pub(crate) fn command(
+        &mut self,
+        v: u16,
+        monitor: &mut Monitor<E>,
+        line: &mut Line,
+    ) -> Result<(), Exception> {
         match v {
             command::COMMIT => {
                 let result = self.commit(monitor);
                 self.commit_error = result.err().unwrap_or(reason::NONE);
+                if result.is_ok() {
+                    line.commit();
+                }
                 result.map_err(|_| Exception::IllegalDataValue)
             }
             command::REVERT => {
                 self.revert();
+                line.revert_staged();
                 self.unlock_ms = UNLOCK_TIMEOUT_S * 1000;
                 Ok(())
             }
@@ -769,6 +791,7 @@ impl<E: Estimator> Commissioning<E> {
         &mut self,
         monitor: &Monitor<E>,
         switches: Switches,
+        line: LineSettings,
         out: &mut [u8; IMAGE_LEN],
     ) -> bool {
         if !self.unsaved {
@@ -795,8 +818,9 @@ impl<E: Estimator> Commissioning<E> {
             }
             let at = 4 + 2 * CONFIG_WORDS;
             out[at..at + 2].copy_from_slice(&(io.bytes as u16).to_le_bytes());
-            (io.save)(monitor.estimator(), &mut out[at + 2..]);
+            (io.save)(monitor.estimator(), &mut out[at + 2..IMAGE_V2_LEN]);
         }
+        out[IMAGE_V2_LEN..].copy_from_slice(&line.to_bytes());
         true
     }
 
@@ -806,33 +830,47 @@ impl<E: Estimator> Commissioning<E> {
         &mut self,
         stored: Stored<'_>,
         monitor: &mut Monitor<E>,
-    ) -> (BootSource, Option<Switches>) {
-        let mut switches = None;
+    ) -> (BootSource, Option<Switches>, Option<LineSettings>) {
+        let (mut switches, mut line) = (None, None);
         self.scene_commissioned = false;
         self.source = match stored {
             Stored::Nothing => BootSource::Defaults,
             Stored::Damaged => BootSource::DefaultsDamaged,
             Stored::Image(image) => match self.apply_image(image, monitor) {
-                Some(s) => {
-                    switches = s;
+                Some((s, l)) => {
+                    (switches, line) = (s, l);
                     BootSource::Committed
                 }
                 None => BootSource::DefaultsDamaged,
             },
         };
         self.revert();
-        (self.source, switches)
+        (self.source, switches, line)
     }
 
-    /// An image's configuration, code and scene checked, then applied, and its
-    /// switches (none in a version 1 image); `None` (and nothing applied) for an image
-    /// that is not one.
-    fn apply_image(&mut self, image: &[u8], monitor: &mut Monitor<E>) -> Option<Option<Switches>> {
-        let image: &[u8; IMAGE_LEN] = image.try_into().ok()?;
-        let (&[version, flags], rest) = image.split_first_chunk::<2>()?;
+    /// An image's configuration, code, scene and line settings checked, then applied,
+    /// and its switches (none in a version 1 image) and line settings (none before
+    /// version 3); `None` (and nothing applied) for an image that is not one.
+    #[allow(clippy::type_complexity)]
+    fn apply_image(
+        &mut self,
+        image: &[u8],
+        monitor: &mut Monitor<E>,
+    ) -> Option<(Option<Switches>, Option<LineSettings>)> {
+        let (&[version, flags], _) = image.split_first_chunk::<2>()?;
+        let (image, line) = match (version, image.len()) {
+            (1 | 2, IMAGE_V2_LEN) => (image, None),
+            (IMAGE_VERSION, IMAGE_LEN) => {
+                let (v2, line) = image.split_at_checked(IMAGE_V2_LEN)?;
+                (v2, Some(LineSettings::from_bytes(line.try_into().ok()?)?))
+            }
+            _ => return None,
+        };
+        let image: &[u8; IMAGE_V2_LEN] = image.try_into().ok()?;
+        let (_, rest) = image.split_first_chunk::<2>()?;
         let switches = match version {
             1 if flags <= flags::SCENE => None,
-            IMAGE_VERSION
+            2 | IMAGE_VERSION
                 if flags & flags::RESERVED == 0
                     && (flags & flags::SCENE_COMMISSIONED == 0 || flags & flags::SCENE != 0) =>
             {
@@ -864,7 +902,7 @@ impl<E: Estimator> Commissioning<E> {
         }
         self.scene_commissioned = flags & flags::SCENE_COMMISSIONED != 0;
         self.code = u16::from_le_bytes(*code);
-        Some(switches)
+        Some((switches, line))
     }
 }
 

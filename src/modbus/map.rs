@@ -4,7 +4,10 @@
 //!
 //! Each of the four Modbus tables is a run of single entries from address 0 without a
 //! hole, then blocks of repeated records (the event window's slots, the external
-//! samples). A 32-bit value takes two registers, the high word first.
+//! samples) or a block of one record without a prefix (the line settings), in order;
+//! between two blocks one run of reserved addresses at most (the holding registers
+//! before [`LINE_ADDRESS`]), which a request refuses with exception 02. A 32-bit
+//! value takes two registers, the high word first.
 
 use super::config::{ConfigField, Reg};
 use super::div::div_rem;
@@ -163,6 +166,11 @@ pub(crate) enum Field {
     Staged(ConfigField),
     /// An external sample's field (the basic or the full record).
     Sample(SampleField),
+    /// A staged line setting (`config_unit_id`, ...).
+    LineStaged(LineField),
+    /// A line setting in force (`active_unit_id`, ...).
+    LineActive(LineField),
+    LineConfirmWindow,
     // Coils.
     Acknowledge,
     Latching(AlarmSet),
@@ -218,6 +226,10 @@ pub(crate) enum Field {
     CheckpointAge,
     /// An active configuration register.
     Active(ConfigField),
+    // The line's input registers.
+    LineReverts,
+    LineStatus,
+    LineConfirmLeft,
 }
 
 /// The fields of an event slot.
@@ -306,6 +318,16 @@ impl Entry {
                 max: u32::from(super::config::command::RESET_STATISTICS),
             },
             F::Sample(SampleField::Flags) => Domain::up_to(3),
+            F::LineStaged(f) => match f {
+                LineField::UnitId => Domain::Whole { min: 1, max: 247 },
+                LineField::Baud => Domain::Whole {
+                    min: BAUD_RATES[0],
+                    max: BAUD_RATES[BAUD_RATES.len() - 1],
+                },
+                LineField::Parity => Domain::up_to(2),
+                LineField::AnswerDelay => Domain::up_to(u32::from(ANSWER_DELAY_MAX_MS)),
+                LineField::BusTimeout => any,
+            },
             F::Staged(f) => match f {
                 G::ThresholdsOn | G::Friction => bit,
                 G::SpikeWindow => Domain::up_to(SPIKE_WINDOW_CAPACITY as u32),
@@ -352,7 +374,8 @@ pub struct Block {
     pub table: Table,
     /// The first record's address.
     pub address: u16,
-    /// The records' name, `<prefix>_<index>_<field>` in the CSV.
+    /// The records' name, `<prefix>_<index>_<field>` in the CSV; empty: one record,
+    /// its fields' names bare.
     pub prefix: &'static str,
     /// Records.
     pub count: u16,
@@ -375,7 +398,8 @@ impl Block {
 pub struct TableMap {
     /// The single entries, sorted by address, without a hole from 0.
     pub entries: &'static [Entry],
-    /// The blocks, after the entries, without a hole between them.
+    /// The blocks, after the entries, in order; one run of reserved addresses at most
+    /// between two of them.
     pub blocks: &'static [Block],
 }
 
@@ -576,15 +600,38 @@ pub static INPUTS: TableMap = TableMap {
         e!(Input, STORAGE_ADDRESS + 8, "checkpoint_age", U32, "s", R, F::CheckpointAge,
             "monitor time since the newest checkpoint, power-off not counted; 0xFFFFFFFF none"),
     ],
-    blocks: &[Block {
-        table: Table::Input,
-        address: EVENT_SLOTS_ADDRESS,
-        prefix: "event",
-        count: EVENT_SLOTS,
-        stride: EVENT_STRIDE,
-        fields: &EVENT_FIELDS,
-    }],
+    blocks: &[
+        Block {
+            table: Table::Input,
+            address: EVENT_SLOTS_ADDRESS,
+            prefix: "event",
+            count: EVENT_SLOTS,
+            stride: EVENT_STRIDE,
+            fields: &EVENT_FIELDS,
+        },
+        Block {
+            table: Table::Input,
+            address: LINE_INPUTS_ADDRESS,
+            prefix: "",
+            count: 1,
+            stride: 4,
+            fields: &LINE_INPUT_FIELDS,
+        },
+    ],
 };
+
+/// Where the line's input registers start, after the event slots.
+pub const LINE_INPUTS_ADDRESS: u16 = EVENT_SLOTS_ADDRESS + EVENT_SLOTS * EVENT_STRIDE;
+
+#[rustfmt::skip]
+static LINE_INPUT_FIELDS: [Entry; 3] = [
+    e!(Input, 0, "line_reverts", U32, "", R, F::LineReverts,
+        "changes of the line settings undone for want of a confirmation within line_confirm_window (each also an event, kind 5)"),
+    e!(Input, 2, "line_status", U16, "", R, F::LineStatus,
+        "bit 0 the master is lost: no request for this node within active_bus_timeout (shown until the answer to the next request); bit 1 a change of the line settings waits for its confirmation"),
+    e!(Input, 3, "line_confirm_left", U16, "s", R, F::LineConfirmLeft,
+        "seconds left for a request at the new line settings before the node goes back to the old ones (0 none waits)"),
+];
 
 use EventField as V;
 
@@ -599,7 +646,7 @@ static EVENT_FIELDS: [Entry; 15] = [
     e!(Input, 6, "elapsed_ms", U16, "ms", R, F::Event(V::ElapsedMs),
         "monotonic time since the first sample, the milliseconds (0-999)"),
     e!(Input, 7, "kind", U16, "", R, F::Event(V::Kind),
-        "0 empty slot, 1 state change, 2 approaching, 3 friction changed, 4 friction back in band"),
+        "0 empty slot, 1 state change, 2 approaching, 3 friction changed, 4 friction back in band, 5 line settings reverted (not confirmed), 6 master lost (bus timeout), 7 master back"),
     e!(Input, 8, "from", U16, "", R, F::Event(V::From),
         "state change: the state left (risk state code as in status)"),
     e!(Input, 9, "to", U16, "", R, F::Event(V::To),
@@ -882,8 +929,50 @@ pub static HOLDINGS: TableMap = TableMap {
             stride: 1,
             fields: &SCENE_FIELDS,
         },
+        Block {
+            table: Table::Holding,
+            address: LINE_ADDRESS,
+            prefix: "",
+            count: 1,
+            stride: 13,
+            fields: &LINE_FIELDS,
+        },
     ],
 };
+
+/// Where the line settings start (holding registers); the addresses from the scene
+/// block's end to here are reserved (exception 02).
+pub const LINE_ADDRESS: u16 = 460;
+const _: () = assert!(SCENE_ADDRESS + SCENE_WORDS <= LINE_ADDRESS);
+
+use super::line::{ANSWER_DELAY_MAX_MS, BAUD_RATES, LineField};
+use LineField as N;
+
+#[rustfmt::skip]
+static LINE_FIELDS: [Entry; 11] = [
+    e!(Holding, 0, "config_unit_id", U16, "", Rw, F::LineStaged(N::UnitId),
+        "needs the unlock; staged: the unit id (1 to 247); committed with command 1, then as every line setting answered at the old settings and in force after, kept only when a request addressed to the node at the new settings comes within line_confirm_window"),
+    e!(Holding, 1, "config_baud", U32, "bit/s", Rw, F::LineStaged(N::Baud),
+        "needs the unlock; staged: the baud rate: 9600, 19200, 38400, 57600 or 115200"),
+    e!(Holding, 3, "config_parity", U16, "", Rw, F::LineStaged(N::Parity),
+        "needs the unlock; staged: 0 none (two stop bits), 1 odd, 2 even (one stop bit)"),
+    e!(Holding, 4, "config_answer_delay", U16, "ms", Rw, F::LineStaged(N::AnswerDelay),
+        "needs the unlock; staged: the least time from a request's end to the answer's start (0 to 1000)"),
+    e!(Holding, 5, "config_bus_timeout", U16, "s", Rw, F::LineStaged(N::BusTimeout),
+        "needs the unlock; staged: the master is lost after this long without a request for this node (event, line_status bit 0, NE 107 out of specification); 0: off"),
+    e!(Holding, 6, "active_unit_id", U16, "", R, F::LineActive(N::UnitId),
+        "the line setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 7, "active_baud", U32, "bit/s", R, F::LineActive(N::Baud),
+        "the line setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 9, "active_parity", U16, "", R, F::LineActive(N::Parity),
+        "the line setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 10, "active_answer_delay", U16, "ms", R, F::LineActive(N::AnswerDelay),
+        "the line setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 11, "active_bus_timeout", U16, "s", R, F::LineActive(N::BusTimeout),
+        "the line setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 12, "line_confirm_window", U16, "s", R, F::LineConfirmWindow,
+        "how long a change of the line settings waits for a request at them before the node goes back to the settings before it (read only)"),
+];
 
 /// The four tables in the CSV's order.
 pub static MAP: [&TableMap; 4] = [&COILS, &DISCRETES, &INPUTS, &HOLDINGS];
@@ -1009,6 +1098,27 @@ pub(crate) struct Served {
     pub entries_end: u16,
     /// The address after the table.
     pub end: u16,
+    /// The reserved addresses between two blocks (`end..end`: none).
+    pub hole: (u16, u16),
+}
+
+/// The reserved addresses between `map`'s blocks: at most one run (checked at compile
+/// time); `(end, end)` for none.
+const fn hole(map: &TableMap) -> (u16, u16) {
+    let mut found = (map.end(), map.end());
+    let mut prev = map.entries_end();
+    let mut i = 0;
+    while i < map.blocks.len() {
+        let b = &map.blocks[i];
+        assert!(b.address >= prev, "blocks in order, without an overlap");
+        if b.address > prev {
+            assert!(found.0 == map.end(), "one reserved run at most");
+            found = (prev, b.address);
+        }
+        prev = b.end();
+        i += 1;
+    }
+    found
 }
 
 /// The entries of a table as slots.
@@ -1059,6 +1169,8 @@ static SAMPLE_SLOTS: [Slot; SAMPLE_FIELDS.len()] = slots(&SAMPLE_FIELDS);
 static SAMPLE_FULL_SLOTS: [Slot; SAMPLE_FULL_FIELDS.len()] = slots(&SAMPLE_FULL_FIELDS);
 static EVENT_FIELD_SLOTS: [Slot; EVENT_FIELDS.len()] = slots(&EVENT_FIELDS);
 static SCENE_SLOTS: [Slot; SCENE_FIELDS.len()] = slots(&SCENE_FIELDS);
+static LINE_SLOTS: [Slot; LINE_FIELDS.len()] = slots(&LINE_FIELDS);
+static LINE_INPUT_SLOTS: [Slot; LINE_INPUT_FIELDS.len()] = slots(&LINE_INPUT_FIELDS);
 
 /// One table as the server holds it: `$map`'s entries as slots, its index, its blocks
 /// with their fields' slots.
@@ -1075,6 +1187,7 @@ macro_rules! served {
             index: &INDEX,
             entries_end: ENDS.0,
             end: ENDS.1,
+            hole: hole(&$map),
         }
     }};
 }
@@ -1083,14 +1196,18 @@ static COILS_SERVED: Served = served!(COILS, []);
 static DISCRETES_SERVED: Served = served!(DISCRETES, []);
 static INPUTS_SERVED: Served = served!(
     INPUTS,
-    [SlotBlock::of(&INPUTS.blocks[0], &EVENT_FIELD_SLOTS)]
+    [
+        SlotBlock::of(&INPUTS.blocks[0], &EVENT_FIELD_SLOTS),
+        SlotBlock::of(&INPUTS.blocks[1], &LINE_INPUT_SLOTS)
+    ]
 );
 static HOLDINGS_SERVED: Served = served!(
     HOLDINGS,
     [
         SlotBlock::of(&HOLDINGS.blocks[0], &SAMPLE_SLOTS),
         SlotBlock::of(&HOLDINGS.blocks[1], &SAMPLE_FULL_SLOTS),
-        SlotBlock::of(&HOLDINGS.blocks[2], &SCENE_SLOTS)
+        SlotBlock::of(&HOLDINGS.blocks[2], &SCENE_SLOTS),
+        SlotBlock::of(&HOLDINGS.blocks[3], &LINE_SLOTS)
     ]
 );
 
@@ -1212,7 +1329,7 @@ pub fn registers_csv(out: &mut impl fmt::Write) -> fmt::Result {
                         out,
                         e,
                         b.address + i * b.stride + e.address,
-                        Some((b.prefix, i)),
+                        Some((b.prefix, i)).filter(|(p, _)| !p.is_empty()),
                     )?;
                 }
             }
@@ -1226,7 +1343,8 @@ mod tests {
     use super::*;
 
     /// Every table: entries from 0 without a hole or an overlap, blocks after them
-    /// likewise, each block's fields filling its stride.
+    /// likewise but for the holding registers' one reserved run before the line
+    /// settings, each block's fields filling its stride.
     #[test]
     fn tables_have_no_hole() {
         for t in MAP {
@@ -1239,7 +1357,12 @@ mod tests {
                 }
             }
             for b in t.blocks {
+                if b.address == LINE_ADDRESS && b.table == Table::Holding {
+                    assert!(next <= LINE_ADDRESS);
+                    next = LINE_ADDRESS;
+                }
                 assert_eq!(b.address, next, "{}", b.prefix);
+                assert!(!b.prefix.is_empty() || b.count == 1);
                 let mut at = 0;
                 for e in b.fields {
                     assert_eq!((e.address, e.table), (at, b.table), "{}", e.name);
@@ -1252,12 +1375,12 @@ mod tests {
         }
     }
 
-    /// The read of holding registers writes the blocks' words as 0 without asking each
-    /// field (`Core::fill`): they are all external samples' fields or the scene's,
-    /// which read 0.
+    /// The read of holding registers below the line settings writes the blocks' words
+    /// as 0 without asking each field (`Core::fill`): they are all external samples'
+    /// fields or the scene's, which read 0.
     #[test]
     fn holding_blocks_read_zero() {
-        for b in HOLDINGS.blocks {
+        for b in HOLDINGS.blocks.iter().filter(|b| b.address < LINE_ADDRESS) {
             for e in b.fields {
                 assert!(
                     matches!(e.field, Field::Sample(_) | Field::Commission(Reg::Scene)),
@@ -1299,6 +1422,10 @@ mod tests {
         {
             let s = Served::of(table);
             for a in 0..s.end {
+                if (s.hole.0..s.hole.1).contains(&a) {
+                    assert!(s.locate(a).is_none(), "{a} reserved");
+                    continue;
+                }
                 let l = s.locate(a).expect("inside the table");
                 assert!(l.word < l.entry.words());
             }

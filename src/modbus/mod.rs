@@ -102,6 +102,7 @@ mod exception;
 mod ident;
 #[cfg(feature = "embedded-io")]
 mod io;
+mod line;
 pub mod map;
 mod pdu;
 pub mod rtu;
@@ -118,6 +119,9 @@ pub use crc::crc16;
 pub use events::{EVENT_WINDOW, StorageStatus};
 pub use exception::Exception;
 pub use ident::Identification;
+pub use line::{
+    ANSWER_DELAY_MAX_MS, BAUD_RATES, LINE_CONFIRM_WINDOW_S, LineError, LineSettings, Parity,
+};
 pub use map::registers_csv;
 pub use rtu::{ADU_MAX, FramingCounters};
 pub use state::Counters;
@@ -128,6 +132,7 @@ use crate::{Estimator, FrictionInverse};
 use config::Commissioning;
 use core::fmt;
 use events::EventWindow;
+use line::Line;
 use rtu::Framer;
 use state::{Core, Step};
 
@@ -168,6 +173,20 @@ pub struct ServerConfig {
     /// application processes no sample ([`Server::scene_commissioned`]). Default
     /// false: the build's scene is a site's (a demonstrator, a test).
     pub scene_required: bool,
+    /// The line settings but the unit id, until a committed image's replace them
+    /// ([`LineSettings::DEFAULT`]'s: 19200 baud, even parity, no answer delay, no bus
+    /// timeout); their `unit_id` is ignored: `unit_id` above is the node's.
+    pub line: LineSettings,
+}
+
+impl ServerConfig {
+    /// The line settings it starts with: `line` with `unit_id`.
+    pub const fn line_settings(&self) -> LineSettings {
+        LineSettings {
+            unit_id: self.unit_id,
+            ..self.line
+        }
+    }
 }
 
 impl Default for ServerConfig {
@@ -179,6 +198,7 @@ impl Default for ServerConfig {
             latching: AlarmSet::NONE,
             unlock_code: DEFAULT_UNLOCK_CODE,
             scene_required: false,
+            line: LineSettings::DEFAULT,
         }
     }
 }
@@ -189,13 +209,16 @@ impl Default for ServerConfig {
 pub enum ServerConfigError {
     /// The unit id is 0 (broadcast) or above 247 (reserved).
     UnitId,
+    /// A line setting the node does not take.
+    Line(LineError),
 }
 
 impl fmt::Display for ServerConfigError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            ServerConfigError::UnitId => "the unit id must be 1 to 247",
-        })
+        match self {
+            ServerConfigError::UnitId => f.write_str("the unit id must be 1 to 247"),
+            ServerConfigError::Line(e) => write!(f, "line settings: {e}"),
+        }
     }
 }
 
@@ -227,6 +250,8 @@ impl<E: Estimator> Server<E> {
         if !(1..=247).contains(&config.unit_id) {
             return Err(ServerConfigError::UnitId);
         }
+        let line = config.line_settings();
+        line.validate().map_err(ServerConfigError::Line)?;
         let pending = monitor.pending_events() as u32;
         let monitor_next = monitor.next_event_seq();
         let from = monitor_next.wrapping_sub(pending);
@@ -239,6 +264,7 @@ impl<E: Estimator> Server<E> {
             framer: Framer::new(),
             core: Core {
                 commissioning: Commissioning::new(config.unlock_code),
+                line: Line::new(line),
                 monitor,
                 step,
                 unit: config.unit_id,
@@ -324,9 +350,30 @@ impl<E: Estimator> Server<E> {
         }
     }
 
-    /// The response was sent.
+    /// The response was sent. After the answer to a commit that changed the line
+    /// settings, they are in force now: set the UART to [`line`](Self::line).
     pub fn sent(&mut self) {
         self.core.response_len = 0;
+        self.core.line_sent();
+    }
+
+    /// The line settings in force (`active_*`): after each [`sent`](Self::sent) and
+    /// [`tick`](Self::tick) the application sets its UART to them when they changed,
+    /// and waits `answer_delay_ms` before each answer.
+    pub fn line(&self) -> LineSettings {
+        self.core.line.active()
+    }
+
+    /// Whether the master is lost: no request for this node within the bus timeout
+    /// (`line_status` bit 0); the answer to the next request clears it.
+    pub fn master_lost(&self) -> bool {
+        self.core.line.master_lost()
+    }
+
+    /// Changes of the line settings undone for want of a confirmation
+    /// (`line_reverts`).
+    pub fn line_reverts(&self) -> u32 {
+        self.core.line.reverts()
     }
 
     /// Processes one of the node's own samples (`Monitor::process`, or
@@ -375,8 +422,15 @@ impl<E: Estimator> Server<E> {
     /// counter (u32, wrapping). The unlock's timeout ([`UNLOCK_TIMEOUT_S`]) and the
     /// lock-out ([`LOCKOUT_S`]) run on it alone; call it at least once a second (without
     /// it, neither ends by itself).
+    ///
+    /// The line settings run on it too: a change not confirmed within
+    /// [`LINE_CONFIRM_WINDOW_S`] goes back to the settings before it (an event, kind
+    /// `LineReverted`, and `line_reverts`; set the UART to [`line`](Self::line) again),
+    /// and no request for [`LineSettings::bus_timeout_s`] raises `MasterLost`.
     pub fn tick(&mut self, now_ms: u32) {
         self.core.commissioning.tick(now_ms);
+        let raised = self.core.line.tick(now_ms);
+        self.core.raise(raised);
     }
 
     /// Whether commissioning writes are unlocked now.
@@ -416,7 +470,8 @@ impl<E: Estimator> Server<E> {
             latching: c.annunciator.latching(),
             external: c.external,
         };
-        c.commissioning.take_committed(&c.monitor, switches, out)
+        c.commissioning
+            .take_committed(&c.monitor, switches, c.line.kept(), out)
     }
 
     /// At boot: applies the configuration the application restored from its storage,
@@ -426,10 +481,14 @@ impl<E: Estimator> Server<E> {
     /// reads after it.
     pub fn restore(&mut self, stored: Stored<'_>) -> BootSource {
         let c = &mut self.core;
-        let (source, switches) = c.commissioning.restore(stored, &mut c.monitor);
+        let (source, switches, line) = c.commissioning.restore(stored, &mut c.monitor);
         if let Some(s) = switches {
             c.annunciator.set_latching(s.latching);
             c.external = s.external;
+        }
+        if let Some(l) = line {
+            c.line.restore(l);
+            c.unit = l.unit_id;
         }
         source
     }

@@ -41,7 +41,9 @@ fn head(pdu: &[u8]) -> Result<Head, Exception> {
 
 /// Whether `start..start + quantity` lies in `map`.
 fn in_map(map: &Served, start: u16, quantity: u16) -> Result<(), Exception> {
-    if u32::from(start) + u32::from(quantity) <= u32::from(map.end) {
+    let end = u32::from(start) + u32::from(quantity);
+    let (h0, h1) = map.hole;
+    if end <= u32::from(map.end) && (start >= h1 || end <= u32::from(h0)) {
         Ok(())
     } else {
         Err(Exception::IllegalDataAddress)
@@ -131,7 +133,10 @@ impl<E: Estimator> Core<E> {
         } else {
             self.dispatch(function, pdu, head).map(Reply::Pdu)
         };
+        self.line_request(!broadcast);
         if broadcast {
+            // No answer to send: a committed change of the line settings now.
+            self.line_sent();
             return;
         }
         let len = match result {
@@ -239,8 +244,10 @@ impl<E: Estimator> Core<E> {
         let bytes = 2 * quantity.min(125) as u8;
         let end = 3 + bytes;
         // Each table's values from a function of its own (small enough to inline).
-        if function == 3 {
+        if function == 3 && start < super::map::LINE_ADDRESS {
             self.fill::<true>(map, start, usize::from(end), Self::value_holding);
+        } else if function == 3 {
+            self.fill::<false>(map, start, usize::from(end), Self::value_holding);
         } else {
             self.fill::<false>(map, start, usize::from(end), Self::value);
         }
@@ -419,7 +426,7 @@ impl<E: Estimator> Core<E> {
         let map = Served::of(Table::Holding);
         in_map(map, start, quantity)?;
         let word = |i: u16| be(data, 2 * usize::from(i)).unwrap_or(0);
-        if start >= map.entries_end {
+        if start >= map.entries_end && start < super::map::LINE_ADDRESS {
             let block = map
                 .blocks
                 .iter()
@@ -435,7 +442,7 @@ impl<E: Estimator> Core<E> {
         // Single entries only, each whole and writable: checked, then written.
         // Inside the map (checked above): no u16 below wraps.
         let end = start.wrapping_add(quantity);
-        if end > map.entries_end {
+        if start < map.entries_end && end > map.entries_end {
             return Err(Exception::IllegalDataAddress);
         }
         for pass in [false, true] {
@@ -552,6 +559,10 @@ impl<E: Estimator> Core<E> {
                 return Err(Exception::IllegalDataAddress);
             }
             Field::Commission(Reg::Unlock) => true,
+            Field::LineStaged(f) => {
+                self.commissioning.guard()?;
+                f.takes(v)
+            }
             Field::Commission(Reg::Command | Reg::NewCode) | Field::Staged(_) => {
                 self.commissioning.guard()?;
                 !matches!(
@@ -602,10 +613,11 @@ impl<E: Estimator> Core<E> {
             Field::LatchingAlarms => self.switch(bits, self.external),
             Field::ExternalMode => self.switch(self.annunciator.latching(), v != 0),
             Field::Staged(f) => c.write_staged(f, v, self.monitor.config()),
+            Field::LineStaged(f) => c.write_line(&mut self.line, f, v),
             Field::Commission(Reg::NewCode) => c.write_new_code(v as u16),
             Field::Commission(Reg::Unlock) => c.unlock(v as u16)?,
             Field::Commission(Reg::Command) => {
-                c.command(v as u16, &mut self.monitor)?;
+                c.command(v as u16, &mut self.monitor, &mut self.line)?;
                 // The events lost count with the statistics (`events_dropped`): the
                 // window's share starts afresh with the monitor's.
                 if v == u32::from(super::config::command::RESET_STATISTICS) {
@@ -743,7 +755,8 @@ mod tests {
 
     /// Every read of registers, from every address and of every length the table
     /// allows (up to 125), answers each register as the value that holds it, located
-    /// alone and computed alone, with the head and the CRC of a valid frame.
+    /// alone and computed alone, with the head and the CRC of a valid frame; a read
+    /// that touches the reserved addresses is refused.
     #[test]
     fn every_read_of_registers_is_each_registers_value() {
         let mut server = server(ServerConfig::default());
@@ -753,9 +766,13 @@ mod tests {
         }
         for function in [3u8, 4] {
             let map = Served::of(table_of(function));
+            let reserved = map.hole.0..map.hole.1;
             let expected: Vec<u16> = (0..map.end)
                 .map(|a| {
-                    let l = map.locate(a).unwrap();
+                    let Some(l) = map.locate(a) else {
+                        assert!(reserved.contains(&a), "{a}");
+                        return 0;
+                    };
                     let (field, record) = (l.entry.field, l.record);
                     let other = server.core.value_other(field, record);
                     // The commissioning registers are value_holding's alone; every
@@ -774,10 +791,14 @@ mod tests {
                 for quantity in 1..=(map.end - start).min(READ_REGISTERS_MAX) {
                     let [a, b] = start.to_be_bytes();
                     let [c, d] = quantity.to_be_bytes();
-                    let n = server
+                    let read = server
                         .core
-                        .read_registers(function, head(&[function, a, b, c, d]).unwrap())
-                        .unwrap();
+                        .read_registers(function, head(&[function, a, b, c, d]).unwrap());
+                    if start < reserved.end && start + quantity > reserved.start {
+                        assert_eq!(read, Err(Exception::IllegalDataAddress));
+                        continue;
+                    }
+                    let n = read.unwrap();
                     let answer = &server.core.response[..n];
                     let bytes = 2 * usize::from(quantity);
                     assert_eq!(n, bytes + 5);

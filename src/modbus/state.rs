@@ -6,6 +6,7 @@
 use super::config::Commissioning;
 use super::events::{EventWindow, StorageStatus};
 use super::ident::Identification;
+use super::line::{Line, Raised};
 use super::rtu::{ADU_MAX, FramingCounters};
 use crate::Estimator;
 use crate::monitor::annunciation::{AlarmSet, Annunciator};
@@ -61,6 +62,8 @@ pub(super) struct Core<E> {
     pub(super) monitor: Monitor<E>,
     /// The staged configuration, the unlock, the commits.
     pub(super) commissioning: Commissioning<E>,
+    /// The line settings: staged, in force, kept; the master's supervision.
+    pub(super) line: Line,
 }
 
 impl<E: Estimator> Core<E> {
@@ -69,6 +72,37 @@ impl<E: Estimator> Core<E> {
         self.last_time_ms = sample.time_ms;
         self.drain();
         state
+    }
+
+    /// An event of the link, raised through the monitor (numbered with its own).
+    pub(super) fn raise(&mut self, raised: Raised) {
+        use crate::monitor::FieldbusEvent as B;
+        let event = match raised {
+            Raised::Nothing => return,
+            Raised::Reverted => B::LineReverted,
+            Raised::MasterLost => B::MasterLost,
+            Raised::MasterBack => B::MasterBack,
+        };
+        self.unit = self.line.active().unit_id;
+        self.monitor.raise_fieldbus(event);
+        self.drain();
+    }
+
+    /// After a request for this node (`addressed`) or a broadcast was handled: the
+    /// master is back, a change is confirmed (and kept, as a commit is).
+    pub(super) fn line_request(&mut self, addressed: bool) {
+        let (confirmed, raised) = self.line.request(addressed);
+        if confirmed {
+            self.commissioning.switched();
+        }
+        self.raise(raised);
+    }
+
+    /// The answer was sent (or none is due): a committed change takes effect.
+    pub(super) fn line_sent(&mut self) {
+        if self.line.sent() {
+            self.unit = self.line.active().unit_id;
+        }
     }
 
     /// The monitor's queued events into the window (unless the application takes

@@ -7,7 +7,9 @@ use super::map::{EventField, Field, SlotBlock};
 use super::state::{Core, Counters};
 use crate::Estimator;
 use crate::monitor::annunciation::AlarmSet;
-use crate::monitor::{Channel, Event, EventKind, FaultCause, Reading, RiskState, Sample};
+use crate::monitor::{
+    Channel, Event, EventKind, FaultCause, FieldbusEvent, Reading, RiskState, Sample,
+};
 use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 use core::fmt;
 
@@ -124,6 +126,9 @@ const fn event_kind_code(kind: &EventKind) -> u32 {
         EventKind::Approaching { .. } => 2,
         EventKind::Friction { changed: true, .. } => 3,
         EventKind::Friction { changed: false, .. } => 4,
+        EventKind::Fieldbus(FieldbusEvent::LineReverted) => 5,
+        EventKind::Fieldbus(FieldbusEvent::MasterLost) => 6,
+        EventKind::Fieldbus(FieldbusEvent::MasterBack) => 7,
     }
 }
 
@@ -148,7 +153,7 @@ fn event_value(e: &Event, field: EventField) -> u32 {
         EventField::Value => match e.kind {
             EventKind::Approaching { time_to_critical_s } => time_to_critical_s.to_bits(),
             EventKind::Friction { mu, .. } => mu.to_bits(),
-            EventKind::StateChange { .. } => NONE,
+            EventKind::StateChange { .. } | EventKind::Fieldbus(_) => NONE,
         },
         EventField::Load => r.load.to_bits(),
         EventField::Phi => r.phi.to_bits(),
@@ -213,6 +218,9 @@ pub fn event_from_registers(regs: &[u16]) -> Result<Option<Event>, DecodeError> 
             mu: f32_at(11),
             changed: r[7] == 3,
         },
+        5 => EventKind::Fieldbus(FieldbusEvent::LineReverted),
+        6 => EventKind::Fieldbus(FieldbusEvent::MasterLost),
+        7 => EventKind::Fieldbus(FieldbusEvent::MasterBack),
         _ => return Err(DecodeError::Code),
     };
     Ok(Some(Event {
@@ -273,6 +281,13 @@ impl<E: Estimator> Core<E> {
             RiskState::Microslip => ne107::MAINTENANCE_REQUIRED,
             _ if a.active().contains(AlarmSet::APPROACHING) => ne107::MAINTENANCE_REQUIRED,
             _ => ne107::GOOD,
+        };
+        // A lost master: out of specification (docs/modbus.md, Line settings), unless
+        // the monitor's own category is graver.
+        let category = if self.line.master_lost() {
+            category.max(ne107::OUT_OF_SPECIFICATION)
+        } else {
+            category
         };
         state.index() as u32 | category << 8 | u32::from(a.unacknowledged().bits()) << 12
     }
@@ -413,6 +428,14 @@ impl<E: Estimator> Core<E> {
             // copy of the commissioning registers' reading, not two.
             Field::Commission(_) | Field::Staged(_) => 0,
             Field::Active(f) => super::config::active(f, self.monitor.config()),
+            Field::LineStaged(f) => self.line.staged_value(f),
+            Field::LineActive(f) => self.line.active().get(f),
+            Field::LineConfirmWindow => u32::from(super::line::LINE_CONFIRM_WINDOW_S),
+            Field::LineReverts => self.line.reverts(),
+            Field::LineStatus => {
+                u32::from(self.line.master_lost()) | u32::from(self.line.confirm_left_ms() > 0) << 1
+            }
+            Field::LineConfirmLeft => div1000(self.line.confirm_left_ms().saturating_add(999)),
         }
     }
 

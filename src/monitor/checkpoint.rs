@@ -21,8 +21,9 @@ use super::risk::Alarm;
 use super::state::Saved;
 use super::trend::TrendInterval;
 use super::{
-    Channel, Config, Event, EventKind, FaultCause, FaultCounts, FrictionConfig, FrictionStatus,
-    MonitorState, Reading, RiskState, SpikeFilter, Statistics, Thresholds, TrendConfig, TrendPoint,
+    Channel, Config, Event, EventKind, FaultCause, FaultCounts, FieldbusEvent, FrictionConfig,
+    FrictionStatus, MonitorState, Reading, RiskState, SpikeFilter, Statistics, Thresholds,
+    TrendConfig, TrendPoint,
 };
 use crate::sensor_fault::{FaultKind, SensorFault, SensorId};
 use crate::storage::{Checkpoint, CodecError, Reader, Writer, kind};
@@ -213,6 +214,15 @@ fn put_kind(w: &mut Writer<'_>, k: &EventKind) -> Result<(), CodecError> {
             w.bool(changed)?;
             put_zeros(w, 3)
         }
+        EventKind::Fieldbus(e) => {
+            w.u8(3)?;
+            w.u8(match e {
+                FieldbusEvent::LineReverted => 0,
+                FieldbusEvent::MasterLost => 1,
+                FieldbusEvent::MasterBack => 2,
+            })?;
+            put_zeros(w, 7)
+        }
     }
 }
 
@@ -241,6 +251,16 @@ fn get_kind(r: &mut Reader<'_>) -> Result<EventKind, CodecError> {
             let changed = r.bool()?;
             get_zeros(r, 3)?;
             EventKind::Friction { mu, changed }
+        }
+        3 => {
+            let e = match r.u8()? {
+                0 => FieldbusEvent::LineReverted,
+                1 => FieldbusEvent::MasterLost,
+                2 => FieldbusEvent::MasterBack,
+                _ => return Err(INVALID),
+            };
+            get_zeros(r, 7)?;
+            EventKind::Fieldbus(e)
         }
         _ => return Err(INVALID),
     };

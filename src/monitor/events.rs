@@ -109,6 +109,35 @@ pub enum EventKind {
         /// Whether the change is raised (false: cleared).
         changed: bool,
     },
+    /// The node's fieldbus link, not the machine: raised by the application's
+    /// fieldbus server ([`Monitor::raise_fieldbus`](super::Monitor::raise_fieldbus)),
+    /// numbered and kept with the monitor's own events; its reading is the monitor's
+    /// last.
+    Fieldbus(FieldbusEvent),
+}
+
+/// What happened on the fieldbus link ([`EventKind::Fieldbus`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FieldbusEvent {
+    /// A change of the line settings went back to the settings before it: no master
+    /// confirmed it within its window.
+    LineReverted,
+    /// No request for this node within the bus timeout: the master is lost.
+    MasterLost,
+    /// A request for this node came after the master was lost.
+    MasterBack,
+}
+
+impl FieldbusEvent {
+    /// Its name in an events file (the monitor example's `--events` kind column).
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            FieldbusEvent::LineReverted => "line_reverted",
+            FieldbusEvent::MasterLost => "master_lost",
+            FieldbusEvent::MasterBack => "master_back",
+        }
+    }
 }
 
 /// One event. Sequence numbers are consecutive from 0, so a consumer sees a dropped

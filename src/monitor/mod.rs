@@ -120,7 +120,7 @@ pub use config::{
     TREND_SLOPE_STANDARD_ERRORS, Thresholds, TrendConfig,
 };
 pub use energy::dissipated_power;
-pub use events::{EVENT_CAPACITY, Event, EventKind, FaultCause, Reading};
+pub use events::{EVENT_CAPACITY, Event, EventKind, FaultCause, FieldbusEvent, Reading};
 pub use friction::FrictionStatus;
 pub use model::model_for_range;
 pub use risk::RiskState;
@@ -339,6 +339,14 @@ impl<E: Estimator> Monitor<E> {
     /// ([`Statistics::events_dropped`]).
     pub fn next_event_seq(&self) -> u32 {
         self.events.next_seq
+    }
+
+    /// Raises an event of the node's fieldbus link (its server's: a reverted line
+    /// change, the master lost or back), numbered after the monitor's own, at the last
+    /// sample's time (0 before any) with the last reading.
+    pub fn raise_fieldbus(&mut self, event: FieldbusEvent) {
+        let time_ms = self.clock.last_time_ms.unwrap_or(0);
+        self.emit(EventKind::Fieldbus(event), time_ms);
     }
 
     fn emit(&mut self, kind: EventKind, time_ms: u32) {

@@ -260,6 +260,8 @@ fn event(e: &misalign::monitor::Event) -> Event {
             "None".into(),
             None,
         ),
+        // Raised by a fieldbus server only: never in the logged node.
+        EventKind::Fieldbus(f) => (f.as_str(), "-", "-", "None".into(), None),
     };
     let r = &e.reading;
     Event {

@@ -70,6 +70,8 @@ pub fn event_record(e: &Event) -> EventRecord {
             None,
             None,
         ),
+        // The link's, not the machine's: no reading of its own.
+        EventKind::Fieldbus(f) => (String::new(), "", f.as_str(), String::new(), None, None),
     };
     EventRecord {
         t: e.elapsed_ms as f64 / 1e3,

@@ -93,5 +93,7 @@ fn log(event: &Event) {
             mu,
             changed
         ),
+        // Not raised: no fieldbus server here.
+        EventKind::Fieldbus(_) => {}
     }
 }

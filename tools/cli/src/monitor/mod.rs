@@ -121,6 +121,7 @@ fn event_line(e: &Event) -> String {
             let what = if changed { "changed" } else { "back in band" };
             format!("friction {what}: mu {mu:.3}")
         }
+        EventKind::Fieldbus(f) => format!("fieldbus: {}", f.as_str()),
     };
     format!(
         "{:>9.1} s  #{:<3} {what:<42} d/b {:.3}  F {:.1} N  P {:.0} N  phi {:.3} mrad  phi0 {} mrad  margin {} mrad",

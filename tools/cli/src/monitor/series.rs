@@ -179,7 +179,9 @@ impl Timeline {
         let bin = self.bin(elapsed_ms);
         let slot = match kind {
             EventKind::StateChange { .. } => &mut bin.state_change,
-            EventKind::Approaching { .. } | EventKind::Friction { .. } => &mut bin.alert,
+            EventKind::Approaching { .. } | EventKind::Friction { .. } | EventKind::Fieldbus(_) => {
+                &mut bin.alert
+            }
         };
         slot.get_or_insert(t);
     }
