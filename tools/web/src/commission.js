@@ -70,17 +70,31 @@ export class Node {
   }
 
   /** Every value of `table` from `first` to `last` (addresses), decoded by the map:
-   * name -> {value, bits, text}. */
+   * name -> {value, bits, text}. Read in runs of registers the map holds without a
+   * gap (a node refuses an address its map leaves out), at most 125 a request. */
   async block(table, first, last) {
-    const words = await this.c.readRegisters(table === 'input' ? 4 : 3, first, last - first, `read ${table} ${first}-${last - 1}`);
+    const fn = table === 'input' ? 4 : 3;
+    const entries = this.map.entries
+      .filter((e) => e.table === table && e.address >= first && e.address + wordsOf(e.type) <= last)
+      .sort((a, b) => a.address - b.address);
+    const runs = [];
+    for (const e of entries) {
+      const run = runs[runs.length - 1];
+      const end = e.address + wordsOf(e.type);
+      if (run && e.address <= run.end && end - run.start <= 125) run.end = Math.max(run.end, end);
+      else runs.push({ start: e.address, end });
+    }
     const out = new Map();
-    for (const e of this.map.entries) {
-      if (e.table !== table || e.address < first || e.address + wordsOf(e.type) > last) continue;
-      const w = words.slice(e.address - first, e.address - first + wordsOf(e.type));
-      const d = decode(e, w);
-      d.text = this.text(e, d);
-      d.words = w;
-      out.set(e.name, d);
+    for (const run of runs) {
+      const words = await this.c.readRegisters(fn, run.start, run.end - run.start, `read ${table} ${run.start}-${run.end - 1}`);
+      for (const e of entries) {
+        if (e.address < run.start || e.address + wordsOf(e.type) > run.end) continue;
+        const w = words.slice(e.address - run.start, e.address - run.start + wordsOf(e.type));
+        const d = decode(e, w);
+        d.text = this.text(e, d);
+        d.words = w;
+        out.set(e.name, d);
+      }
     }
     return out;
   }
