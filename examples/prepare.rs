@@ -10,35 +10,10 @@
 //!
 //! Prints the bytes in hex (and a Rust array with `--rust`); `--out` writes them raw.
 
-use clap::{Parser, ValueEnum};
+use clap::Parser;
 use misalign::Scene;
-use misalign::fixed::{FixedAuto, FixedEllipticScene, FixedLineScene};
-use misalign::float::{Auto, EllipticScene, LineScene};
-use misalign::reference::ModelChoice;
+use misalign_cli::prepare::{self, Choice, Options, SceneType};
 use std::process::ExitCode;
-
-#[derive(Clone, Copy, ValueEnum)]
-enum Type {
-    /// `fixed::FixedEllipticScene` (Cortex-M0/M3)
-    FixedElliptic,
-    /// `fixed::FixedLineScene`
-    FixedLine,
-    /// `fixed::FixedAuto` (section 9's choice, or `--choice`)
-    FixedAuto,
-    /// `float::EllipticScene` (FPU; the node names its tables)
-    Elliptic,
-    /// `float::LineScene`
-    Line,
-    /// `float::Auto`
-    Auto,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum Choice {
-    Section9,
-    Elliptic,
-    Line,
-}
 
 /// Prepare a scene on the host and write it as bytes for the node (`from_bytes`).
 #[derive(Parser)]
@@ -55,7 +30,7 @@ struct Args {
     mu: f64,
     /// The prepared scene type the node loads.
     #[arg(long, value_enum, default_value = "fixed-elliptic")]
-    r#type: Type,
+    r#type: SceneType,
     /// Roller contact length (m), for section 9's choice and line contact's total load.
     #[arg(long)]
     length: Option<f64>,
@@ -63,10 +38,10 @@ struct Args {
     #[arg(long, value_enum, default_value = "section9")]
     choice: Choice,
     /// The fixed-point core's load LSB (N per count).
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = Options::default().load_lsb)]
     load_lsb: f64,
     /// The fixed-point core's angle LSB (rad per count).
-    #[arg(long, default_value_t = 1e-11)]
+    #[arg(long, default_value_t = Options::default().angle_lsb)]
     angle_lsb: f64,
     /// The d/b threshold of the risk flag.
     #[arg(long)]
@@ -109,39 +84,12 @@ fn prepare(args: &Args) -> Result<Vec<u8>, misalign::Error> {
     if let Some(l) = args.length {
         scene = scene.with_length(l)?;
     }
-    let choice = match args.choice {
-        Choice::Section9 => ModelChoice::Section9,
-        Choice::Elliptic => ModelChoice::Elliptic,
-        Choice::Line => ModelChoice::Line,
+    let options = Options {
+        scene_type: args.r#type,
+        choice: args.choice,
+        load_lsb: args.load_lsb,
+        angle_lsb: args.angle_lsb,
+        risk: args.risk,
     };
-    let risk = args
-        .risk
-        .unwrap_or(misalign::estimator::DEFAULT_RISK_SLIP_RATIO);
-    let (p, a) = (args.load_lsb, args.angle_lsb);
-    Ok(match args.r#type {
-        Type::FixedElliptic => FixedEllipticScene::new(&scene, p, a)?
-            .with_risk_slip_ratio(risk)?
-            .to_bytes()
-            .to_vec(),
-        Type::FixedLine => FixedLineScene::new(&scene, p, a)?
-            .with_risk_slip_ratio(risk)?
-            .to_bytes()
-            .to_vec(),
-        Type::FixedAuto => FixedAuto::with_choice(&scene, p, a, choice)?
-            .with_risk_slip_ratio(risk)?
-            .to_bytes()
-            .to_vec(),
-        Type::Elliptic => EllipticScene::new(&scene)?
-            .with_risk_slip_ratio(risk)?
-            .to_bytes()
-            .to_vec(),
-        Type::Line => LineScene::new(&scene)?
-            .with_risk_slip_ratio(risk)?
-            .to_bytes()
-            .to_vec(),
-        Type::Auto => Auto::with_choice(&scene, choice)?
-            .with_risk_slip_ratio(risk)?
-            .to_bytes()
-            .to_vec(),
-    })
+    prepare::prepared(&scene, &options)
 }

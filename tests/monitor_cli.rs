@@ -240,6 +240,35 @@ fn the_replay_goes_on_past_bad_rows() {
     assert_eq!(faults, "2", "{out}");
 }
 
+/// `--model reference` replays on the f64 reference: over the built-in scenario the
+/// f32 core (within 2.4e-7 of it) raises the same events at the same times, and the
+/// readings they carry agree to the core's error.
+#[test]
+fn the_reference_replay_is_the_cores_events_without_their_rounding() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("monitor_cli");
+    std::fs::create_dir_all(&dir).unwrap();
+    let events = |model: &str| {
+        let path = dir.join(format!("events-{model}.csv"));
+        let (code, _, err) = monitor(&["--model", model, "--events", path.to_str().unwrap()]);
+        assert_eq!(code, 0, "{err}");
+        std::fs::read_to_string(path).unwrap()
+    };
+    let (reference, core) = (events("reference"), events("f32"));
+    assert!(reference.lines().count() > 10, "{reference}");
+    assert_eq!(reference.lines().count(), core.lines().count());
+    for (r, c) in reference.lines().zip(core.lines()).skip(1) {
+        let (r, c): (Vec<&str>, Vec<&str>) = (r.split(',').collect(), c.split(',').collect());
+        // t, seq, state, from, kind, fault and time_ms: the same.
+        assert_eq!((&r[..6], r[13]), (&c[..6], c[13]));
+        // d/b (column s): the core's error, 2.4e-7 relative, on a monitor's reading.
+        let s = |row: &[&str]| row[8].parse::<f64>().unwrap_or(0.0);
+        assert!(
+            (s(&r) - s(&c)).abs() <= 1e-6 * s(&r).abs().max(1e-3),
+            "{r:?} {c:?}"
+        );
+    }
+}
+
 /// A trace in ns is refused before the replay, naming the row and the unit.
 #[test]
 fn a_trace_in_ns_is_refused_before_the_replay() {

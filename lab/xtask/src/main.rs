@@ -25,6 +25,7 @@ mod tools;
 mod trace;
 #[cfg(test)]
 mod tracked;
+mod web;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -135,6 +136,9 @@ enum Task {
     /// The Raspberry Pi Pico node in an emulator of its chip (rp2040js, lab/pico), its
     /// sensors simulated at the pins: the checks, --serve, --trace, --uf2, --measure.
     Pico(pico::Args),
+    /// The web console (tools/web): build it; or serve it, run its browser tests,
+    /// measure its download, start and replay rate.
+    Web(web::Args),
 }
 
 fn root() -> PathBuf {
@@ -178,6 +182,7 @@ fn main() -> ExitCode {
         Task::Modbus(args) => modbus::run(&args),
         Task::Docs(args) => docs::run(&args),
         Task::Pico(args) => pico::run(&args),
+        Task::Web(args) => web::run(&args),
     }
 }
 

@@ -13,8 +13,11 @@ pub mod bench;
 pub mod firmware;
 pub mod shapes;
 pub mod sweep;
+pub mod web;
 
-use crate::records::{self, AccuracyRow, BenchRow, NodeRow, PicoRow, ShapeRow, SizeRow, SweepRow};
+use crate::records::{
+    self, AccuracyRow, BenchRow, NodeRow, PicoRow, ShapeRow, SizeRow, SweepRow, WebRow,
+};
 use bench::find;
 use misalign_workload::{Model, Operation};
 use std::fmt::Write as _;
@@ -40,6 +43,7 @@ fn blocks() -> Result<Vec<Block>, String> {
     let nodes = records::read::<NodeRow>()?;
     let accuracy = records::read::<AccuracyRow>()?;
     let pico = records::read::<PicoRow>()?;
+    let web = records::read::<WebRow>()?;
     let block = |file, name, text| Block { file, name, text };
     Ok(vec![
         block(README, "headline", headline(&bench, &accuracy)),
@@ -60,6 +64,7 @@ fn blocks() -> Result<Vec<Block>, String> {
         block(PAGE, "firmware", sizes_block(&sizes)),
         block(PAGE, "node", node(&nodes)),
         block(PAGE, "pico", pico_table(&pico)),
+        block(PAGE, "web", web::table(&web)?),
     ])
 }
 

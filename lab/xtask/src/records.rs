@@ -347,6 +347,20 @@ record! {
     }
 }
 
+record! {
+    /// docs/web.csv (`cargo xtask web --measure`): one measured quantity of the web
+    /// console (tools/web).
+    WebRow in "web.csv" {
+        /// `download_wasm_gzip`, `download_script_gzip`, `ready`, `replay_rows`,
+        /// `replay_page`, `replay_example`, `replay_longest_pause`,
+        /// `idle_longest_pause`.
+        quantity: String = "quantity",
+        value: f64 = "value",
+        /// `B`, `ms`, `rows`, `rows/s`.
+        unit: String = "unit",
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,5 +13,8 @@ pub mod estimate;
 pub mod monitor;
 pub mod monitor_input;
 pub mod monitor_output;
+pub mod prepare;
+pub mod reference_core;
+pub mod replay;
 pub mod svg;
 pub mod table;

@@ -128,6 +128,35 @@ pub fn events_csv(events: &[Event]) -> String {
     out
 }
 
+/// The `--events` file written as the events happen: the header first, then a line
+/// per event.
+#[derive(Debug)]
+pub struct EventsWriter<W: std::io::Write>(W);
+
+impl<W: std::io::Write> EventsWriter<W> {
+    /// The file with its header.
+    ///
+    /// # Errors
+    /// The writer's.
+    pub fn new(mut out: W) -> std::io::Result<Self> {
+        writeln!(out, "{EVENTS_HEADER}")?;
+        Ok(EventsWriter(out))
+    }
+
+    /// One event's line.
+    ///
+    /// # Errors
+    /// The writer's.
+    pub fn event(&mut self, e: &Event) -> std::io::Result<()> {
+        writeln!(self.0, "{}", event_row(e))
+    }
+
+    /// The writer, the file complete.
+    pub fn into_inner(self) -> W {
+        self.0
+    }
+}
+
 /// The misalignment (rad) at which d/b reaches `target` at `load`, by bisection
 /// (d/b grows with |phi|); `None` if it does not below `hi`.
 pub fn angle_for_slip_ratio<E: Estimator>(

@@ -18,14 +18,17 @@ pub fn number(name: &str, field: &[u8]) -> Result<f64, String> {
     let x: f64 = text
         .parse()
         .map_err(|_| format!("{name}: not a number: {text:?}"))?;
-    let mantissa = text.split(['e', 'E']).next().unwrap_or("");
-    let literal_inf = mantissa.to_ascii_lowercase().contains("inf");
-    if x.is_infinite() && !literal_inf {
+    // Asked only of an infinity or a zero: the common number costs no more.
+    let mantissa = || text.split(['e', 'E']).next().unwrap_or("");
+    // An infinity written as one (`inf`, `-Infinity`) is a number; one from overflow
+    // is not.
+    let literal_inf = || mantissa().to_ascii_lowercase().contains("inf");
+    if x.is_infinite() && !literal_inf() {
         return Err(format!(
             "{name} = {text} is outside the range of f64 numbers (|x| <= 1.8e308)"
         ));
     }
-    if x == 0.0 && mantissa.bytes().any(|b| (b'1'..=b'9').contains(&b)) {
+    if x == 0.0 && mantissa().bytes().any(|b| (b'1'..=b'9').contains(&b)) {
         return Err(format!(
             "{name} = {text} is below the smallest f64 number (4.9e-324)"
         ));

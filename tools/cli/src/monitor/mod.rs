@@ -15,15 +15,13 @@
 mod plot;
 pub mod series;
 
-use crate::monitor_input::{self as input, Trace};
-use crate::monitor_output as output;
+use crate::monitor_input as input;
+use crate::monitor_output::{self as output, EventsWriter};
+use crate::replay::{self, Model, Replay, Samples, Survey};
 use crate::table;
-use clap::{Parser, ValueEnum};
-use misalign::Estimator;
-use misalign::fixed::FixedAuto;
-use misalign::float::Auto;
-use misalign::monitor::{Config, Event, EventKind, Monitor, RiskState, Sample, scenario};
-use series::{Decimated, Quantile, Timeline};
+use clap::Parser;
+use misalign::monitor::{Event, EventKind, RiskState, scenario};
+use series::{Decimated, Timeline};
 use std::error::Error;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Write};
@@ -68,7 +66,8 @@ struct Args {
     /// G = 79.3 GPa, nu = 0.3, mu = 0.3).
     #[arg(long, value_name = "FILE.csv")]
     scene: Option<PathBuf>,
-    /// The estimator core: f32 (Cortex-M4F) or fixed (Cortex-M0/M3).
+    /// The estimator core: f32 (Cortex-M4F), fixed (Cortex-M0/M3), or the f64
+    /// reference (the PC only: the events of the physics without a core's rounding).
     #[arg(long, value_enum, default_value_t = Model::F32)]
     model: Model,
     /// Writes every event as a CSV row (t,seq,state,...).
@@ -83,14 +82,6 @@ struct Args {
     /// figure is written beside the plot as *-thresholds.svg).
     #[arg(long, value_name = "OUT.csv")]
     thresholds: Option<PathBuf>,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
-enum Model {
-    /// The f32 core, model chosen for the operating range (section 9).
-    F32,
-    /// The fixed-point core.
-    Fixed,
 }
 
 /// stdout closed (`| head`): the run ends quietly.
@@ -145,84 +136,36 @@ fn event_line(e: &Event) -> String {
     )
 }
 
-/// The samples of a run: the built-in scenario or a trace, read from its start.
-enum Samples {
-    Builtin(scenario::Scenario),
-    Trace(Box<Trace<BufReader<File>>>),
-}
-
-impl Samples {
-    fn open(trace: Option<&Path>) -> Res<Samples> {
-        Ok(match trace {
-            None => Samples::Builtin(scenario::Scenario::new()),
-            Some(path) => {
-                let file = File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
-                let trace = Trace::new(BufReader::new(file))
-                    .map_err(|e| format!("{}: {e}", path.display()))?;
-                Samples::Trace(Box::new(trace))
-            }
-        })
-    }
-}
-
-impl Iterator for Samples {
-    type Item = Result<Sample, String>;
-
-    fn next(&mut self) -> Option<Self::Item> {
-        match self {
-            Samples::Builtin(s) => s.next().map(Ok),
-            Samples::Trace(t) => t.next(),
+/// The samples of a run: the built-in scenario or `trace`, read from its start.
+fn open(trace: Option<&Path>) -> Res<Samples<BufReader<File>>> {
+    Ok(match trace {
+        None => Samples::builtin(),
+        Some(path) => {
+            let file = File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            Samples::trace(BufReader::new(file)).map_err(|e| format!("{}: {e}", path.display()))?
         }
-    }
+    })
 }
 
-/// What the first pass learns: how many samples, the largest finite load (N, at least
-/// the scenario's), and the first pass of the loads' 99.9th percentile.
-struct Survey {
-    total: u64,
-    load_max: f64,
-    loads: Option<Quantile>,
-}
-
+/// The first pass (`replay::Survey`), the trace's errors naming its file.
 fn survey(args: &Args, err: &mut dyn Write) -> Res<Survey> {
-    let mut samples = Samples::open(args.trace.as_deref())?;
-    if let Samples::Trace(t) = &samples
-        && t.delimiter() == b';'
-    {
+    let samples = open(args.trace.as_deref())?;
+    if samples.as_trace().is_some_and(|t| t.delimiter() == b';') {
         let _ = writeln!(err, "monitor: trace: {}", table::SEMICOLON_NOTE);
     }
-    let mut s = Survey {
-        total: 0,
-        load_max: scenario::LOAD_MAX,
-        loads: args.thresholds.as_ref().map(|_| Quantile::default()),
-    };
     let at = |e: String| match &args.trace {
         Some(path) => format!("{}: {e}", path.display()),
         None => e,
     };
-    for sample in &mut samples {
-        let load = sample.map_err(at)?.load;
-        s.total += 1;
-        if load.is_finite() {
-            s.load_max = s.load_max.max(f64::from(load));
-            if let Some(q) = &mut s.loads {
-                q.count(load);
-            }
-        }
-    }
-    Ok(s)
+    Ok(Survey::of(samples, args.thresholds.is_some()).map_err(at)?)
 }
-
-/// How a monitor takes a sample: `Monitor::process_with_friction` on the f32 core
-/// (mu from a measured F), `Monitor::process` on the fixed-point core (no inverse).
-type Step<E> = fn(&mut Monitor<E>, Sample) -> RiskState;
 
 fn hms(ms: u64) -> String {
     let s = ms / 1000;
     format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
 }
 
-fn summary<E: Estimator>(out: &mut dyn Write, m: &Monitor<E>) -> Res<()> {
+fn summary(out: &mut dyn Write, m: &Replay) -> Res<()> {
     let s = m.statistics();
     let total_ms: u64 = RiskState::ALL
         .iter()
@@ -317,80 +260,84 @@ struct Io<'a> {
     progress: bool,
 }
 
-fn replay<E: Estimator + Copy>(
-    core: E,
-    step: Step<E>,
-    args: &Args,
-    mut survey: Survey,
-    io: &mut Io<'_>,
-) -> Res<()> {
-    let config = Config::default();
-    let mut monitor = Monitor::new(core, config).map_err(|e| format!("configuration: {e}"))?;
-    let builtin = args.trace.is_none();
-    if builtin {
+/// The example's side of the second pass: each event printed, written to `--events`
+/// and marked on the timeline; each sample on the timeline; the progress bar.
+struct Output<'a, 'b> {
+    io: &'a mut Io<'b>,
+    events: Option<EventsWriter<BufWriter<File>>>,
+    timeline: Timeline,
+    operating: Decimated<(f32, f32)>,
+    /// Samples in the trace and done, the last percentage drawn; `None`: no bar.
+    progress: Option<(u64, u64, u64)>,
+}
+
+impl replay::Sink for Output<'_, '_> {
+    fn event(&mut self, e: &Event) -> Res<()> {
+        say!(self.io.out, "{}", event_line(e));
+        if let Some(w) = &mut self.events {
+            w.event(e)?;
+        }
+        self.timeline.event(e.elapsed_ms, &e.kind);
+        Ok(())
+    }
+
+    fn sample(&mut self, replay: &Replay, state: RiskState) -> Res<()> {
+        let reading = replay.reading();
+        if self.timeline.add(replay.elapsed_ms(), state, reading)
+            && let Some(r) = reading
+        {
+            self.operating.add((r.load, r.phi.abs()));
+        }
+        if let Some((total, done, last_percent)) = &mut self.progress {
+            *done += 1;
+            let percent = *done * 100 / (*total).max(1);
+            if percent != *last_percent {
+                *last_percent = percent;
+                let bar = "#".repeat(percent as usize / 4) + &" ".repeat(25 - percent as usize / 4);
+                let _ = write!(self.io.err, "\r[{bar}] {percent:>3} %");
+            }
+        }
+        Ok(())
+    }
+}
+
+fn run_replay(mut replay: Replay, args: &Args, total: u64, io: &mut Io<'_>) -> Res<()> {
+    if args.trace.is_none() {
         say!(
             io.out,
             "built-in scenario: one 8 h shift of a press roller pair (see misalign::monitor::scenario)"
         );
     }
     say!(io.out, "{:>9}    {:<4} {:<42}", "t", "seq", "event");
-    let mut events = match &args.events {
+    let events = match &args.events {
         Some(path) => {
-            let mut w =
-                BufWriter::new(File::create(path).map_err(|e| format!("{}: {e}", path.display()))?);
-            writeln!(w, "{}", output::EVENTS_HEADER)?;
-            Some(w)
+            let file = File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            Some(EventsWriter::new(BufWriter::new(file))?)
         }
         None => None,
     };
-    // The 99.9th percentile of the loads: the threshold planner's range, so that a
-    // spike does not stretch it.
-    let mut loads = survey
-        .loads
-        .take()
-        .and_then(|mut q| q.aim(|n| n * 999 / 1000).then_some(q));
-    let mut timeline = Timeline::new();
-    let mut operating = Decimated::default();
-    let progress = io.progress && survey.total >= 10_000;
-    let mut last_percent = u64::MAX;
-    let mut samples = Samples::open(args.trace.as_deref())?;
-    let mut i = 0u64;
-    for sample in &mut samples {
-        let sample = sample?;
-        if let Some(q) = &mut loads
-            && sample.load.is_finite()
-        {
-            q.refine(sample.load);
-        }
-        let state = step(&mut monitor, sample);
-        while let Some(e) = monitor.pop_event() {
-            say!(io.out, "{}", event_line(&e));
-            if let Some(w) = &mut events {
-                writeln!(w, "{}", output::event_row(&e))?;
-            }
-            timeline.event(e.elapsed_ms, &e.kind);
-        }
-        let reading = monitor.reading();
-        if timeline.add(monitor.elapsed_ms(), state, reading)
-            && let Some(r) = reading
-        {
-            operating.add((r.load, r.phi.abs()));
-        }
-        i += 1;
-        if progress {
-            let percent = i * 100 / survey.total.max(1);
-            if percent != last_percent {
-                last_percent = percent;
-                let bar = "#".repeat(percent as usize / 4) + &" ".repeat(25 - percent as usize / 4);
-                let _ = write!(io.err, "\r[{bar}] {percent:>3} %");
-            }
-        }
-    }
+    let progress = io.progress && total >= 10_000;
+    let mut samples = open(args.trace.as_deref())?;
+    let mut output = Output {
+        io,
+        events,
+        timeline: Timeline::new(),
+        operating: Decimated::default(),
+        progress: progress.then_some((total, 0, u64::MAX)),
+    };
+    replay::run(&mut replay, &mut samples, &mut output)?;
+    let Output {
+        io,
+        events,
+        timeline,
+        operating,
+        ..
+    } = output;
     if progress {
         let _ = writeln!(io.err);
     }
-    summary(io.out, &monitor)?;
-    if let Samples::Trace(t) = &samples {
+    summary(io.out, &replay)?;
+    if let Some(t) = samples.as_trace() {
         let (skipped, unreadable) = (t.skipped(), t.unreadable());
         say!(
             io.out,
@@ -408,7 +355,10 @@ fn replay<E: Estimator + Copy>(
         }
     }
     if let (Some(w), Some(path)) = (events, &args.events) {
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        w.into_inner()
+            .into_inner()
+            .map_err(|e| e.into_error())?
+            .sync_all()?;
         let _ = writeln!(io.err, "wrote {}", path.display());
     }
     if let Some(path) = &args.plot {
@@ -419,12 +369,13 @@ fn replay<E: Estimator + Copy>(
             ),
             None => "the built-in 8 h scenario".to_string(),
         };
-        plot::timeline(path, &timeline, &config.thresholds, &source)?;
+        plot::timeline(path, &timeline, &replay.config().thresholds, &source)?;
         let _ = writeln!(io.err, "wrote {}", path.display());
     }
     if let Some(path) = &args.thresholds {
-        let range = output::PlanRange::Trace(loads.as_ref().and_then(Quantile::value));
-        let plan = output::threshold_plan(&core, &config, range)
+        let plan = replay
+            .thresholds()
+            .ok_or("--thresholds: the loads were not counted")?
             .map_err(|e| format!("--thresholds: {e}"))?;
         if let Some(note) = &plan.note {
             let _ = writeln!(io.err, "monitor: --thresholds: {note}");
@@ -461,26 +412,11 @@ fn run_parsed(args: &Args, io: &mut Io<'_>) -> Res<()> {
         }
         None => scenario::scene()?,
     };
-    let survey = survey(args, io.err)?;
+    let mut survey = survey(args, io.err)?;
     // One model for the trace's operating range (section 9, decided once), as the
     // node builds it for the built-in scenario.
-    let load_max = survey.load_max;
-    match args.model {
-        Model::F32 => replay(
-            scenario::estimator_for::<Auto>(&scene, load_max)?,
-            Monitor::process_with_friction,
-            args,
-            survey,
-            io,
-        ),
-        Model::Fixed => replay(
-            scenario::estimator_for::<FixedAuto>(&scene, load_max)?,
-            Monitor::process,
-            args,
-            survey,
-            io,
-        ),
-    }
+    let replay = Replay::new(args.model, &scene, &mut survey)?;
+    run_replay(replay, args, survey.total, io)
 }
 
 /// Runs the monitor example with `args` (without the program's name): the log to

@@ -2,7 +2,7 @@
 //! trace: the timeline in at most [`2 * COLUMNS`](COLUMNS) time bins, each holding
 //! every curve's minimum and maximum (with their times, so that a one-sample spike is
 //! drawn) and whether an event fell in it; the operating points (P, |phi|) evenly
-//! decimated to at most [`MAX_SCATTER`]; a load quantile from two fixed histograms.
+//! decimated to at most [`MAX_SCATTER`].
 
 use misalign::monitor::{EventKind, Reading, RiskState};
 
@@ -269,87 +269,6 @@ impl<T> Decimated<T> {
     }
 }
 
-/// An order statistic of f32 values (the same as sorting them by `total_cmp` and
-/// taking one) in two passes over them and fixed memory: the first counts the values
-/// by the high 16 bits of their order key, the second, within the bin that holds the
-/// wanted rank, by the low 16.
-#[derive(Debug, Clone)]
-pub struct Quantile {
-    high: Vec<u64>,
-    low: Vec<u64>,
-    count: u64,
-    /// After the first pass: the wanted high bits and the rank within them.
-    target: Option<(u32, u64)>,
-}
-
-/// A key whose unsigned order is `f32::total_cmp`'s.
-fn key(x: f32) -> u32 {
-    let b = x.to_bits();
-    if b >> 31 == 1 { !b } else { b | 1 << 31 }
-}
-
-fn from_key(k: u32) -> f32 {
-    f32::from_bits(if k >> 31 == 1 { k & !(1 << 31) } else { !k })
-}
-
-impl Default for Quantile {
-    fn default() -> Self {
-        Quantile {
-            high: vec![0; 1 << 16],
-            low: vec![0; 1 << 16],
-            count: 0,
-            target: None,
-        }
-    }
-}
-
-impl Quantile {
-    /// First pass: a value.
-    pub fn count(&mut self, x: f32) {
-        self.high[(key(x) >> 16) as usize] += 1;
-        self.count += 1;
-    }
-
-    /// Between the passes: the rank wanted, as `rank(n)` of the n values counted (0
-    /// the smallest). `false` when no value was counted.
-    pub fn aim(&mut self, rank: impl FnOnce(u64) -> u64) -> bool {
-        if self.count == 0 {
-            return false;
-        }
-        let mut r = rank(self.count).min(self.count - 1);
-        for (h, &n) in self.high.iter().enumerate() {
-            if r < n {
-                self.target = Some((h as u32, r));
-                return true;
-            }
-            r -= n;
-        }
-        false
-    }
-
-    /// Second pass: the same values again.
-    pub fn refine(&mut self, x: f32) {
-        let k = key(x);
-        if let Some((h, _)) = self.target
-            && k >> 16 == h
-        {
-            self.low[(k & 0xffff) as usize] += 1;
-        }
-    }
-
-    /// After the second pass: the value of the rank aimed at.
-    pub fn value(&self) -> Option<f32> {
-        let (h, mut r) = self.target?;
-        for (l, &n) in self.low.iter().enumerate() {
-            if r < n {
-                return Some(from_key(h << 16 | l as u32));
-            }
-            r -= n;
-        }
-        None
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -442,29 +361,5 @@ mod tests {
             let step = p[1] - p[0];
             assert!(p.windows(2).all(|w| w[1] - w[0] == step));
         }
-    }
-
-    #[test]
-    fn the_quantile_is_the_sorted_values_own() {
-        let values: Vec<f32> = (0..20_001)
-            .map(|i| ((i * 7919) % 20_001) as f32 * 0.37 - 100.0)
-            .chain([f32::MAX, -0.0, 0.0, 1e-42])
-            .collect();
-        let mut sorted = values.clone();
-        sorted.sort_by(f32::total_cmp);
-        for rank in [
-            |n: u64| n * 999 / 1000,
-            |_| 0,
-            |n: u64| n - 1,
-            |n: u64| n / 2,
-        ] {
-            let mut q = Quantile::default();
-            values.iter().for_each(|&x| q.count(x));
-            assert!(q.aim(rank));
-            values.iter().for_each(|&x| q.refine(x));
-            let want = sorted[rank(sorted.len() as u64) as usize];
-            assert_eq!(q.value().map(f32::to_bits), Some(want.to_bits()));
-        }
-        assert!(!Quantile::default().aim(|n| n));
     }
 }
