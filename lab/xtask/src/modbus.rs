@@ -459,7 +459,11 @@ fn tests(boards: bool, stored_only: bool) -> Result<(), String> {
     if failures.is_empty() {
         println!(
             "modbus: every test passed on every node{}",
-            if stored_only { " with flash" } else { " and the page" }
+            if stored_only {
+                " with flash"
+            } else {
+                " and the page"
+            }
         );
         return Ok(());
     }
