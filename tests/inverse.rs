@@ -675,7 +675,9 @@ mod properties {
             let r2 = if plane == 0 { f64::INFINITY } else { r2 };
             let s = Scene::new(r1, r2, g, nu, mu).unwrap();
             let s = if exact { s.with_theta_relation(misalign::ThetaRelation::Exact) } else { s };
-            if with_length { s.with_length(length).unwrap() } else { s }
+            // A length below the scene's shortest is refused (tests/model_choice.rs): such
+            // a draw takes the shortest, the boundary itself.
+            if with_length { s.with_length(length.max(s.shortest_length())).unwrap() } else { s }
         }
     }
 

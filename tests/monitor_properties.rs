@@ -160,6 +160,9 @@ fn check<E: Estimator>(core: E, config: Config, samples: &[Sample]) -> Result<()
                 EventKind::Friction { .. } => {
                     prop_assert!(false, "no friction without process_with_friction")
                 }
+                EventKind::Fieldbus(link) => {
+                    prop_assert!(false, "the link's {:?} raised by the monitor alone", link)
+                }
             }
         }
         prop_assert_eq!(changed, before != after, "every change has its event");
