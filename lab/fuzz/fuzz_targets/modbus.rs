@@ -104,37 +104,45 @@ fuzz_target!(|data: &[u8]| {
             }
         }
     }
-    // The server still answers: every register and bit of the map.
+    // The server still answers, at the unit id in force (the stream may have
+    // commissioned another): every register and bit of the map.
     s.idle();
     s.sent();
+    let unit = s.line().unit_id;
     for (function, table, chunk) in [
         (1u8, Table::Coil, 2000u16),
         (2, Table::Discrete, 2000),
         (4, Table::Input, 125),
         (3, Table::Holding, 125),
     ] {
-        let end = TableMap::of(table).end();
-        let mut address = 0;
-        while address < end {
-            let n = chunk.min(end - address);
-            let [a1, a0] = address.to_be_bytes();
-            let [n1, n0] = n.to_be_bytes();
-            let answer = send(&mut s, &[1, function, a1, a0, n1, n0]).expect("answered");
-            assert_eq!(answer[1], function, "{answer:02x?}");
-            if function == 4 && address == 0 {
-                let status = u16::from_be_bytes([answer[3], answer[4]]);
-                assert!(
-                    status & 0xFF <= 4 && (status >> 8) & 0xF <= 4,
-                    "{status:#06x}"
-                );
+        // Every address the map holds, run by run: the reserved run between two blocks
+        // is refused (exception 02), as the map says.
+        let map = TableMap::of(table);
+        let runs = core::iter::once((0, map.entries_end()))
+            .chain(map.blocks.iter().map(|b| (b.address, b.end())));
+        for (start, end) in runs {
+            let mut address = start;
+            while address < end {
+                let n = chunk.min(end - address);
+                let [a1, a0] = address.to_be_bytes();
+                let [n1, n0] = n.to_be_bytes();
+                let answer = send(&mut s, &[unit, function, a1, a0, n1, n0]).expect("answered");
+                assert_eq!(answer[1], function, "{answer:02x?}");
+                if function == 4 && address == 0 {
+                    let status = u16::from_be_bytes([answer[3], answer[4]]);
+                    assert!(
+                        status & 0xFF <= 4 && (status >> 8) & 0xF <= 4,
+                        "{status:#06x}"
+                    );
+                }
+                address += n;
             }
-            address += n;
         }
     }
     let slots = send(
         &mut s,
         &[
-            1,
+            unit,
             4,
             (EVENT_SLOTS_ADDRESS >> 8) as u8,
             EVENT_SLOTS_ADDRESS as u8,
