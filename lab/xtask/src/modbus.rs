@@ -964,7 +964,7 @@ pub(crate) mod host {
     }
 
     /// Every value of the map, read as the test reads the node: table by table, in
-    /// reads of at most [`READ_MAX`] from address 0 up; `read,table,address,value`.
+    /// reads of at most [`READ_MAX`] from address 0 up, around the reserved run; `read,table,address,value`.
     /// The server counts the reads (`bus_*`), and so does the node's: the same reads
     /// in the same order leave the same counts.
     fn dump<E: Estimator + PreparedScene>(core: E) -> Result<String, String> {
@@ -979,30 +979,34 @@ pub(crate) mod host {
         let mut out = String::from("read,table,address,value\n");
         let mut read = 0;
         for (table, function, name) in TABLES {
-            let end = TableMap::of(table).end();
-            let mut start = 0;
-            while start < end {
-                let n = READ_MAX.min(end - start);
-                let [a, b] = start.to_be_bytes();
-                let [c, d] = n.to_be_bytes();
-                let answer = request(&mut server, &[function, a, b, c, d]);
-                if answer.get(1) != Some(&function) {
-                    return Err(format!(
-                        "{name} {start}+{n}: the host's server answered {answer:02x?}"
-                    ));
+            // Run by run: the reserved run between two blocks is refused (exception 02).
+            let map = TableMap::of(table);
+            let runs = std::iter::once((0, map.entries_end()))
+                .chain(map.blocks.iter().map(|b| (b.address, b.end())));
+            for (mut start, end) in runs {
+                while start < end {
+                    let n = READ_MAX.min(end - start);
+                    let [a, b] = start.to_be_bytes();
+                    let [c, d] = n.to_be_bytes();
+                    let answer = request(&mut server, &[function, a, b, c, d]);
+                    if answer.get(1) != Some(&function) {
+                        return Err(format!(
+                            "{name} {start}+{n}: the host's server answered {answer:02x?}"
+                        ));
+                    }
+                    let data = &answer[3..answer.len() - 2];
+                    for k in 0..n {
+                        let value = if function <= 2 {
+                            u16::from(data[usize::from(k / 8)] >> (k % 8) & 1)
+                        } else {
+                            let i = usize::from(k) * 2;
+                            u16::from_be_bytes([data[i], data[i + 1]])
+                        };
+                        writeln!(out, "{read},{name},{},{value}", start + k).unwrap();
+                    }
+                    read += 1;
+                    start += n;
                 }
-                let data = &answer[3..answer.len() - 2];
-                for k in 0..n {
-                    let value = if function <= 2 {
-                        u16::from(data[usize::from(k / 8)] >> (k % 8) & 1)
-                    } else {
-                        let i = usize::from(k) * 2;
-                        u16::from_be_bytes([data[i], data[i + 1]])
-                    };
-                    writeln!(out, "{read},{name},{},{value}", start + k).unwrap();
-                }
-                read += 1;
-                start += n;
             }
         }
         Ok(out)
