@@ -1003,6 +1003,14 @@ impl TableMap {
             None => self.entries_end(),
         }
     }
+
+    /// The addresses the table holds, run by run in order: the single entries from 0,
+    /// then each block. A read within a run is answered; one that takes in the reserved
+    /// run between two blocks is refused (exception 02).
+    pub fn runs(&self) -> impl Iterator<Item = core::ops::Range<u16>> + '_ {
+        core::iter::once(0..self.entries_end())
+            .chain(self.blocks.iter().map(|b| b.address..b.end()))
+    }
 }
 
 // What the server reads and writes by: the tables above without their text.
@@ -1430,6 +1438,11 @@ mod tests {
                 assert!(l.word < l.entry.words());
             }
             assert!(s.locate(s.end).is_none());
+            // The runs hold every address but the reserved ones.
+            let held: std::vec::Vec<u16> = t.runs().flatten().collect();
+            let located: std::vec::Vec<u16> =
+                (0..s.end).filter(|&a| s.locate(a).is_some()).collect();
+            assert_eq!(held, located);
             // The bit tables: one entry a bit, in address order, without blocks (a read
             // of bits takes the entries from its start, `Core::read_bits`).
             if matches!(table, Table::Coil | Table::Discrete) {

@@ -115,13 +115,10 @@ fuzz_target!(|data: &[u8]| {
         (4, Table::Input, 125),
         (3, Table::Holding, 125),
     ] {
-        // Every address the map holds, run by run: the reserved run between two blocks
-        // is refused (exception 02), as the map says.
-        let map = TableMap::of(table);
-        let runs = core::iter::once((0, map.entries_end()))
-            .chain(map.blocks.iter().map(|b| (b.address, b.end())));
-        for (start, end) in runs {
-            let mut address = start;
+        // Every address the map holds, run by run (a read across the reserved run
+        // between two blocks is refused).
+        for run in TableMap::of(table).runs() {
+            let (mut address, end) = (run.start, run.end);
             while address < end {
                 let n = chunk.min(end - address);
                 let [a1, a0] = address.to_be_bytes();

@@ -979,11 +979,8 @@ pub(crate) mod host {
         let mut out = String::from("read,table,address,value\n");
         let mut read = 0;
         for (table, function, name) in TABLES {
-            // Run by run: the reserved run between two blocks is refused (exception 02).
-            let map = TableMap::of(table);
-            let runs = std::iter::once((0, map.entries_end()))
-                .chain(map.blocks.iter().map(|b| (b.address, b.end())));
-            for (mut start, end) in runs {
+            for run in TableMap::of(table).runs() {
+                let (mut start, end) = (run.start, run.end);
                 while start < end {
                     let n = READ_MAX.min(end - start);
                     let [a, b] = start.to_be_bytes();
