@@ -117,7 +117,7 @@ pub fn build() -> Result<PathBuf, String> {
 }
 
 /// The harness's packages (`npm ci` from its lock file, once).
-fn npm() -> Result<(), String> {
+pub(crate) fn npm() -> Result<(), String> {
     let lab = crate::root().join("lab/pico");
     let lock = std::fs::read_to_string(lab.join("package-lock.json")).map_err(|e| e.to_string())?;
     let stamp = lab.join("node_modules/.misalign-lock");
@@ -155,7 +155,7 @@ struct Row {
 /// shorter repeat is a steady value, read through the sensor's noise) (flags 1 load,
 /// 2 the probes, 4 and 8 the rails); an empty speed holds the last (the
 /// configuration's nominal speed before one).
-fn drive(samples: &[Sample]) -> Result<String, String> {
+pub(crate) fn drive(samples: &[Sample]) -> Result<String, String> {
     let cal = board::calibration().map_err(|e| format!("the node's calibration: {e}"))?;
     let volts_per_code = board::ADS1115_FULL_SCALE_V / 32768.0;
     let pulse_hz = |v: f32| {
@@ -232,7 +232,7 @@ fn drive(samples: &[Sample]) -> Result<String, String> {
 }
 
 /// The steady process of `--serve` and the checks: 2500 N, 2e-4 rad, 2 m/s.
-fn steady() -> Sample {
+pub(crate) fn steady() -> Sample {
     Sample::new(0, 2500.0, 2e-4).with_speed(2.0)
 }
 
