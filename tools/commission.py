@@ -655,9 +655,21 @@ def ask_raw(client, unit, at, timeout):
     if hasattr(port, "recv"):
         port.settimeout(0.02)
     try:
+        # A late answer to the unit asked before is not this one's.
+        if hasattr(port, "recv"):
+            while recv():
+                pass
+        else:
+            port.reset_input_buffer()
         send(body + crc16(body))
         deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
+        extended = False
+        while True:
+            if time.monotonic() >= deadline:
+                # The start of this unit's answer, late: the rest gets as long again.
+                if extended or not (got[:3] == bytes([unit, 3, 4]) and len(got) < 9):
+                    break
+                deadline, extended = time.monotonic() + timeout, True
             chunk = recv()
             if chunk is None:
                 break
