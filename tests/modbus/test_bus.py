@@ -325,7 +325,8 @@ def commit_baud(c, unit, baud):
 
 def test_a_change_never_confirmed_reverts_and_a_confirmed_one_survives_a_reset(bench):
     never, kept = "m0-2", "m4f-3"
-    c = client(bench)
+    # 5 s for an answer: a commit writes the node's flash first (the micro:bit's NVMC).
+    c = client(bench, timeout=5.0)
     window = read(c, UNITS[never], "line_confirm_window")
     reverts = read(c, UNITS[never], "line_reverts", "input")
     start = time.monotonic()
@@ -345,11 +346,8 @@ def test_a_change_never_confirmed_reverts_and_a_confirmed_one_survives_a_reset(b
         time.sleep(0.5)
     assert read(c, UNITS[kept], "active_baud") == 38400, "kept through the reset"
     assert read(c, UNITS[kept], "active_unit_id") == UNITS[kept]
-    # Back to 19200 for the rest, confirmed at once.
-    commit_baud(c, UNITS[kept], 19200)
-    bench.bus(f"set {kept} 19200 even")
+    # The master back at 19200 for the node that waits; this one stays at 38400.
     bench.bus("set master 19200 even")
-    assert read(c, UNITS[kept], "active_baud") == 19200
     # The node never asked at 57600 goes back by itself within its window. The master,
     # at 19200, has no answer from it meanwhile.
     assert Tally(c, tries=1).read(UNITS[never], holding("unit_id"), 1) is None
