@@ -69,6 +69,11 @@ impl Board for Bare {
 /// and reports "not commissioned": `ServerConfig::scene_required`), each monitored
 /// sample logged as a `sample` line.
 /// `None` if the monitor refuses its configuration.
+///
+/// The server and the storage are built once, where the node keeps them (each step
+/// out of line, so that no copy of them or of what built them stays on the stack
+/// while the node serves); the deepest stack is then the serving loop's frame and a
+/// request's or a checkpoint's calls, on top of these two.
 pub fn node<
     E: Estimator + PreparedScene,
     U: Read + ReadReady + Write,
@@ -78,60 +83,28 @@ pub fn node<
     core: E,
     model: &'static str,
     uart: &mut U,
-    mut clock: LineClock<T>,
+    clock: LineClock<T>,
     board: &mut B,
 ) -> Option<core::convert::Infallible> {
-    let monitor = match Monitor::new(core, Config::default()) {
-        Ok(m) => m,
-        Err(e) => {
-            defmt::error!("node: configuration refused: {}", e);
-            return None;
-        }
-    };
+    let mut server = server::<E, B>(core, model);
+    let server = server.as_mut()?;
     #[cfg(feature = "modbus-flash")]
-    let Some(mut persist) = crate::persist::Persist::open() else {
+    let mut persist = crate::persist::Persist::open();
+    #[cfg(feature = "modbus-flash")]
+    let Some(persist) = persist.as_mut() else {
         defmt::error!("node: the flash cannot be opened");
         return None;
     };
-    let config = ServerConfig {
-        external_samples: EXTERNAL_SAMPLES,
-        scene_required: B::SENSORS && !EXTERNAL_SAMPLES,
-        ident: Identification {
-            model_name: model,
-            ..Identification::default()
-        },
-        ..ServerConfig::default()
-    };
-    let mut server = match Server::new(monitor, config) {
-        Ok(s) => s,
-        Err(e) => {
-            defmt::error!("node: server configuration refused: {}", e);
-            return None;
-        }
-    };
-    // Commissioning takes scenes of the node's core type over the bus.
-    server.accept_scenes();
     // With flash (`modbus-flash`): the committed configuration, then the monitor's
     // last checkpoint under it.
     #[cfg(feature = "modbus-flash")]
-    {
-        let (source, restored) = persist.start(&mut server);
-        defmt::println!(
-            "storage: configuration from {}, state restored {=bool}, {=u64} samples monitored",
-            source,
-            restored,
-            server.monitor().statistics().samples()
-        );
-    }
+    start_storage(server, persist);
     if !EXTERNAL_SAMPLES && !B::SENSORS {
-        // The scenario's samples not yet monitored (after a restored checkpoint, those
-        // after it).
-        let done = server.monitor().statistics().samples() as usize;
-        for sample in Scenario::new().skip(done) {
-            server.process(sample);
+        scenario(
+            server,
             #[cfg(feature = "modbus-flash")]
-            persist.service(&mut server);
-        }
+            persist,
+        );
     }
     defmt::println!(
         "modbus: serving, {=str}, samples from {=str}, {=u64} processed",
@@ -145,6 +118,88 @@ pub fn node<
         },
         server.monitor().statistics().samples()
     );
+    serve(
+        server,
+        #[cfg(feature = "modbus-flash")]
+        persist,
+        uart,
+        clock,
+        board,
+    )
+}
+
+/// The server over a new monitor of `core`, taking scenes of its core type over the
+/// bus (commissioning); `None` if the monitor or the server refuses its configuration.
+#[inline(never)]
+fn server<E: Estimator + PreparedScene, B: Board>(
+    core: E,
+    model: &'static str,
+) -> Option<Server<E>> {
+    let monitor = match Monitor::new(core, Config::default()) {
+        Ok(m) => m,
+        Err(e) => {
+            defmt::error!("node: configuration refused: {}", e);
+            return None;
+        }
+    };
+    let config = ServerConfig {
+        external_samples: EXTERNAL_SAMPLES,
+        scene_required: B::SENSORS && !EXTERNAL_SAMPLES,
+        ident: Identification {
+            model_name: model,
+            ..Identification::default()
+        },
+        ..ServerConfig::default()
+    };
+    match Server::new(monitor, config) {
+        Ok(mut s) => {
+            s.accept_scenes();
+            Some(s)
+        }
+        Err(e) => {
+            defmt::error!("node: server configuration refused: {}", e);
+            None
+        }
+    }
+}
+
+/// The committed configuration and the monitor's last checkpoint, from the flash.
+#[cfg(feature = "modbus-flash")]
+#[inline(never)]
+fn start_storage<E: Estimator>(server: &mut Server<E>, persist: &mut crate::persist::Persist) {
+    let (source, restored) = persist.start(server);
+    defmt::println!(
+        "storage: configuration from {}, state restored {=bool}, {=u64} samples monitored",
+        source,
+        restored,
+        server.monitor().statistics().samples()
+    );
+}
+
+/// The built-in scenario's samples not yet monitored (after a restored checkpoint,
+/// those after it).
+#[inline(never)]
+fn scenario<E: Estimator>(
+    server: &mut Server<E>,
+    #[cfg(feature = "modbus-flash")] persist: &mut crate::persist::Persist,
+) {
+    let done = server.monitor().statistics().samples() as usize;
+    for sample in Scenario::new().skip(done) {
+        server.process(sample);
+        #[cfg(feature = "modbus-flash")]
+        persist.service(server);
+    }
+}
+
+/// Serves forever: the board's samples, the requests, the storage, the line's clock.
+#[inline(never)]
+fn serve<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32, B: Board>(
+    server: &mut Server<E>,
+    #[cfg(feature = "modbus-flash")] persist: &mut crate::persist::Persist,
+    uart: &mut U,
+    mut clock: LineClock<T>,
+    board: &mut B,
+) -> Option<core::convert::Infallible> {
     // When the last byte came, and whether a frame may be waiting for the silence that
     // ends it (garbage, a truncated frame, a function the server does not know: the
     // server drops or answers it then).
@@ -173,7 +228,7 @@ pub fn node<
             defmt::warn!("modbus: a UART error");
         }
         #[cfg(feature = "modbus-flash")]
-        persist.service(&mut server);
+        persist.service(server);
         if server.line() != line {
             line = server.line();
             log_line(&line);
