@@ -3,11 +3,12 @@
 //! implementing the `embedded-io` 0.7 traits: the QEMU images' register-level drivers
 //! (`uart.rs`) and a real board's HAL (`nodes/pico`) alike. What a board adds (its own
 //! sensors sampled on its timer, sleeping between requests and samples, a watchdog)
-//! comes through [`Board`]; the QEMU images have none of it ([`Bare`]).
+//! comes through [`Board`]; the QEMU images have none of it but their UART's settings
+//! (`main.rs`).
 
 use embedded_io::{ErrorType, Read, ReadReady, Write};
 use misalign::Estimator;
-use misalign::modbus::{Identification, PreparedScene, Server, ServerConfig};
+use misalign::modbus::{Identification, LineSettings, PreparedScene, Server, ServerConfig};
 use misalign::monitor::scenario::Scenario;
 use misalign::monitor::{Config, Monitor, Sample};
 
@@ -44,18 +45,10 @@ pub trait Board {
     fn idle(&mut self, wait: u32, pending: &mut dyn FnMut() -> bool);
     /// Once per pass of the loop: the node is alive (a board feeds its watchdog).
     fn alive(&mut self);
-}
-
-/// A board with none of it: the QEMU images (busy polling, no sensors, no watchdog).
-pub struct Bare;
-
-impl Board for Bare {
-    const SENSORS: bool = false;
-    fn sample(&mut self) -> Option<Sample> {
-        None
-    }
-    fn idle(&mut self, _: u32, _: &mut dyn FnMut() -> bool) {}
-    fn alive(&mut self) {}
+    /// The line settings in force, at the start (the committed configuration's) and
+    /// whenever they change (a commit after its answer, a revert): a board sets its
+    /// UART's rate and frame to them here. The node has logged them.
+    fn line(&mut self, _settings: &LineSettings) {}
 }
 
 /// The Modbus node: a `misalign::modbus::Server` over the monitor of `core`
@@ -203,16 +196,24 @@ fn serve<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32, B: Board>
     // When the last byte came, and whether a frame may be waiting for the silence that
     // ends it (garbage, a truncated frame, a function the server does not know: the
     // server drops or answers it then).
-    let (mut last_byte, mut waiting) = ((clock.ticks)(), false);
-    let mut uart = Watched { uart, seen: false };
-    // The commissioning's milliseconds, from the line's ticks.
-    let (mut ms, mut ticked) = (0u32, last_byte);
     let per_ms = clock.per_ms.max(1);
+    let mut last_byte = (clock.ticks)();
+    let mut waiting = false;
     // The line settings the UART runs: set again when the server's change (a commit
-    // after its answer, a revert). The QEMU UARTs carry bytes at any rate (the TCP
-    // bridge): the settings are logged, the unit id is the server's own.
+    // after its answer, a revert); the answer delay in force held before each answer.
     let mut line = server.line();
     log_line(&line);
+    board.line(&line);
+    let mut uart = Watched {
+        uart,
+        seen: false,
+        clock,
+        last_read: last_byte,
+        delay: u32::from(line.answer_delay_ms).saturating_mul(per_ms),
+        held: None,
+    };
+    // The commissioning's milliseconds, from the line's ticks.
+    let (mut ms, mut ticked) = (0u32, last_byte);
     loop {
         board.alive();
         if let Some(sample) = board.sample()
@@ -229,11 +230,20 @@ fn serve<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32, B: Board>
         }
         #[cfg(feature = "modbus-flash")]
         persist.service(server);
+        if let Some(waited) = uart.held.take() {
+            defmt::println!(
+                "modbus: answered {=u32} ms after the request (answer delay {=u16} ms)",
+                waited / per_ms,
+                line.answer_delay_ms
+            );
+        }
         if server.line() != line {
             line = server.line();
             log_line(&line);
+            board.line(&line);
+            uart.delay = u32::from(line.answer_delay_ms).saturating_mul(per_ms);
         }
-        let now = (clock.ticks)();
+        let now = (uart.clock.ticks)();
         let step = now.wrapping_sub(ticked);
         if step >= per_ms {
             ms = ms.wrapping_add(step / per_ms);
@@ -242,7 +252,7 @@ fn serve<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32, B: Board>
         }
         if core::mem::take(&mut uart.seen) {
             (last_byte, waiting) = (now, true);
-        } else if waiting && now.wrapping_sub(last_byte) >= clock.silence {
+        } else if waiting && now.wrapping_sub(last_byte) >= uart.clock.silence {
             server.idle();
             waiting = false;
         }
@@ -250,7 +260,7 @@ fn serve<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32, B: Board>
             // Until the silence ends a frame, else at least once a second (the
             // commissioning's clock).
             let wait = if waiting {
-                clock
+                uart.clock
                     .silence
                     .saturating_sub(now.wrapping_sub(last_byte))
                     .max(1)
@@ -297,32 +307,49 @@ fn log_sample(s: &Sample) {
     );
 }
 
-/// A UART that notes whether a read took a byte.
-struct Watched<'a, U> {
+/// A UART that notes whether a read took a byte, and when; and holds the first write
+/// after a read (an answer's start) until `delay` ticks of the line's clock have passed
+/// since that read (the answer delay in force), noting in `held` how long it was.
+struct Watched<'a, U, T: FnMut() -> u32> {
     uart: &'a mut U,
     seen: bool,
+    clock: LineClock<T>,
+    last_read: u32,
+    delay: u32,
+    held: Option<u32>,
 }
 
-impl<U: ErrorType> ErrorType for Watched<'_, U> {
+impl<U: ErrorType, T: FnMut() -> u32> ErrorType for Watched<'_, U, T> {
     type Error = U::Error;
 }
 
-impl<U: ReadReady> ReadReady for Watched<'_, U> {
+impl<U: ReadReady, T: FnMut() -> u32> ReadReady for Watched<'_, U, T> {
     fn read_ready(&mut self) -> Result<bool, U::Error> {
         self.uart.read_ready()
     }
 }
 
-impl<U: Read> Read for Watched<'_, U> {
+impl<U: Read, T: FnMut() -> u32> Read for Watched<'_, U, T> {
     fn read(&mut self, buf: &mut [u8]) -> Result<usize, U::Error> {
         let n = self.uart.read(buf)?;
-        self.seen |= n > 0;
+        if n > 0 {
+            self.seen = true;
+            self.last_read = (self.clock.ticks)();
+        }
         Ok(n)
     }
 }
 
-impl<U: Write> Write for Watched<'_, U> {
+impl<U: Write, T: FnMut() -> u32> Write for Watched<'_, U, T> {
     fn write(&mut self, buf: &[u8]) -> Result<usize, U::Error> {
+        if self.delay > 0 && self.held.is_none() {
+            // Busy: the line's clock runs on the core's (SysTick in QEMU).
+            let mut waited = (self.clock.ticks)().wrapping_sub(self.last_read);
+            while waited < self.delay {
+                waited = (self.clock.ticks)().wrapping_sub(self.last_read);
+            }
+            self.held = Some(waited);
+        }
         self.uart.write(buf)
     }
 

@@ -319,8 +319,13 @@ fn boot(
         .map_err(|e| format!("cannot run lab/qemu-run: {e}"))?;
     let stdout = child.stdout.take().unwrap();
     let (tx, rx) = mpsc::channel();
+    // The whole log also in a file beside the image, for the tests that read what the
+    // node measured (`MODBUS_NODE_LOG`).
+    let mut file = std::fs::File::create(node_log(elf)).map_err(|e| e.to_string())?;
     std::thread::spawn(move || {
+        use std::io::Write as _;
         for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            let _ = writeln!(file, "{line}");
             let notable = ["modbus", "storage", "ERROR", "WARN", "panick", "qemu"];
             if all || notable.iter().any(|n| line.contains(n)) {
                 eprintln!("  node| {line}");
@@ -352,6 +357,11 @@ fn boot(
             Err(mpsc::RecvTimeoutError::Timeout) => {}
         }
     }
+}
+
+/// The file a booted node's whole log goes to: beside its image.
+fn node_log(elf: &Path) -> PathBuf {
+    elf.with_extension("log")
 }
 
 /// The virtual environment with the pinned packages; its python.
@@ -561,6 +571,7 @@ fn test_node(node: &Node, python: &Path, dir: &Path, registers: &Path) -> Result
         .env("MODBUS_SAMPLES", dir.join("samples.csv"))
         .env("MODBUS_ELF", &elf)
         .env("MODBUS_MACHINE", node.machine)
+        .env("MODBUS_NODE_LOG", node_log(&elf))
         // The plan file of a test build's power cuts: the image's path and `.cut`.
         .env("MODBUS_POWER_CUT_PLAN", elf.with_extension("cut"))
         .env("MODBUS_EVENTS_OUT", &file)
