@@ -23,7 +23,7 @@
 //!   library's kernels only.
 //!
 //! - the linker's identical code folding (`--icf=all`) for the node images
-//!   (`minimal_node`, `modbus_node`).
+//!   (`minimal_node`, `modbus_node`, `modbus_flash_node`).
 //!
 //! Besides that, on the host it does nothing. The library `misalign` has no build
 //! script.
@@ -72,7 +72,7 @@ fn main() {
     // (compiler_builtins' __aeabi_memclr4 and memclr8, memcpy4 and memcpy8 are the same
     // code twice). Nothing in them compares two functions' addresses, the one thing
     // folding changes. The other images keep the link their tables were measured with.
-    for node in ["minimal_node", "modbus_node"] {
+    for node in ["minimal_node", "modbus_node", "modbus_flash_node"] {
         println!("cargo:rustc-link-arg-bin={node}=--icf=all");
     }
 }

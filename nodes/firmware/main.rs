@@ -100,6 +100,31 @@ impl node::Count for misalign_harness::support::counter::Counter {
     }
 }
 
+/// The QEMU boards for the Modbus node: no sensors, no sleep (busy polling), no
+/// watchdog; the UART set to the line settings in force, its registers logged.
+#[cfg(all(target_os = "none", feature = "modbus-node"))]
+struct Qemu(uart::Uart);
+
+#[cfg(all(target_os = "none", feature = "modbus-node"))]
+impl serve::Board for Qemu {
+    const SENSORS: bool = false;
+    fn sample(&mut self) -> Option<misalign::monitor::Sample> {
+        None
+    }
+    fn idle(&mut self, _: u32, _: &mut dyn FnMut() -> bool) {}
+    fn alive(&mut self) {}
+    fn line(&mut self, settings: &misalign::modbus::LineSettings) {
+        let set = self.0.configure(settings.baud, settings.parity);
+        defmt::println!(
+            "modbus: {} set to {=u32} baud, parity {=u8}: {}",
+            self.0,
+            settings.baud,
+            settings.parity as u8,
+            set
+        );
+    }
+}
+
 #[cfg(target_os = "none")]
 #[cortex_m_rt::entry]
 fn main() -> ! {
@@ -119,7 +144,9 @@ fn main() -> ! {
     #[cfg(feature = "modbus-node")]
     if failures == 0 {
         let mut uart = uart::Uart::for_this_board(&peripherals.CPUID);
-        defmt::println!("modbus: unit 1 on {}", uart);
+        // The unit id and line settings in force are the committed configuration's,
+        // logged once the node has restored it (`serve.rs`).
+        defmt::println!("modbus: on {}", uart);
         // SysTick runs free (the counter set it up): its 24-bit down-count as a
         // wrapping up-count of core clock ticks, in QEMU's virtual time.
         let clock = {
@@ -136,13 +163,13 @@ fn main() -> ! {
                 per_ms: uart.silence_ticks() / 1000,
             }
         };
+        let mut board = Qemu(uart);
         let served = if fpu {
             node::f32_core()
-                .map(|core| serve::node(core, serve::MODEL_F32, &mut uart, clock, &mut serve::Bare))
+                .map(|core| serve::node(core, serve::MODEL_F32, &mut uart, clock, &mut board))
         } else {
-            node::fixed_core().map(|core| {
-                serve::node(core, serve::MODEL_FIXED, &mut uart, clock, &mut serve::Bare)
-            })
+            node::fixed_core()
+                .map(|core| serve::node(core, serve::MODEL_FIXED, &mut uart, clock, &mut board))
         };
         match served {
             Ok(_) => support::exit(3),

@@ -72,6 +72,7 @@ pub struct Persist {
 impl Persist {
     /// The two regions, opened once at boot; the event queue read through. `None` on
     /// a flash error.
+    #[inline(never)]
     pub fn open() -> Option<Self> {
         let (store, events) = flash::regions()?;
         let store = Store::new(BlockingFlash(store), 0..STORE_SIZE as u32, INTERVAL_S).ok()?;

@@ -3,11 +3,12 @@
 //! implementing the `embedded-io` 0.7 traits: the QEMU images' register-level drivers
 //! (`uart.rs`) and a real board's HAL (`nodes/pico`) alike. What a board adds (its own
 //! sensors sampled on its timer, sleeping between requests and samples, a watchdog)
-//! comes through [`Board`]; the QEMU images have none of it ([`Bare`]).
+//! comes through [`Board`]; the QEMU images have none of it but their UART's settings
+//! (`main.rs`).
 
 use embedded_io::{ErrorType, Read, ReadReady, Write};
 use misalign::Estimator;
-use misalign::modbus::{Identification, PreparedScene, Server, ServerConfig};
+use misalign::modbus::{Identification, LineSettings, PreparedScene, Server, ServerConfig};
 use misalign::monitor::scenario::Scenario;
 use misalign::monitor::{Config, Monitor, Sample};
 
@@ -44,18 +45,10 @@ pub trait Board {
     fn idle(&mut self, wait: u32, pending: &mut dyn FnMut() -> bool);
     /// Once per pass of the loop: the node is alive (a board feeds its watchdog).
     fn alive(&mut self);
-}
-
-/// A board with none of it: the QEMU images (busy polling, no sensors, no watchdog).
-pub struct Bare;
-
-impl Board for Bare {
-    const SENSORS: bool = false;
-    fn sample(&mut self) -> Option<Sample> {
-        None
-    }
-    fn idle(&mut self, _: u32, _: &mut dyn FnMut() -> bool) {}
-    fn alive(&mut self) {}
+    /// The line settings in force, at the start (the committed configuration's) and
+    /// whenever they change (a commit after its answer, a revert): a board sets its
+    /// UART's rate and frame to them here. The node has logged them.
+    fn line(&mut self, _settings: &LineSettings) {}
 }
 
 /// The Modbus node: a `misalign::modbus::Server` over the monitor of `core`
@@ -69,6 +62,11 @@ impl Board for Bare {
 /// and reports "not commissioned": `ServerConfig::scene_required`), each monitored
 /// sample logged as a `sample` line.
 /// `None` if the monitor refuses its configuration.
+///
+/// The server and the storage are built once, where the node keeps them (each step
+/// out of line, so that no copy of them or of what built them stays on the stack
+/// while the node serves); the deepest stack is then the serving loop's frame and a
+/// request's or a checkpoint's calls, on top of these two.
 pub fn node<
     E: Estimator + PreparedScene,
     U: Read + ReadReady + Write,
@@ -78,60 +76,28 @@ pub fn node<
     core: E,
     model: &'static str,
     uart: &mut U,
-    mut clock: LineClock<T>,
+    clock: LineClock<T>,
     board: &mut B,
 ) -> Option<core::convert::Infallible> {
-    let monitor = match Monitor::new(core, Config::default()) {
-        Ok(m) => m,
-        Err(e) => {
-            defmt::error!("node: configuration refused: {}", e);
-            return None;
-        }
-    };
+    let mut server = server::<E, B>(core, model);
+    let server = server.as_mut()?;
     #[cfg(feature = "modbus-flash")]
-    let Some(mut persist) = crate::persist::Persist::open() else {
+    let mut persist = crate::persist::Persist::open();
+    #[cfg(feature = "modbus-flash")]
+    let Some(persist) = persist.as_mut() else {
         defmt::error!("node: the flash cannot be opened");
         return None;
     };
-    let config = ServerConfig {
-        external_samples: EXTERNAL_SAMPLES,
-        scene_required: B::SENSORS && !EXTERNAL_SAMPLES,
-        ident: Identification {
-            model_name: model,
-            ..Identification::default()
-        },
-        ..ServerConfig::default()
-    };
-    let mut server = match Server::new(monitor, config) {
-        Ok(s) => s,
-        Err(e) => {
-            defmt::error!("node: server configuration refused: {}", e);
-            return None;
-        }
-    };
-    // Commissioning takes scenes of the node's core type over the bus.
-    server.accept_scenes();
     // With flash (`modbus-flash`): the committed configuration, then the monitor's
     // last checkpoint under it.
     #[cfg(feature = "modbus-flash")]
-    {
-        let (source, restored) = persist.start(&mut server);
-        defmt::println!(
-            "storage: configuration from {}, state restored {=bool}, {=u64} samples monitored",
-            source,
-            restored,
-            server.monitor().statistics().samples()
-        );
-    }
+    start_storage(server, persist);
     if !EXTERNAL_SAMPLES && !B::SENSORS {
-        // The scenario's samples not yet monitored (after a restored checkpoint, those
-        // after it).
-        let done = server.monitor().statistics().samples() as usize;
-        for sample in Scenario::new().skip(done) {
-            server.process(sample);
+        scenario(
+            server,
             #[cfg(feature = "modbus-flash")]
-            persist.service(&mut server);
-        }
+            persist,
+        );
     }
     defmt::println!(
         "modbus: serving, {=str}, samples from {=str}, {=u64} processed",
@@ -145,19 +111,109 @@ pub fn node<
         },
         server.monitor().statistics().samples()
     );
+    serve(
+        server,
+        #[cfg(feature = "modbus-flash")]
+        persist,
+        uart,
+        clock,
+        board,
+    )
+}
+
+/// The server over a new monitor of `core`, taking scenes of its core type over the
+/// bus (commissioning); `None` if the monitor or the server refuses its configuration.
+#[inline(never)]
+fn server<E: Estimator + PreparedScene, B: Board>(
+    core: E,
+    model: &'static str,
+) -> Option<Server<E>> {
+    let monitor = match Monitor::new(core, Config::default()) {
+        Ok(m) => m,
+        Err(e) => {
+            defmt::error!("node: configuration refused: {}", e);
+            return None;
+        }
+    };
+    let config = ServerConfig {
+        external_samples: EXTERNAL_SAMPLES,
+        scene_required: B::SENSORS && !EXTERNAL_SAMPLES,
+        ident: Identification {
+            model_name: model,
+            ..Identification::default()
+        },
+        ..ServerConfig::default()
+    };
+    match Server::new(monitor, config) {
+        Ok(mut s) => {
+            s.accept_scenes();
+            Some(s)
+        }
+        Err(e) => {
+            defmt::error!("node: server configuration refused: {}", e);
+            None
+        }
+    }
+}
+
+/// The committed configuration and the monitor's last checkpoint, from the flash.
+#[cfg(feature = "modbus-flash")]
+#[inline(never)]
+fn start_storage<E: Estimator>(server: &mut Server<E>, persist: &mut crate::persist::Persist) {
+    let (source, restored) = persist.start(server);
+    defmt::println!(
+        "storage: configuration from {}, state restored {=bool}, {=u64} samples monitored",
+        source,
+        restored,
+        server.monitor().statistics().samples()
+    );
+}
+
+/// The built-in scenario's samples not yet monitored (after a restored checkpoint,
+/// those after it).
+#[inline(never)]
+fn scenario<E: Estimator>(
+    server: &mut Server<E>,
+    #[cfg(feature = "modbus-flash")] persist: &mut crate::persist::Persist,
+) {
+    let done = server.monitor().statistics().samples() as usize;
+    for sample in Scenario::new().skip(done) {
+        server.process(sample);
+        #[cfg(feature = "modbus-flash")]
+        persist.service(server);
+    }
+}
+
+/// Serves forever: the board's samples, the requests, the storage, the line's clock.
+#[inline(never)]
+fn serve<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32, B: Board>(
+    server: &mut Server<E>,
+    #[cfg(feature = "modbus-flash")] persist: &mut crate::persist::Persist,
+    uart: &mut U,
+    mut clock: LineClock<T>,
+    board: &mut B,
+) -> Option<core::convert::Infallible> {
     // When the last byte came, and whether a frame may be waiting for the silence that
     // ends it (garbage, a truncated frame, a function the server does not know: the
     // server drops or answers it then).
-    let (mut last_byte, mut waiting) = ((clock.ticks)(), false);
-    let mut uart = Watched { uart, seen: false };
-    // The commissioning's milliseconds, from the line's ticks.
-    let (mut ms, mut ticked) = (0u32, last_byte);
     let per_ms = clock.per_ms.max(1);
+    let mut last_byte = (clock.ticks)();
+    let mut waiting = false;
     // The line settings the UART runs: set again when the server's change (a commit
-    // after its answer, a revert). The QEMU UARTs carry bytes at any rate (the TCP
-    // bridge): the settings are logged, the unit id is the server's own.
+    // after its answer, a revert); the answer delay in force held before each answer.
     let mut line = server.line();
     log_line(&line);
+    board.line(&line);
+    let mut uart = Watched {
+        uart,
+        seen: false,
+        clock,
+        last_read: last_byte,
+        delay: u32::from(line.answer_delay_ms).saturating_mul(per_ms),
+        held: None,
+    };
+    // The commissioning's milliseconds, from the line's ticks.
+    let (mut ms, mut ticked) = (0u32, last_byte);
     loop {
         board.alive();
         if let Some(sample) = board.sample()
@@ -173,12 +229,21 @@ pub fn node<
             defmt::warn!("modbus: a UART error");
         }
         #[cfg(feature = "modbus-flash")]
-        persist.service(&mut server);
+        persist.service(server);
+        if let Some(waited) = uart.held.take() {
+            defmt::println!(
+                "modbus: answered {=u32} ms after the request (answer delay {=u16} ms)",
+                waited / per_ms,
+                line.answer_delay_ms
+            );
+        }
         if server.line() != line {
             line = server.line();
             log_line(&line);
+            board.line(&line);
+            uart.delay = u32::from(line.answer_delay_ms).saturating_mul(per_ms);
         }
-        let now = (clock.ticks)();
+        let now = (uart.clock.ticks)();
         let step = now.wrapping_sub(ticked);
         if step >= per_ms {
             ms = ms.wrapping_add(step / per_ms);
@@ -187,7 +252,7 @@ pub fn node<
         }
         if core::mem::take(&mut uart.seen) {
             (last_byte, waiting) = (now, true);
-        } else if waiting && now.wrapping_sub(last_byte) >= clock.silence {
+        } else if waiting && now.wrapping_sub(last_byte) >= uart.clock.silence {
             server.idle();
             waiting = false;
         }
@@ -195,7 +260,7 @@ pub fn node<
             // Until the silence ends a frame, else at least once a second (the
             // commissioning's clock).
             let wait = if waiting {
-                clock
+                uart.clock
                     .silence
                     .saturating_sub(now.wrapping_sub(last_byte))
                     .max(1)
@@ -242,32 +307,49 @@ fn log_sample(s: &Sample) {
     );
 }
 
-/// A UART that notes whether a read took a byte.
-struct Watched<'a, U> {
+/// A UART that notes whether a read took a byte, and when; and holds the first write
+/// after a read (an answer's start) until `delay` ticks of the line's clock have passed
+/// since that read (the answer delay in force), noting in `held` how long it was.
+struct Watched<'a, U, T: FnMut() -> u32> {
     uart: &'a mut U,
     seen: bool,
+    clock: LineClock<T>,
+    last_read: u32,
+    delay: u32,
+    held: Option<u32>,
 }
 
-impl<U: ErrorType> ErrorType for Watched<'_, U> {
+impl<U: ErrorType, T: FnMut() -> u32> ErrorType for Watched<'_, U, T> {
     type Error = U::Error;
 }
 
-impl<U: ReadReady> ReadReady for Watched<'_, U> {
+impl<U: ReadReady, T: FnMut() -> u32> ReadReady for Watched<'_, U, T> {
     fn read_ready(&mut self) -> Result<bool, U::Error> {
         self.uart.read_ready()
     }
 }
 
-impl<U: Read> Read for Watched<'_, U> {
+impl<U: Read, T: FnMut() -> u32> Read for Watched<'_, U, T> {
     fn read(&mut self, buf: &mut [u8]) -> Result<usize, U::Error> {
         let n = self.uart.read(buf)?;
-        self.seen |= n > 0;
+        if n > 0 {
+            self.seen = true;
+            self.last_read = (self.clock.ticks)();
+        }
         Ok(n)
     }
 }
 
-impl<U: Write> Write for Watched<'_, U> {
+impl<U: Write, T: FnMut() -> u32> Write for Watched<'_, U, T> {
     fn write(&mut self, buf: &[u8]) -> Result<usize, U::Error> {
+        if self.delay > 0 && self.held.is_none() {
+            // Busy: the line's clock runs on the core's (SysTick in QEMU).
+            let mut waited = (self.clock.ticks)().wrapping_sub(self.last_read);
+            while waited < self.delay {
+                waited = (self.clock.ticks)().wrapping_sub(self.last_read);
+            }
+            self.held = Some(waited);
+        }
         self.uart.write(buf)
     }
 

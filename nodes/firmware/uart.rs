@@ -1,5 +1,7 @@
 //! The boards' UARTs by their registers, polled (no interrupts, no DMA), 8N1 at
-//! 115200 baud: what QEMU's boards give serial0, and enough for the real chips.
+//! 115200 baud at start, then at the line settings in force ([`Uart::configure`]):
+//! what QEMU's boards give serial0, and enough for the real chips. (QEMU's serial0
+//! over TCP carries bytes at any rate: the registers are written, the bytes flow.)
 //!
 //! - CMSDK APB UART0 at 0x4000_4000 on the MPS2 boards (mps2-an385 Cortex-M3,
 //!   mps2-an386 Cortex-M4F, mps2-an500 Cortex-M7): a one-byte receive buffer.
@@ -68,8 +70,19 @@ mod nrf51 {
     pub const RXD: Reg = Reg(BASE + 0x518);
     pub const TXD: Reg = Reg(BASE + 0x51C);
     pub const BAUDRATE: Reg = Reg(BASE + 0x524);
+    pub const CONFIG: Reg = Reg(BASE + 0x56C);
     /// BAUDRATE's value for 115200 baud.
     pub const BAUD_115200: u32 = 0x01D7_E000;
+    /// BAUDRATE's values of the line's rates (the manual's table, 29.10.11).
+    pub const BAUDS: [(u32, u32); 5] = [
+        (9_600, 0x0027_5000),
+        (19_200, 0x004E_A000),
+        (38_400, 0x009D_5000),
+        (57_600, 0x00EB_F000),
+        (115_200, BAUD_115200),
+    ];
+    /// CONFIG's PARITY field (bits 3:1): 0b111 includes an even parity bit.
+    pub const PARITY_EVEN: u32 = 0b111 << 1;
     /// The micro:bit's interface-chip UART pins: TX P0.24, RX P0.25.
     pub const TX_PIN: u32 = 24;
     pub const RX_PIN: u32 = 25;
@@ -84,6 +97,13 @@ mod stm32 {
     pub const DR: Reg = Reg(BASE + 0x04);
     pub const BRR: Reg = Reg(BASE + 0x08);
     pub const CR1: Reg = Reg(BASE + 0x0C);
+    pub const CR2: Reg = Reg(BASE + 0x10);
+    /// CR1: M (9 data bits: 8 and the parity bit), PCE (parity on), PS (odd).
+    pub const M: u32 = 1 << 12;
+    pub const PCE: u32 = 1 << 10;
+    pub const PS: u32 = 1 << 9;
+    /// CR2's STOP field (bits 13:12): 0b10, two stop bits.
+    pub const STOP_2: u32 = 0b10 << 12;
     pub const RXNE: u32 = 1 << 5;
     pub const TC: u32 = 1 << 6;
     pub const TXE: u32 = 1 << 7;
@@ -155,7 +175,83 @@ impl Uart {
     }
 }
 
+/// What [`Uart::configure`] wrote: the baud rate's register and its value, the
+/// frame's (parity, stop bits) register and its value, if the UART has one; and
+/// whether the UART could take the parity and stop bits asked.
+#[derive(Clone, Copy, defmt::Format)]
+pub struct Configured {
+    pub rate: (&'static str, u32),
+    pub frame: Option<(&'static str, u32)>,
+    pub as_asked: bool,
+}
+
 impl Uart {
+    /// Sets the UART to `baud` bits per second and `parity` (8 data bits; two stop
+    /// bits without parity, one with it): the CMSDK UART's BAUDDIV (it has no parity
+    /// and one stop bit only), the nRF51's BAUDRATE and CONFIG (even parity only, one
+    /// stop bit only), the STM32's BRR, CR1 and CR2. A rate the nRF51's table does not
+    /// hold leaves its BAUDRATE as it was.
+    pub fn configure(self, baud: u32, parity: misalign::modbus::Parity) -> Configured {
+        use misalign::modbus::Parity;
+        let baud = baud.max(1);
+        match self {
+            Uart::Cmsdk => {
+                let div = cmsdk::CLOCK / baud;
+                cmsdk::BAUDDIV.write(div);
+                Configured {
+                    rate: ("BAUDDIV", div),
+                    frame: None,
+                    as_asked: false,
+                }
+            }
+            Uart::Nrf51 => {
+                let rate = nrf51::BAUDS
+                    .iter()
+                    .find(|(b, _)| *b == baud)
+                    .map(|(_, v)| *v);
+                if let Some(v) = rate {
+                    nrf51::BAUDRATE.write(v);
+                }
+                let config = if parity == Parity::Even {
+                    nrf51::PARITY_EVEN
+                } else {
+                    0
+                };
+                nrf51::CONFIG.write(config);
+                Configured {
+                    rate: ("BAUDRATE", nrf51::BAUDRATE.read()),
+                    frame: Some(("CONFIG", config)),
+                    as_asked: rate.is_some() && parity == Parity::Even,
+                }
+            }
+            Uart::Stm32 => {
+                let brr = stm32::CLOCK.div_ceil(baud);
+                let cr1 = stm32::ENABLE
+                    | match parity {
+                        Parity::None => 0,
+                        Parity::Odd => stm32::M | stm32::PCE | stm32::PS,
+                        Parity::Even => stm32::M | stm32::PCE,
+                    };
+                let cr2 = if parity == Parity::None {
+                    stm32::STOP_2
+                } else {
+                    0
+                };
+                // The frame's format is changed with the USART disabled (RM0090, 30.6).
+                while stm32::SR.read() & stm32::TC == 0 {}
+                stm32::CR1.write(0);
+                stm32::BRR.write(brr);
+                stm32::CR2.write(cr2);
+                stm32::CR1.write(cr1);
+                Configured {
+                    rate: ("BRR", brr),
+                    frame: Some(("CR1", cr1)),
+                    as_asked: true,
+                }
+            }
+        }
+    }
+
     /// The silence that ends a frame, in core clock ticks (SysTick's). Not the 3.5
     /// character times of a real line (1750 us at this baud): in QEMU the line is a
     /// TCP socket whose bytes QEMU's I/O thread hands over one by one, and while that

@@ -5,6 +5,9 @@ test_reset.py); a change that no request confirms is not kept through a reset, s
 wrong setting cannot lock the node out. Over the TCP bridge, as on a serial line:
 the commit answered at the old unit id, the new one in force after it.
 
+The answer delay in force holds each answer, as the node's own clock measures it
+(its log, MODBUS_NODE_LOG).
+
 MODBUS_QEMU_MONITOR: the monitor's loopback port.
 """
 
@@ -100,3 +103,43 @@ def test_scan_address_reset_and_an_unconfirmed_change(client):
     assert done.returncode == 0, done.stderr
     answering(1, 10).close()
     assert client.connect()
+
+
+def answered_after(log, start):
+    """The node's `answered N ms after the request` lines in its log (MODBUS_NODE_LOG)
+    after its first `start` lines: N, measured by the node's own clock (SysTick, in
+    QEMU's virtual time, which a master's wall clock does not follow)."""
+    with open(log, errors="replace") as f:
+        lines = f.read().splitlines()[start:]
+    marker = "modbus: answered "
+    return [int(l.split(marker)[1].split()[0]) for l in lines if marker in l]
+
+
+def test_the_answer_delay_holds_each_answer(client):
+    log = os.environ["MODBUS_NODE_LOG"]
+    client.close()
+    delay = 250
+    done = commission("--code", str(code()), "--set", f"config_answer_delay={delay}")
+    assert done.returncode == 0, done.stdout + done.stderr
+    c = answering(1, 10)
+    with open(log, errors="replace") as f:
+        start = len(f.read().splitlines())
+    for _ in range(3):
+        r = c.read_holding_registers(holding("active_answer_delay"), count=1, device_id=1)
+        assert not r.isError() and r.registers[0] == delay
+    time.sleep(0.5)
+    waited = answered_after(log, start)
+    assert len(waited) >= 3, waited
+    assert all(ms >= delay for ms in waited), waited
+    assert all(ms < delay + 100 for ms in waited), waited
+    c.close()
+    # Back to none, which holds no answer.
+    done = commission("--code", str(code()), "--set", "config_answer_delay=0")
+    assert done.returncode == 0, done.stdout + done.stderr
+    c = answering(1, 10)
+    with open(log, errors="replace") as f:
+        start = len(f.read().splitlines())
+    assert not c.read_holding_registers(holding("unit_id"), count=1, device_id=1).isError()
+    time.sleep(0.5)
+    assert answered_after(log, start) == []
+    c.close()

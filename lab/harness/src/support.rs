@@ -71,6 +71,15 @@ pub mod stack {
     unsafe extern "C" {
         /// Lowest address of the stack (end of .bss/.uninit), from cortex-m-rt's link.x.
         static _stack_end: u32;
+        /// The stack's top (the RAM's end), from cortex-m-rt's link.x.
+        static _stack_start: u32;
+    }
+
+    /// The stack's top: [`used`]`(top())` is the deepest stack use since the last
+    /// [`paint`], the frames above its caller's included.
+    #[inline(always)]
+    pub fn top() -> usize {
+        (&raw const _stack_start) as usize
     }
 
     /// The stack pointer of the function this is inlined into.

@@ -16,7 +16,8 @@ pub mod sweep;
 pub mod web;
 
 use crate::records::{
-    self, AccuracyRow, BenchRow, NodeRow, PicoRow, ShapeRow, SizeRow, SweepRow, WebRow,
+    self, AccuracyRow, BenchRow, ModbusNodeRow, NodeRow, PicoRow, ShapeRow, SizeRow, SweepRow,
+    WebRow,
 };
 use bench::find;
 use misalign_workload::{Model, Operation};
@@ -43,6 +44,7 @@ fn blocks() -> Result<Vec<Block>, String> {
     let nodes = records::read::<NodeRow>()?;
     let accuracy = records::read::<AccuracyRow>()?;
     let pico = records::read::<PicoRow>()?;
+    let modbus_node = records::read::<ModbusNodeRow>()?;
     let web = records::read::<WebRow>()?;
     let block = |file, name, text| Block { file, name, text };
     Ok(vec![
@@ -63,6 +65,7 @@ fn blocks() -> Result<Vec<Block>, String> {
         block(PAGE, "sweep", sweep::markdown(&sweep, false)),
         block(PAGE, "firmware", sizes_block(&sizes)),
         block(PAGE, "node", node(&nodes)),
+        block(PAGE, "modbus-node", modbus_node_table(&modbus_node)),
         block(PAGE, "pico", pico_table(&pico)),
         block(PAGE, "web", web::table(&web)?),
     ])
@@ -130,6 +133,43 @@ fn node(rows: &[NodeRow]) -> String {
         }
         _ => table,
     }
+}
+
+/// The Modbus node with flash (docs/modbus-node.csv): its program and the RAM it leaves
+/// free, against the Cortex-M0's targets (`crate::modbus`).
+fn modbus_node_table(rows: &[ModbusNodeRow]) -> String {
+    use crate::modbus::{M0_PROGRAM_TARGET, M0_RAM_FREE_TARGET};
+    let mut s = String::from(
+        "| core | program | RAM: statics + deepest stack | left free of the board's RAM |\n\
+         |---|--:|--:|--:|\n",
+    );
+    for r in rows {
+        let used = r.ram + r.stack;
+        let free = r.board_ram as i64 - used as i64;
+        let m0 = r.core == "Cortex-M0";
+        let mark = |missed: bool| if m0 && missed { " **over target**" } else { "" };
+        writeln!(
+            s,
+            "| {} | {}{} | {} + {} = {used} | {free} of {}{} |",
+            r.core,
+            r.program,
+            mark(r.program > M0_PROGRAM_TARGET),
+            r.ram,
+            r.stack,
+            r.board_ram,
+            mark(free < M0_RAM_FREE_TARGET as i64)
+        )
+        .unwrap();
+    }
+    write!(
+        s,
+        "\nTargets of the Cortex-M0 node with flash (the micro:bit's 16 KiB of RAM; a 64 KiB \
+         part keeping 16 KiB of its flash for the storage): a program of at most {M0_PROGRAM_TARGET} B \
+         and at least {M0_RAM_FREE_TARGET} B of RAM left free. `cargo xtask modbus --measure` \
+         fails when one is missed, after writing what it measured.\n"
+    )
+    .unwrap();
+    s
 }
 
 /// The Pico node's table (docs/pico.csv).

@@ -332,6 +332,22 @@ record! {
 }
 
 record! {
+    /// docs/modbus-node.csv (`cargo xtask modbus --measure`): the Modbus node with its
+    /// flash storage (`lab/harness/src/bin/modbus_flash_node.rs`) on one core: its
+    /// program and the RAM it leaves free.
+    ModbusNodeRow in "modbus-node.csv" {
+        /// `Cortex-M0`, `Cortex-M4F`.
+        core: String = "core",
+        /// Bytes: the program (flash: vector table, code, read-only data, .data's
+        /// values), the statics, the deepest stack of its run, the board's RAM.
+        program: u64 = "program",
+        ram: u64 = "ram_statics",
+        stack: u64 = "stack",
+        board_ram: u64 = "board_ram",
+    }
+}
+
+record! {
     /// docs/accuracy.csv (`cargo xtask accuracy`): the worst relative error of one
     /// quantity of one model, over every row of the reference data for its contact.
     AccuracyRow in "accuracy.csv" {

@@ -22,7 +22,7 @@
 #![no_main]
 
 use misalign::Estimator;
-use misalign::modbus::{Server, ServerConfig, crc16};
+use misalign::modbus::{Server, ServerConfig};
 use misalign::monitor::{Config, Monitor, Sample};
 use misalign_harness::support::counter::Counter;
 use misalign_harness::{io, prepared, support};
@@ -32,7 +32,7 @@ use misalign_logger as _;
 #[path = "../../../../nodes/firmware/uart.rs"]
 mod uart;
 
-use misalign_harness::node_samples::{ANGLES, LOADS, SAMPLES};
+use misalign_harness::node_samples::{ANGLES, LOADS, SAMPLES, frame, samples_request};
 
 misalign_harness::exit_on_panic!();
 
@@ -72,16 +72,6 @@ fn main() -> ! {
         costs.stack_samples
     );
     support::exit(0)
-}
-
-/// A request frame for unit 1: `pdu`, then its CRC, in `buf`; its length.
-fn frame(buf: &mut [u8; 256], pdu: &[u8]) -> usize {
-    buf[0] = 1;
-    buf[1..=pdu.len()].copy_from_slice(pdu);
-    let n = pdu.len() + 1;
-    let crc = crc16(&buf[..n]).to_le_bytes();
-    buf[n..n + 2].copy_from_slice(&crc);
-    n + 2
 }
 
 /// Feeds `request` to the server under the counter; the instructions, if it answered
@@ -151,24 +141,8 @@ fn run<E: Estimator>(
     // Function 4: input registers 0-15 (status, alarms, the readings).
     let n = frame(&mut buf, &[4, 0, 0, 0, 16]);
     let fc4 = measure(&mut server, counter, &buf[..n], 4, 37)?;
-    // Function 16: 20 samples (time, P, phi: 6 registers each) from holding register
-    // `sample_0_time_ms`, one a second after the last. Answer: 8 bytes.
-    // Built in place (a PDU buffer beside it would be the image's stack, not the node's).
-    let start = misalign::modbus::map::SAMPLES_ADDRESS.to_be_bytes();
-    buf[..7].copy_from_slice(&[1, 16, start[0], start[1], 0, 120, 240]);
-    for k in 0..20u32 {
-        time_ms += 1000;
-        let load = io::read(&LOADS[(k % 8) as usize]);
-        let phi = io::read(&ANGLES[3]);
-        let words = [time_ms, load.to_bits(), phi.to_bits()];
-        for (w, x) in words.iter().enumerate() {
-            let at = 7 + k as usize * 12 + w * 4;
-            buf[at..at + 4].copy_from_slice(&x.to_be_bytes());
-        }
-    }
-    let crc = crc16(&buf[..247]).to_le_bytes();
-    buf[247..249].copy_from_slice(&crc);
-    let n = 249;
+    // Function 16: 20 samples, one a second after the last. Answer: 8 bytes.
+    let n = samples_request(&mut buf, time_ms);
     let fc16 = measure(&mut server, counter, &buf[..n], 16, 8)?;
     Some(Costs {
         requests: [fc3, fc4, fc16],
