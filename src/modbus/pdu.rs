@@ -243,11 +243,12 @@ impl<E: Estimator> Core<E> {
         // At most 125 registers: 250 bytes, from response[3].
         let bytes = 2 * quantity.min(125) as u8;
         let end = 3 + bytes;
-        // Each table's values from a function of its own (small enough to inline).
+        // Each table's values from a function of its own (small enough to inline), one
+        // `fill` each: a second `fill` with `value_holding` would take it out of line, a
+        // call per register. The line settings (a read from `LINE_ADDRESS` on stays in
+        // their block: `in_map`) are all `value_other`'s, which `value` falls to.
         if function == 3 && start < super::map::LINE_ADDRESS {
             self.fill::<true>(map, start, usize::from(end), Self::value_holding);
-        } else if function == 3 {
-            self.fill::<false>(map, start, usize::from(end), Self::value_holding);
         } else {
             self.fill::<false>(map, start, usize::from(end), Self::value);
         }
