@@ -203,7 +203,11 @@ fn the_sensor_registers_are_in_the_map() {
     assert_eq!(view(&mut s, "active"), defaults);
     // One read of the whole block.
     assert_eq!(read(&mut s, SENSORS_ADDRESS, 52).unwrap().len(), 52);
-    assert_eq!(read(&mut s, SENSORS_ADDRESS + 1, 52), Err(2), "past the end");
+    assert_eq!(
+        read(&mut s, SENSORS_ADDRESS + 1, 52),
+        Err(2),
+        "past the end"
+    );
 }
 
 /// Every write needs the unlock; a value outside its domain (NaN, an infinity, a
@@ -263,9 +267,16 @@ fn a_commit_applies_the_sensor_settings_and_a_revert_discards_them() {
         view(&mut s, "active"),
         bits(&SensorSettings::DEFAULT).to_vec()
     );
-    assert_eq!(s.sensors(), SensorSettings::DEFAULT, "not before the commit");
+    assert_eq!(
+        s.sensors(),
+        SensorSettings::DEFAULT,
+        "not before the commit"
+    );
     cmd(&mut s, command::REVERT).unwrap();
-    assert_eq!(view(&mut s, "config"), bits(&SensorSettings::DEFAULT).to_vec());
+    assert_eq!(
+        view(&mut s, "config"),
+        bits(&SensorSettings::DEFAULT).to_vec()
+    );
     assert_eq!(get(&mut s, "staged"), 0);
 
     stage(&mut s, &site());
@@ -379,7 +390,10 @@ fn the_default_is_the_data_sheets_calibration() {
         LoadCalibration::from_rated_output(Hx711Channel::A128, 2.0, 20e3).unwrap()
     );
     let probe = ProbeCalibration::two_point((4800.0, 0.0), (24000.0, 2e-3), spec).unwrap();
-    assert_eq!((c.misalignment.probe1, c.misalignment.probe2), (probe, probe));
+    assert_eq!(
+        (c.misalignment.probe1, c.misalignment.probe2),
+        (probe, probe)
+    );
     assert_eq!(
         (c.misalignment.span_m, c.misalignment.zero_offset_m),
         (0.4, 0.0)

@@ -7,7 +7,7 @@
 
 use embedded_io::{ErrorType, Read, ReadReady, Write};
 use misalign::Estimator;
-use misalign::modbus::{Identification, PreparedScene, Server, ServerConfig};
+use misalign::modbus::{Identification, PreparedScene, SensorSettings, Server, ServerConfig};
 use misalign::monitor::scenario::Scenario;
 use misalign::monitor::{Config, Monitor, Sample};
 
@@ -44,6 +44,9 @@ pub trait Board {
     fn idle(&mut self, wait: u32, pending: &mut dyn FnMut() -> bool);
     /// Once per pass of the loop: the node is alive (a board feeds its watchdog).
     fn alive(&mut self);
+    /// The sampling period and the sensors' calibration in force: at the start (the
+    /// committed image's, or the build's) and after each commit that changed them.
+    fn sensors(&mut self, settings: &SensorSettings);
 }
 
 /// A board with none of it: the QEMU images (busy polling, no sensors, no watchdog).
@@ -56,6 +59,8 @@ impl Board for Bare {
     }
     fn idle(&mut self, _: u32, _: &mut dyn FnMut() -> bool) {}
     fn alive(&mut self) {}
+    // The built-in scenario keeps its own timestamps and simulated sensors.
+    fn sensors(&mut self, _: &SensorSettings) {}
 }
 
 /// The Modbus node: a `misalign::modbus::Server` over the monitor of `core`
@@ -123,6 +128,8 @@ pub fn node<
             server.monitor().statistics().samples()
         );
     }
+    let mut sensors = server.sensors();
+    board.sensors(&sensors);
     if !EXTERNAL_SAMPLES && !B::SENSORS {
         // The scenario's samples not yet monitored (after a restored checkpoint, those
         // after it).
@@ -177,6 +184,10 @@ pub fn node<
         if server.line() != line {
             line = server.line();
             log_line(&line);
+        }
+        if server.sensors() != sensors {
+            sensors = server.sensors();
+            board.sensors(&sensors);
         }
         let now = (clock.ticks)();
         let step = now.wrapping_sub(ticked);

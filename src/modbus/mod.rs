@@ -135,8 +135,8 @@ use config::Commissioning;
 use core::fmt;
 use events::EventWindow;
 use line::Line;
-use sensing::Sensing;
 use rtu::Framer;
+use sensing::Sensing;
 use state::{Core, Step};
 
 /// The default unit id.

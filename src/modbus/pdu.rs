@@ -622,7 +622,12 @@ impl<E: Estimator> Core<E> {
             Field::Commission(Reg::NewCode) => c.write_new_code(v as u16),
             Field::Commission(Reg::Unlock) => c.unlock(v as u16)?,
             Field::Commission(Reg::Command) => {
-                c.command(v as u16, &mut self.monitor, &mut self.line, &mut self.sensing)?;
+                c.command(
+                    v as u16,
+                    &mut self.monitor,
+                    &mut self.line,
+                    &mut self.sensing,
+                )?;
                 // The events lost count with the statistics (`events_dropped`): the
                 // window's share starts afresh with the monitor's.
                 if v == u32::from(super::config::command::RESET_STATISTICS) {
