@@ -61,8 +61,8 @@ def installations(n, seed=4):
 
 def peer_floor(P, phi, repeat):
     """What the peer cannot avoid: ns per row of one K, E pair of scipy
-    (``ellipkm1`` and ``ellipe``) at the rows' k'^2, on one core; the peer takes four a
-    row (two Newton steps for k', two for theta0)."""
+    (``ellipkm1`` and ``ellipe``) at the rows' k'^2, on one core; the peer takes two a
+    row (one Newton step for k', one for theta0)."""
     from scipy.special import ellipe, ellipkm1
 
     theta = np.abs(phi)
@@ -248,14 +248,17 @@ def page(args, load, speed, err_digits, digit_rows, err_rows, samples, fleet_s, 
         "**How the peer was checked.** Its error is in the table: within "
         f"{max(err_digits['peer'].values()):.0e} of the 50-digit values (asserted below "
         f"{BOUNDS['peer']:.0e}). Its speed: a row costs it {peer_ns:.0f} ns on one core, of "
-        f"which the four pairs of scipy's `ellipkm1` and `ellipe` it needs (two Newton steps "
-        f"for k', two for theta0, each pair {cost['peer_pair']:.0f} ns a row here) take "
-        f"{4 * cost['peer_pair']:.0f} ns: the rest (seeds, logarithms, the closed forms) "
+        f"which the two pairs of scipy's `ellipkm1` and `ellipe` it needs (one Newton step "
+        f"for k', one for theta0, each pair {cost['peer_pair']:.0f} ns a row here) take "
+        f"{2 * cost['peer_pair']:.0f} ns: the rest (seeds, logarithms, the closed forms) "
         "cannot be made much cheaper in numpy. It is written for speed (its docstring: rows "
-        "in cache-sized chunks, one K, E pair a step with their derivatives from them, a "
-        "seed good to 1e-6 so that two steps reach rounding, the answer taken to first order "
-        "in the last step instead of another pair); the textbook form, a Newton loop to a tolerance "
-        "then one more step and one more pair, takes six or more pairs a row).",
+        "in cache-sized chunks, one K, E pair a step with their derivatives from them, seeds "
+        "from the series of K and E to second order in k'^2, good to 1e-10, so that one step "
+        "reaches rounding, the answer taken to first order in that step instead of another "
+        "pair; tools/python/tests/test_peer.py holds its answers to Newton's method iterated "
+        "to rounding over every angle); with first-order seeds it needed two pairs a solve, "
+        "and the textbook form, a Newton loop to a tolerance then one more step and one "
+        "more pair, takes six or more pairs a row.",
         "",
         f"**Where the package's time goes** (one thread, the first {cost_rows:,} of these "
         f"rows, ns per row, each the best of {args.repeat}, "

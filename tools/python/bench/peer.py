@@ -3,18 +3,23 @@ vectorised over all rows, kept beside the package as the benchmark's yardstick.
 
 theta from eq (4); k' from eqs (5)/(6), tan^2(theta/2) = k'^2 (K - E) / (E - k'^2 K),
 by Newton's method in x = ln k' on all rows at once, K = ``scipy.special.ellipkm1(k'^2)``
-and E = ``ellipe(1 - k'^2)``, from the small-k' asymptotics as the seed; m from eq (5),
-n = k' m; d/b from eq (16); F from eq (21) rearranged against cancellation; phi0 by a
-second Newton solve in ln k', for g(theta0) = m n theta0 at d/b = 1 (eq 18).
+and E = ``ellipe(1 - k'^2)``; m from eq (5), n = k' m; d/b from eq (16); F from eq (21)
+rearranged against cancellation; phi0 by a second Newton solve in ln k', for
+g(theta0) = m n theta0 at d/b = 1 (eq 18).
 
 Written for speed as a numerical engineer would: the rows in chunks that stay in the
 cache; each Newton step's K and E evaluated once, their derivatives from them (DLMF
-19.4.1); a seed good to about k'^2 ln(4/k') (1e-6 on practical rows), so that two steps
-reach rounding: the second step is below 1e-8, so the root is within about 1e-16 of
-the last point, and the answer there is taken to first order in that step (its error
-the step squared) rather than by one more evaluation of K and E. Rows whose step is
-still larger (large angles: k' near 1, where the seed is poor) iterate alone until
-they converge. So a practical row costs two pairs of K, E for k' and two for theta0.
+19.4.1); the seed of each solve from the small-k' series of K and E to second order in
+k'^2 (a few logarithms, no elliptic integral), good to about (k'^2 ln(4/k'))^2, 1e-10
+or better on practical rows, so that one Newton step reaches rounding: the step is
+below 1e-8, so the root is within about 1e-16 of the point it gives, and the answer
+there is taken to first order in that step (its error the step squared) rather than
+by another evaluation of K and E. Rows whose step is still larger (large angles: k'
+near 1, where the series is poor) iterate alone until they converge. So a practical
+row costs one pair of K, E for k' and one for theta0. Checked: the seeds' first steps
+on the benchmark's rows (at most 1.3e-12 for k', 1.3e-10 for theta0), and the answers
+against Newton's method iterated until its steps are at rounding, over theta in
+[1e-7, 1.5] rad and ln g in [-20, ln(pi/2)] (tools/python/tests/test_peer.py).
 
 Its error against the 50-digit data of tests/data and its speed are measured by the
 benchmark, which writes them beside the package's and asserts the error below 2e-14
@@ -30,6 +35,8 @@ _PI = np.pi
 CHUNK = 16384
 #: A Newton step below this (in ln k') has converged: the root is within its square.
 _CONVERGED = 1e-8
+_LN4 = np.log(4.0)
+_C_G = 2.0 / 3.0 * np.log(2.0 / np.pi) + np.log(2.0)
 
 
 def _pair(x):
@@ -49,45 +56,58 @@ def _pair(x):
 
 
 def _solve(residual, x):
-    """Newton's method in x = ln k' on every row: ``residual(x)`` returns the value,
-    its slope and what the caller needs at the root as (values, slopes in x). Returns
-    x and those at the root (to first order in the last step)."""
-    value, slope, at, d_at = residual(x)
+    """Newton's method in x = ln k' on every row: ``residual(x, rows)`` returns the
+    value, its slope and what the caller needs at the root as (values, slopes in x).
+    Returns x and those at the root, to first order in the last step."""
+    value, slope, at, d_at = residual(x, slice(None))
     step = value / slope
     x = np.minimum(x - step, 0.0)
     at = [a - d * step for a, d in zip(at, d_at)]
-    # The second step; rows not converged then (large angles) iterate alone.
-    todo = np.arange(x.size)
+    # Rows whose step was not below _CONVERGED (a poor seed: large angles) iterate
+    # alone, gathered by index.
+    todo = np.flatnonzero(np.abs(step) >= _CONVERGED)
     for _ in range(60):
+        if todo.size == 0:
+            break
         value, slope, at_t, d_t = residual(x[todo], todo)
         step = value / slope
         x[todo] = np.minimum(x[todo] - step, 0.0)
         for a, a_t, d in zip(at, at_t, d_t):
             a[todo] = a_t - d * step
-        still = np.abs(step) >= _CONVERGED
-        if not still.any():
-            break
-        todo = todo[still]
+        todo = todo[np.abs(step) >= _CONVERGED]
     return x, at
 
 
-def _seed_x(theta):
-    """ln k' at theta from the small-k' asymptotics: tan^2(theta/2) = k'^2 (L - 1),
-    L = ln(4/k') (K ~ L, E ~ 1)."""
-    lam = np.log(8.0 / theta) - 1.0
+def _lam(a, q):
+    """lam with lam - q ln lam = a (lam = ln(4/k') - 1, the small-k' variable), by
+    Newton's method from lam = a + q ln a: two steps reach 1e-12 for a >= 5."""
+    a = np.maximum(a, 1.0)
+    lam = a + q * np.log(a)
     for _ in range(2):
-        lam = np.log(8.0 * np.sqrt(lam) / theta) - 1.0
-    return np.log(np.minimum(theta / (2.0 * np.sqrt(lam)), 0.9))
+        lam = np.maximum(lam - (lam - q * np.log(lam) - a) / (1.0 - q / lam), 1.0)
+    return lam
+
+
+def _seed_x(half):
+    """ln k' where tan^2(theta/2) = half^2, from the small-k' series of K and E to
+    second order (K = L + k'^2 (L - 1)/4, E = 1 + k'^2 (L - 1/2)/2, L = ln(4/k')):
+    2 ln k' + ln lam + c = ln tan^2(theta/2), c = k'^2 (L/2 + 1/4 - L/(4 lam)),
+    lam = L - 1. Good to about (k'^2 L)^2."""
+    lam = _lam(_LN4 - 1.0 - np.log(half), 0.5)
+    x = _LN4 - 1.0 - lam
+    L = lam + 1.0
+    c = np.exp(2.0 * x) * (0.5 * L + 0.25 - 0.25 * L / lam)
+    return np.minimum(x - c / (2.0 - 1.0 / lam), np.log(0.9))
 
 
 def _seed_x_of_g(log_g):
-    """ln k' where g = m n theta reaches e^log_g, from the same asymptotics:
-    g^3 = 32 k'^2 lam^(3/2) / pi^2, lam = ln(4/k') - 1."""
-    base = 0.5 * (np.log(_PI * _PI / 32.0) + 3.0 * log_g)  # ln k' + 0.75 ln lam
-    x = base - 0.75 * np.log(np.maximum(np.log(4.0) - base - 1.0, 1.0))
-    for _ in range(2):
-        x = base - 0.75 * np.log(np.maximum(np.log(4.0) - x - 1.0, 1.0))
-    return np.minimum(x, np.log(0.9))
+    """ln k' where g = m n theta reaches e^log_g, from the same series: ln g =
+    2/3 ln k' + 2/3 ln(2/pi) + ln 2 + 1/2 ln lam + c_g, c_g = k'^2 (lam/4 + 5/12 -
+    1/(8 lam))."""
+    lam = _lam(1.5 * (_C_G - log_g) + _LN4 - 1.0, 0.75)
+    x = _LN4 - 1.0 - lam
+    c = np.exp(2.0 * x) * (0.25 * lam + 5.0 / 12.0 - 0.125 / lam)
+    return np.minimum(x - c / (2.0 / 3.0 - 0.5 / lam), np.log(0.9))
 
 
 def _ellipse(theta):
@@ -99,7 +119,7 @@ def _ellipse(theta):
         lt, dlt, lnA, _, _, dA, _ = _pair(x)
         return lt - target[rows], dlt, [lnA], [dA]
 
-    x, (lnA,) = _solve(residual, _seed_x(theta))
+    x, (lnA,) = _solve(residual, _seed_x(half))
     t2 = half * half
     k2 = 1.0 - np.exp(2.0 * x)
     m = np.cbrt(2.0 * np.exp(lnA) * (1.0 + t2) / (_PI * k2 * t2))
