@@ -14,18 +14,15 @@
 
 use misalign::sensors::{CalibrationError, Hx711Channel, ProbeSpec, SensorCalibration, Timeout};
 
-/// The RS-485 line: baud rate (8 data bits, no parity, 1 stop bit: embassy-rp's
-/// defaults) and the node's Modbus unit id. The one place a line setting is made.
+/// The UART's baud rate as built (8 data bits, no parity, 1 stop bit: embassy-rp's
+/// defaults); the unit id and the line settings the server reports are commissioned
+/// (docs/modbus.md, Line settings).
 pub struct Line {
     pub baud: u32,
-    pub unit_id: u8,
 }
 
-/// The line as built: 115200 baud 8N1, unit 1.
-pub const LINE: Line = Line {
-    baud: 115_200,
-    unit_id: 1,
-};
+/// The UART as built: 115200 baud 8N1.
+pub const LINE: Line = Line { baud: 115_200 };
 
 /// The sampling period and the sensors' calibration are commissioned over the bus
 /// (`config_sample_period`, `config_load_zero`, ... in docs/modbus.md) and kept on

@@ -210,9 +210,10 @@ fn main() -> ! {
         sensors: sensors.ok(),
         watchdog,
     };
+    // The unit id and line settings in force are the server's (committed, or the
+    // build's), logged once it has restored them; the UART runs the build's baud.
     defmt::println!(
-        "modbus: unit {=u8} at {=u32} baud 8N1 on UART0, driver enable GP2",
-        board::LINE.unit_id,
+        "modbus: RS-485 on UART0 at {=u32} baud 8N1, driver enable GP2",
         board::LINE.baud
     );
     let served = node::fixed_core().map(|core| {
