@@ -622,31 +622,99 @@ def status(node, events_out, events_from):
     return lines
 
 
-def scan(client, regs, units):
+def crc16(data):
+    """Modbus RTU's CRC-16 (0xA001 reflected, from 0xFFFF), low byte first on the wire."""
+    crc = 0xFFFF
+    for b in data:
+        crc ^= b
+        for _ in range(8):
+            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
+    return bytes([crc & 0xFF, crc >> 8])
+
+
+def ask_raw(client, unit, at, timeout):
+    """A read of two holding registers from `at`, sent on the client's own port as
+    bytes; every byte that comes back within `timeout` s (less once a whole answer
+    is in), so that garbled bytes are seen rather than taken for silence."""
+    import time
+    body = bytes([unit, 3, at >> 8, at & 0xFF, 0, 2])
+    port = client.socket
+    send = port.sendall if hasattr(port, "sendall") else port.write
+
+    def recv():
+        """Bytes now (b"" for none yet); None at the end of the connection."""
+        if hasattr(port, "recv"):
+            try:
+                return port.recv(256) or None
+            except TimeoutError:
+                return b""
+        return port.read(port.in_waiting or 1)
+
+    got = b""
+    kept = port.gettimeout() if hasattr(port, "recv") else None
+    if hasattr(port, "recv"):
+        port.settimeout(0.02)
+    try:
+        # A late answer to the unit asked before is not this one's.
+        if hasattr(port, "recv"):
+            while recv():
+                pass
+        else:
+            port.reset_input_buffer()
+        send(body + crc16(body))
+        deadline = time.monotonic() + timeout
+        extended = False
+        while True:
+            if time.monotonic() >= deadline:
+                # The start of this unit's answer, late: the rest gets as long again.
+                if extended or not (got[:3] == bytes([unit, 3, 4]) and len(got) < 9):
+                    break
+                deadline, extended = time.monotonic() + timeout, True
+            chunk = recv()
+            if chunk is None:
+                break
+            got += chunk
+            if answer_of(got, unit) is not None:
+                break
+    finally:
+        if hasattr(port, "recv"):
+            port.settimeout(kept)
+    return got
+
+
+def answer_of(got, unit):
+    """The two registers of `got` if it is exactly one valid answer of `unit`."""
+    if len(got) == 9 and got[:3] == bytes([unit, 3, 4]) and crc16(got[:7]) == got[7:]:
+        return [got[3] << 8 | got[4], got[5] << 8 | got[6]]
+    return None
+
+
+def scan(client, regs, units, timeout):
     """Each unit id in `units` asked once (`unit_id` and `map_version`): the nodes
-    found as lines, and the clashes (an answer that is not the node asked)."""
-    from pymodbus.exceptions import ModbusIOException
+    found as lines, and the clashes (an answer that is not the node asked: bytes that
+    are not one valid answer, as two nodes answering at once make, or another unit
+    id in `unit_id`)."""
     found, clashes = [], []
     at = int(regs.row("unit_id")["address"])
     for unit in units:
-        try:
-            r = client.read_holding_registers(at, count=2, device_id=unit)
-        except ModbusIOException:
+        got = ask_raw(client, unit, at, timeout)
+        if not got:
             continue
-        except Exception as e:  # noqa: BLE001 (garbled bytes: two nodes answering)
-            clashes.append(f"unit {unit}: clash: {type(e).__name__} (two nodes at one unit id?)")
-            continue
-        if r.isError():
-            if getattr(r, "exception_code", None):
-                clashes.append(f"unit {unit}: exception {r.exception_code} to a read every node "
+        registers = answer_of(got, unit)
+        if registers is None:
+            if len(got) == 5 and got[0] == unit and got[1] == 0x83 and crc16(got[:3]) == got[3:]:
+                clashes.append(f"unit {unit}: exception {got[2]} to a read every node "
                                f"answers: not this map's node")
+            else:
+                clashes.append(f"unit {unit}: clash: {len(got)} bytes that are not one valid answer "
+                               f"(two nodes at one unit id?): {got[:12].hex()}")
             continue
-        if r.registers[0] != unit:
-            clashes.append(f"unit {unit}: answered with unit_id {r.registers[0]} (a clash)")
+        if registers[0] != unit:
+            clashes.append(f"unit {unit}: answered with unit_id {registers[0]} (a clash)")
             continue
         node = Node(client, regs, unit)
         try:
-            found.append(describe(node, r.registers[1]))
+            found.append(describe(node, registers[1]))
         except Exception as e:  # noqa: BLE001 (garbled mid-way: a clash)
             clashes.append(f"unit {unit}: clash while reading it: {e}")
     return found, clashes
@@ -774,7 +842,7 @@ def main():
             print(f"commission: --scan: {e}", file=sys.stderr)
             return 1
         try:
-            found, clashes = scan(client, regs, units)
+            found, clashes = scan(client, regs, units, args.scan_timeout)
         finally:
             client.close()
         for line in found:

@@ -67,15 +67,16 @@ def read_samples(path):
 
 
 class Master:
-    def __init__(self, client, regmap):
+    def __init__(self, client, regmap, unit=UNIT):
         self.c = client
+        self.unit = unit
         self.m = regmap
         self.next_seq = None
         self.events = []
         self.missed = 0
 
     def write(self, address, values):
-        r = self.c.write_registers(address, values, device_id=UNIT)
+        r = self.c.write_registers(address, values, device_id=self.unit)
         assert not r.isError(), f"write {address}+{len(values)}: {r}"
 
     def feed(self, chunk):
@@ -101,7 +102,7 @@ class Master:
         m = self.m
         while True:
             n = m.slot0 + m.slots * m.stride - m.event_first
-            r = self.c.read_input_registers(m.event_first, count=n, device_id=UNIT)
+            r = self.c.read_input_registers(m.event_first, count=n, device_id=self.unit)
             assert not r.isError(), f"event window: {r}"
             w = r.registers
             first = w[0] << 16 | w[1]

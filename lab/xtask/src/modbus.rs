@@ -158,6 +158,12 @@ pub struct Args {
     /// test_line.py, on the Cortex-M4F and the Cortex-M0), without the page.
     #[arg(long, conflicts_with_all = ["boards", "measure", "trace", "serve", "registers", "docs"])]
     stored: bool,
+    /// Eight nodes on one RS-485 line (lab/bus): four Cortex-M4F and three Cortex-M0
+    /// nodes with flash and a Pico, addressed one by one, polled together, through a
+    /// wrong baud rate, a babbler, a stopped node and an unconfirmed change
+    /// (tests/modbus/test_bus.py); each QEMU node's events against the host replay.
+    #[arg(long, conflicts_with_all = ["boards", "measure", "trace", "serve", "registers", "docs", "stored"])]
+    bus: bool,
 }
 
 /// `cargo xtask modbus`.
@@ -170,6 +176,8 @@ pub fn run(args: &Args) -> ExitCode {
         measure()
     } else if let Some(port) = &args.serve {
         serve(port, args.target.as_deref())
+    } else if args.bus {
+        bus()
     } else if args.docs {
         prepare().and_then(|(python, _, _)| docs(&python))
     } else if args.trace.is_some() {
@@ -468,6 +476,78 @@ fn tests(boards: bool, stored_only: bool) -> Result<(), String> {
         return Ok(());
     }
     Err(failures.join("\n"))
+}
+
+/// The samples each QEMU node on the bus is fed: the scenario's first five minutes (its
+/// first event among them), so that seven nodes take them in about a minute at 19200
+/// baud.
+const BUS_SAMPLES: usize = 300;
+
+/// `--bus`: tests/modbus/test_bus.py on eight nodes joined by lab/bus/bus.py, then
+/// each QEMU node's events against the host's replay of the samples it was fed.
+fn bus() -> Result<(), String> {
+    let start = Instant::now();
+    let (python, dir, registers) = prepare()?;
+    crate::tools::preflight_defmt()?;
+    let stored = |id| Node {
+        stored: true,
+        ..Node::on(cpu(id), true)
+    };
+    let m4f = build(&stored("cortex-m4f"))?;
+    let m0 = build(&stored("cortex-m0"))?;
+    let pico = crate::pico::build()?;
+    crate::pico::npm()?;
+    let drive = dir.join("bus-pico-drive.csv");
+    std::fs::write(&drive, crate::pico::drive(&[crate::pico::steady()])?)
+        .map_err(|e| e.to_string())?;
+    let samples: Vec<_> = host::scenario().into_iter().take(BUS_SAMPLES).collect();
+    host::write_samples(&dir.join("bus-samples.csv"), &samples)?;
+    let out = dir.join("bus");
+    let _ = std::fs::remove_dir_all(&out);
+    std::fs::create_dir_all(&out).map_err(|e| e.to_string())?;
+    println!("built in {} s", start.elapsed().as_secs());
+    let status = Command::new(&python)
+        .current_dir(crate::root())
+        .args(["-m", "pytest", "-q", "-s", "-p", "no:cacheprovider"])
+        .arg("tests/modbus/test_bus.py")
+        .env("BUS_M4F_ELF", &m4f)
+        .env("BUS_M0_ELF", &m0)
+        .env("PICO_ELF", &pico)
+        .env("PICO_DRIVE", &drive)
+        .env("MODBUS_REGISTERS", &registers)
+        .env("MODBUS_SAMPLES", dir.join("bus-samples.csv"))
+        .env(
+            "MODBUS_UNLOCK_CODE",
+            misalign::modbus::DEFAULT_UNLOCK_CODE.to_string(),
+        )
+        .env("BUS_OUT", &out)
+        .status()
+        .map_err(|e| format!("pytest: {e}"))?;
+    if !status.success() {
+        return Err(format!("pytest tests/modbus/test_bus.py: {status}"));
+    }
+    for (name, fpu) in [
+        ("m4f-1", true),
+        ("m4f-2", true),
+        ("m4f-3", true),
+        ("m4f-4", true),
+        ("m0-1", false),
+        ("m0-2", false),
+        ("m0-3", false),
+    ] {
+        let raw = out.join(format!("events-{name}.csv"));
+        let compared = host::compare_events(crate::node::core(fpu)?, &samples, &raw)
+            .map_err(|e| format!("{name}: {e}"))?;
+        if compared.events == 0 {
+            return Err(format!("{name}: no event to compare"));
+        }
+        println!(
+            "  {name}: its {} events are the host replay's, bit for bit",
+            compared.events
+        );
+    }
+    println!("the bus test took {} s", start.elapsed().as_secs());
+    Ok(())
 }
 
 /// Every command and snippet of docs/modbus.md, as the page shows them

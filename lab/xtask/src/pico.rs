@@ -123,7 +123,7 @@ pub fn build() -> Result<PathBuf, String> {
 }
 
 /// The harness's packages (`npm ci` from its lock file, once).
-fn npm() -> Result<(), String> {
+pub(crate) fn npm() -> Result<(), String> {
     let lab = crate::root().join("lab/pico");
     let lock = std::fs::read_to_string(lab.join("package-lock.json")).map_err(|e| e.to_string())?;
     let stamp = lab.join("node_modules/.misalign-lock");
@@ -161,7 +161,12 @@ struct Row {
 /// shorter repeat is a steady value, read through the sensor's noise) (flags 1 load,
 /// 2 the probes, 4 and 8 the rails); an empty speed holds the last (the
 /// configuration's nominal speed before one).
-fn drive(samples: &[Sample], settings: &board::SensorSettings) -> Result<String, String> {
+pub(crate) fn drive(samples: &[Sample]) -> Result<String, String> {
+    drive_through(samples, &board::SensorSettings::DEFAULT)
+}
+
+/// [`drive`] through the inverse of `settings`' calibration (the node's in force).
+fn drive_through(samples: &[Sample], settings: &board::SensorSettings) -> Result<String, String> {
     let cal = board::calibration(settings).map_err(|e| format!("the node's calibration: {e}"))?;
     let speed_cal = cal
         .speed
@@ -241,7 +246,7 @@ fn drive(samples: &[Sample], settings: &board::SensorSettings) -> Result<String,
 }
 
 /// The steady process of `--serve` and the checks: 2500 N, 2e-4 rad, 2 m/s.
-fn steady() -> Sample {
+pub(crate) fn steady() -> Sample {
     Sample::new(0, 2500.0, 2e-4).with_speed(2.0)
 }
 
@@ -382,11 +387,7 @@ fn serve(port: u16) -> Result<(), String> {
     let elf = build()?;
     let dir = dir()?;
     let drive_path = dir.join("steady-drive.csv");
-    std::fs::write(
-        &drive_path,
-        drive(&[steady()], &board::SensorSettings::DEFAULT)?,
-    )
-    .map_err(|e| e.to_string())?;
+    std::fs::write(&drive_path, drive(&[steady()])?).map_err(|e| e.to_string())?;
     let flash = dir.join("serve-flash.bin");
     let mut h = Harness::start(
         &elf,
@@ -420,11 +421,7 @@ fn run_trace(
     let dir = dir()?;
     let drive_path = dir.join("trace-drive.csv");
     // Until the node's settings are read back: the build's.
-    std::fs::write(
-        &drive_path,
-        drive(&samples, &board::SensorSettings::DEFAULT)?,
-    )
-    .map_err(|e| e.to_string())?;
+    std::fs::write(&drive_path, drive(&samples)?).map_err(|e| e.to_string())?;
     // The scene's estimator for the trace's operating range, as the monitor example
     // builds it: its prepared bytes go to the node.
     let load_max = samples
@@ -469,7 +466,7 @@ fn run_trace(
     }
     // The sensors driven through the inverse of the calibration the node runs.
     let in_force = read_sensor_settings(h.port)?;
-    std::fs::write(&drive_path, drive(&samples, &in_force)?).map_err(|e| e.to_string())?;
+    std::fs::write(&drive_path, drive_through(&samples, &in_force)?).map_err(|e| e.to_string())?;
     let answer = h.command(&format!("drive {}", drive_path.display()))?;
     if !answer.contains("\"ok\":true") {
         return Err(format!("the harness refused the drive: {answer}"));
@@ -670,11 +667,7 @@ fn flash_image(elf: &[u8]) -> Result<Vec<(u32, Vec<u8>)>, String> {
 fn fresh(elf: &Path, name: &str) -> Result<Harness, String> {
     let dir = dir()?;
     let drive_path = dir.join("steady-drive.csv");
-    std::fs::write(
-        &drive_path,
-        drive(&[steady()], &board::SensorSettings::DEFAULT)?,
-    )
-    .map_err(|e| e.to_string())?;
+    std::fs::write(&drive_path, drive(&[steady()])?).map_err(|e| e.to_string())?;
     let flash = dir.join(format!("{name}-flash.bin"));
     let _ = std::fs::remove_file(&flash);
     Harness::start(
@@ -947,7 +940,7 @@ mod tests {
             Sample::new(1100, f32::NAN, 2e-4),
             Sample::new(1200, 2500.0, f32::NAN).with_speed(1.0),
         ];
-        let d = rows(&drive(&samples, settings).unwrap());
+        let d = rows(&drive_through(&samples, settings).unwrap());
         assert_eq!(d.len(), 3);
         assert_eq!(d[0][0], "0");
         assert_eq!(d[2][0], "200");
@@ -976,7 +969,7 @@ mod tests {
         samples = (0..=stuck / 1000 + 1)
             .map(|s| Sample::new(s * 1000, 2500.0, 2e-4 + s as f32 * 1e-6))
             .collect();
-        let d = rows(&drive(&samples, settings).unwrap());
+        let d = rows(&drive_through(&samples, settings).unwrap());
         let frozen: Vec<bool> = d.iter().map(|r| r[5] == "1").collect();
         let first = frozen.iter().position(|&f| f).unwrap();
         assert_eq!(d[first][0].parse::<u32>().unwrap(), stuck);
