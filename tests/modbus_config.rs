@@ -571,7 +571,7 @@ fn the_committed_image_restores_at_boot() {
     let demo = fresh.monitor().estimator().to_bytes();
     let mut cases: Vec<Vec<u8>> = vec![image[..IMAGE_LEN - 1].to_vec(), vec![0; IMAGE_LEN]];
     let mut bad = image;
-    bad[0] = 4; // a newer image version
+    bad[0] = misalign::modbus::IMAGE_VERSION + 1; // a newer image version
     cases.push(bad.to_vec());
     let mut bad = image;
     bad[1] |= 8; // a flag no version has
@@ -640,8 +640,8 @@ fn latching_and_the_samples_source_are_kept_through_a_reset() {
     assert!(!again.external_samples());
 
     // Version 1: the configuration, and the build's switches.
-    // Versions 1 and 2 are 10 bytes shorter: no line settings.
-    let mut v1 = image[..IMAGE_LEN - 10].to_vec();
+    // Versions 1 and 2 are 62 bytes shorter: no line settings, no sensor settings.
+    let mut v1 = image[..IMAGE_LEN - 62].to_vec();
     v1[0] = 1;
     v1[1] &= 1;
     let monitor = Monitor::new(core(&Scene::DEMO), Config::default()).unwrap();
@@ -758,7 +758,7 @@ mod power_loss {
     };
 
     type Flash = MockFlash<4, 1024, 4>;
-    type S = Store<BlockingFlash<Flash>, 296>;
+    type S = Store<BlockingFlash<Flash>, 348>;
     type Image = ConfigImage<IMAGE_LEN>;
 
     fn open(flash: Flash) -> S {
@@ -841,8 +841,14 @@ mod power_loss {
         assert!(i[134 + bytes.len()..262].iter().all(|&b| b == 0));
         // The line settings: the defaults (unit 1, even parity, 19200 baud, no answer
         // delay, no bus timeout).
-        assert_eq!(i[262..], [1, 2, 0x00, 0x4B, 0, 0, 0, 0, 0, 0]);
+        assert_eq!(i[262..272], [1, 2, 0x00, 0x4B, 0, 0, 0, 0, 0, 0]);
         assert!(spec.contains("| 262 | 1 | the unit id"));
+        // The sensor settings: the defaults, each register's bits u32 little-endian,
+        // the sample period (ms) first.
+        assert_eq!(i[272..276], 100u32.to_le_bytes());
+        assert_eq!(i[276..280], 0f32.to_bits().to_le_bytes());
+        assert_eq!(IMAGE_LEN, 324);
+        assert!(spec.contains("| 272 | 4 | the sample period"));
         // In its record: the frame of every checkpoint record, this payload.
         let mut record = vec![0; codec::record_len(IMAGE_LEN)];
         codec::encode(&image, 9, &mut record).unwrap();
@@ -855,7 +861,7 @@ mod power_loss {
     fn a_power_cut_at_every_point_of_a_commit_leaves_the_old_or_the_new() {
         let mut base = Flash::new();
         let mut points_total = 0;
-        // Enough commits for the map to erase sectors (3 records a sector).
+        // Enough commits for the map to erase sectors (2 records a sector).
         for n in 1..=10u32 {
             let new = image(n);
             // How many points the write takes.

@@ -190,11 +190,9 @@ fn the_reserved_addresses_are_refused() {
     assert_eq!(u32::from(all[1]) << 16 | u32::from(all[2]), 19_200);
     assert_eq!(all[3], Parity::Even as u16);
     assert_eq!(all[12], LINE_CONFIRM_WINDOW_S);
-    assert_eq!(
-        read_table(&mut s, 1, 3, LINE_ADDRESS + 12, 2),
-        Err(2),
-        "past the end"
-    );
+    let end = misalign::modbus::map::HOLDINGS.end();
+    assert!(read_table(&mut s, 1, 3, LINE_ADDRESS + 12, 2).is_ok());
+    assert_eq!(read_table(&mut s, 1, 3, end - 1, 2), Err(2), "past the end");
 }
 
 /// Every line setting needs the unlock; a value outside its domain is refused at the

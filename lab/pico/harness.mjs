@@ -11,7 +11,8 @@
 // skipped while the core sleeps (or paced to the wall clock with --realtime). The
 // node's defmt log (RTT, read from its RAM) is decoded by defmt-print onto stdout; its
 // `sample` lines go to --samples. A control port takes one command a line (answering
-// one JSON line): status, sensor NAME ok|unplugged|stuck, cut N POINTS, reset, quit.
+// one JSON line): status, sensor NAME ok|unplugged|stuck, cut N POINTS, reset,
+// drive PATH (new rows before the trace starts), quit.
 import fs from 'node:fs';
 import net from 'node:net';
 import { spawn } from 'node:child_process';
@@ -98,6 +99,17 @@ class Scheduler {
 /** The trace's rows (DRIVE.csv) at emulated times: row 0 until the anchor. */
 class World {
   constructor(path, sched, periodNs) {
+    this.load(path);
+    this.sched = sched;
+    this.periodNs = periodNs;
+    this.i = 0;
+    this.anchorNs = null;
+    this.anchorMs = null;
+    this.listeners = [];
+    this.next = null;
+  }
+  /** DRIVE.csv's rows (again, before the trace starts: `drive PATH`). */
+  load(path) {
     const lines = fs.readFileSync(path, 'utf8').trim().split('\n');
     const header = lines[0].split(',');
     const col = (n) => header.indexOf(n);
@@ -115,13 +127,6 @@ class World {
         phiBad: !!(flags & 8),
       };
     });
-    this.sched = sched;
-    this.periodNs = periodNs;
-    this.i = 0;
-    this.anchorNs = null;
-    this.anchorMs = null;
-    this.listeners = [];
-    this.next = null;
   }
   current() {
     return this.rows[this.i];
@@ -197,6 +202,10 @@ class Harness {
   }
 
   logLine(line) {
+    // The sampling period the node runs: the trace's rows change half of one before
+    // their time.
+    const period = line.match(/sensors: sample period (\d+) ms/);
+    if (period) this.world.periodNs = Number(period[1]) * 1e6;
     const m = line.match(/sample t=(\d+) P=(\d+) phi=(\d+) measured=(true|false) V=(\d+) fault=(\d+)/);
     if (m) {
       this.samples += 1;
@@ -440,6 +449,18 @@ class Harness {
       case 'reset':
         this.resetPending = true;
         return { ok: true };
+      case 'drive':
+        // New rows for the sensors (the inverse of the calibration the node runs),
+        // before the trace starts.
+        if (this.world.anchorNs !== null) return { error: 'the trace has started' };
+        try {
+          this.world.load(w[1]);
+        } catch (e) {
+          return { error: `drive ${w[1]}: ${e.message}` };
+        }
+        this.world.i = 0;
+        for (const f of this.world.listeners) f();
+        return { ok: true, rows: this.world.rows.length };
       case 'quit':
         setTimeout(() => process.exit(0), 10);
         return { ok: true };

@@ -8,7 +8,9 @@
 
 use embedded_io::{ErrorType, Read, ReadReady, Write};
 use misalign::Estimator;
-use misalign::modbus::{Identification, LineSettings, PreparedScene, Server, ServerConfig};
+use misalign::modbus::{
+    Identification, LineSettings, PreparedScene, SensorSettings, Server, ServerConfig,
+};
 use misalign::monitor::scenario::Scenario;
 use misalign::monitor::{Config, Monitor, Sample};
 
@@ -49,6 +51,11 @@ pub trait Board {
     /// whenever they change (a commit after its answer, a revert): a board sets its
     /// UART's rate and frame to them here. The node has logged them.
     fn line(&mut self, _settings: &LineSettings) {}
+    /// The sampling period and the sensors' calibration in force: at the start (the
+    /// committed image's, or the build's) and after each commit that changed them. A
+    /// board without sensors (the QEMU images: their built-in scenario keeps its own
+    /// timestamps and simulated sensors) ignores them.
+    fn sensors(&mut self, _settings: &SensorSettings) {}
 }
 
 /// The Modbus node: a `misalign::modbus::Server` over the monitor of `core`
@@ -204,6 +211,8 @@ fn serve<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32, B: Board>
     let mut line = server.line();
     log_line(&line);
     board.line(&line);
+    let mut sensors = server.sensors();
+    board.sensors(&sensors);
     let mut uart = Watched {
         uart,
         seen: false,
@@ -242,6 +251,10 @@ fn serve<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32, B: Board>
             log_line(&line);
             board.line(&line);
             uart.delay = u32::from(line.answer_delay_ms).saturating_mul(per_ms);
+        }
+        if server.sensors() != sensors {
+            sensors = server.sensors();
+            board.sensors(&sensors);
         }
         let now = (uart.clock.ticks)();
         let step = now.wrapping_sub(ticked);

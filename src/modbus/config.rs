@@ -18,6 +18,7 @@
 use super::div::div1000;
 use super::exception::Exception;
 use super::line::{LINE_BYTES, Line, LineSettings};
+use super::sensing::{SENSOR_BYTES, Sensing, SensorField, SensorSettings};
 use crate::monitor::annunciation::AlarmSet;
 use crate::monitor::{
     Config, ConfigError, FrictionConfig, Monitor, SpikeFilter, Thresholds, TrendConfig,
@@ -40,13 +41,16 @@ pub const WRONG_CODES_MAX: u8 = 3;
 /// The lock-out's length (s).
 pub const LOCKOUT_S: u32 = 300;
 /// Bytes of the committed configuration's image ([`Server::take_committed`](super::Server::take_committed)).
-pub const IMAGE_LEN: usize = IMAGE_V2_LEN + LINE_BYTES;
+pub const IMAGE_LEN: usize = IMAGE_V3_LEN + SENSOR_BYTES;
 /// Bytes of an image of version 1 or 2 (without the line settings).
 const IMAGE_V2_LEN: usize = 4 + 2 * CONFIG_WORDS + 2 + SCENE_BYTES_MAX;
+/// Bytes of an image of version 3 (without the sensor settings).
+const IMAGE_V3_LEN: usize = IMAGE_V2_LEN + LINE_BYTES;
 /// The image's format version (its byte 0). Version 1 held no switches: its
 /// latching and samples' source stay the build's; versions 1 and 2 (10 bytes
-/// shorter) held no line settings: the build's stay.
-pub const IMAGE_VERSION: u8 = 3;
+/// shorter than 3) held no line settings, versions 1 to 3 (52 bytes shorter than 4)
+/// no sensor settings: the build's stay.
+pub const IMAGE_VERSION: u8 = 4;
 
 /// The image's byte 1: bit 0 a scene follows, bit 1 external samples are taken, bit 2
 /// the scene was committed over the bus (not the build's), bits 4-7 the alarms that
@@ -468,6 +472,8 @@ pub mod staged {
     pub const CODE: u16 = 4;
     /// The line settings were written.
     pub const LINE: u16 = 8;
+    /// The sensor settings (sample period, calibration) were written.
+    pub const SENSORS: u16 = 16;
 }
 
 /// The commissioning registers that are not the configuration's.
@@ -652,6 +658,12 @@ impl<E: Estimator> Commissioning<E> {
         self.touched(staged::CONFIG);
     }
 
+    /// A sensor setting written (the guard passed, the value in its domain).
+    pub(crate) fn write_sensor(&mut self, sensing: &mut Sensing, f: SensorField, v: u32) {
+        sensing.write_staged(f, v);
+        self.touched(staged::SENSORS);
+    }
+
     /// A line setting written (the guard passed, the value in its domain).
     pub(crate) fn write_line(&mut self, line: &mut Line, f: super::line::LineField, v: u32) {
         if line.write_staged(f, v) {
@@ -714,6 +726,7 @@ impl<E: Estimator> Commissioning<E> {
         v: u16,
         monitor: &mut Monitor<E>,
         line: &mut Line,
+        sensing: &mut Sensing,
     ) -> Result<(), Exception> {
         match v {
             command::COMMIT => {
@@ -721,12 +734,14 @@ impl<E: Estimator> Commissioning<E> {
                 self.commit_error = result.err().unwrap_or(reason::NONE);
                 if result.is_ok() {
                     line.commit();
+                    sensing.commit();
                 }
                 result.map_err(|_| Exception::IllegalDataValue)
             }
             command::REVERT => {
                 self.revert();
                 line.revert_staged();
+                sensing.revert_staged();
                 self.unlock_ms = UNLOCK_TIMEOUT_S * 1000;
                 Ok(())
             }
@@ -792,6 +807,7 @@ impl<E: Estimator> Commissioning<E> {
         monitor: &Monitor<E>,
         switches: Switches,
         line: LineSettings,
+        sensors: SensorSettings,
         out: &mut [u8; IMAGE_LEN],
     ) -> bool {
         if !self.unsaved {
@@ -820,7 +836,8 @@ impl<E: Estimator> Commissioning<E> {
             out[at..at + 2].copy_from_slice(&(io.bytes as u16).to_le_bytes());
             (io.save)(monitor.estimator(), &mut out[at + 2..IMAGE_V2_LEN]);
         }
-        out[IMAGE_V2_LEN..].copy_from_slice(&line.to_bytes());
+        out[IMAGE_V2_LEN..IMAGE_V3_LEN].copy_from_slice(&line.to_bytes());
+        out[IMAGE_V3_LEN..].copy_from_slice(&sensors.to_bytes());
         true
     }
 
@@ -830,39 +847,45 @@ impl<E: Estimator> Commissioning<E> {
         &mut self,
         stored: Stored<'_>,
         monitor: &mut Monitor<E>,
-    ) -> (BootSource, Option<Switches>, Option<LineSettings>) {
-        let (mut switches, mut line) = (None, None);
+    ) -> (BootSource, Option<Switches>, Kept) {
+        let (mut switches, mut kept) = (None, Kept::default());
         self.scene_commissioned = false;
         self.source = match stored {
             Stored::Nothing => BootSource::Defaults,
             Stored::Damaged => BootSource::DefaultsDamaged,
             Stored::Image(image) => match self.apply_image(image, monitor) {
-                Some((s, l)) => {
-                    (switches, line) = (s, l);
+                Some((s, k)) => {
+                    (switches, kept) = (s, k);
                     BootSource::Committed
                 }
                 None => BootSource::DefaultsDamaged,
             },
         };
         self.revert();
-        (self.source, switches, line)
+        (self.source, switches, kept)
     }
 
-    /// An image's configuration, code, scene and line settings checked, then applied,
-    /// and its switches (none in a version 1 image) and line settings (none before
-    /// version 3); `None` (and nothing applied) for an image that is not one.
-    #[allow(clippy::type_complexity)]
+    /// An image's configuration, code, scene, line and sensor settings checked, then
+    /// applied, and its switches (none in a version 1 image), line settings (none
+    /// before version 3) and sensor settings (none before version 4); `None` (and
+    /// nothing applied) for an image that is not one.
     fn apply_image(
         &mut self,
         image: &[u8],
         monitor: &mut Monitor<E>,
-    ) -> Option<(Option<Switches>, Option<LineSettings>)> {
+    ) -> Option<(Option<Switches>, Kept)> {
         let (&[version, flags], _) = image.split_first_chunk::<2>()?;
-        let (image, line) = match (version, image.len()) {
-            (1 | 2, IMAGE_V2_LEN) => (image, None),
-            (IMAGE_VERSION, IMAGE_LEN) => {
-                let (v2, line) = image.split_at_checked(IMAGE_V2_LEN)?;
-                (v2, Some(LineSettings::from_bytes(line.try_into().ok()?)?))
+        let mut kept = Kept::default();
+        let image = match (version, image.len()) {
+            (1 | 2, IMAGE_V2_LEN) => image,
+            (3, IMAGE_V3_LEN) | (IMAGE_VERSION, IMAGE_LEN) => {
+                let (v2, rest) = image.split_at_checked(IMAGE_V2_LEN)?;
+                let (line, sensors) = rest.split_at_checked(LINE_BYTES)?;
+                kept.line = Some(LineSettings::from_bytes(line.try_into().ok()?)?);
+                if version == IMAGE_VERSION {
+                    kept.sensors = Some(SensorSettings::from_bytes(sensors.try_into().ok()?)?);
+                }
+                v2
             }
             _ => return None,
         };
@@ -870,7 +893,7 @@ impl<E: Estimator> Commissioning<E> {
         let (_, rest) = image.split_first_chunk::<2>()?;
         let switches = match version {
             1 if flags <= flags::SCENE => None,
-            2 | IMAGE_VERSION
+            2..=IMAGE_VERSION
                 if flags & flags::RESERVED == 0
                     && (flags & flags::SCENE_COMMISSIONED == 0 || flags & flags::SCENE != 0) =>
             {
@@ -902,8 +925,16 @@ impl<E: Estimator> Commissioning<E> {
         }
         self.scene_commissioned = flags & flags::SCENE_COMMISSIONED != 0;
         self.code = u16::from_le_bytes(*code);
-        Some((switches, line))
+        Some((switches, kept))
     }
+}
+
+/// What a committed image keeps beside the configuration: the line settings (from
+/// version 3) and the sensor settings (from version 4).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Kept {
+    pub line: Option<LineSettings>,
+    pub sensors: Option<SensorSettings>,
 }
 
 /// Whole seconds in `ms`, rounded up.

@@ -171,6 +171,10 @@ pub(crate) enum Field {
     /// A line setting in force (`active_unit_id`, ...).
     LineActive(LineField),
     LineConfirmWindow,
+    /// A staged sensor setting (`config_sample_period`, `config_load_zero`, ...).
+    SensorStaged(SensorField),
+    /// A sensor setting in force (`active_sample_period`, ...).
+    SensorActive(SensorField),
     // Coils.
     Acknowledge,
     Latching(AlarmSet),
@@ -328,6 +332,11 @@ impl Entry {
                 LineField::AnswerDelay => Domain::up_to(u32::from(ANSWER_DELAY_MAX_MS)),
                 LineField::BusTimeout => any,
             },
+            F::SensorStaged(f) => match f.bounds() {
+                Bounds::Whole(min, max) => Domain::Whole { min, max },
+                Bounds::Finite(min, max) => Domain::Finite { min, max },
+                Bounds::NonZero(m) => Domain::Finite { min: -m, max: m },
+            },
             F::Staged(f) => match f {
                 G::ThresholdsOn | G::Friction => bit,
                 G::SpikeWindow => Domain::up_to(SPIKE_WINDOW_CAPACITY as u32),
@@ -478,7 +487,7 @@ pub static DISCRETES: TableMap = TableMap {
 
 /// The register map's version (holding register `map_version`): a change of an
 /// address, a type or a meaning increments it.
-pub const MAP_VERSION: u16 = 3;
+pub const MAP_VERSION: u16 = 4;
 
 /// Where the event window's header starts (input registers).
 pub const EVENT_WINDOW_ADDRESS: u16 = 82;
@@ -750,7 +759,7 @@ pub static HOLDINGS: TableMap = TableMap {
         e!(Holding, 12, "config_source", U16, "", R, F::Commission(K::Source),
             "the configuration running: 0 the build-time defaults (none stored), 1 the committed one, 2 the build-time defaults because the stored one was damaged"),
         e!(Holding, 13, "staged", U16, "", R, F::Commission(K::Staged),
-            "what is staged: bit 0 the configuration, bit 1 the scene, bit 2 a new code (0: the staged copy is the active one)"),
+            "what is staged: bit 0 the configuration, bit 1 the scene, bit 2 a new code, bit 3 the line settings, bit 4 the sensor settings (0: the staged copy is the active one)"),
         e!(Holding, 14, "staged_generation", U16, "", R, F::Commission(K::Generation),
             "values written into the staged copy (modulo 2^16): a change between a master's writes and its commit is another master's"),
         e!(Holding, 15, "lockout", U16, "s", R, F::Commission(K::Lockout),
@@ -937,6 +946,14 @@ pub static HOLDINGS: TableMap = TableMap {
             stride: 13,
             fields: &LINE_FIELDS,
         },
+        Block {
+            table: Table::Holding,
+            address: SENSORS_ADDRESS,
+            prefix: "",
+            count: 1,
+            stride: 2 * 2 * SENSOR_FIELDS_N as u16,
+            fields: &SENSOR_FIELDS,
+        },
     ],
 };
 
@@ -972,6 +989,69 @@ static LINE_FIELDS: [Entry; 11] = [
         "the line setting in force (read only); config_ with the same field name is its staged copy"),
     e!(Holding, 12, "line_confirm_window", U16, "s", R, F::LineConfirmWindow,
         "how long a change of the line settings waits for a request at them before the node goes back to the settings before it (read only)"),
+];
+
+/// Where the sensor settings start (holding registers), after the line settings.
+pub const SENSORS_ADDRESS: u16 = LINE_ADDRESS + 13;
+const SENSOR_FIELDS_N: usize = SensorField::ALL.len();
+
+use super::sensing::{Bounds, SensorField};
+use SensorField as Z;
+
+#[rustfmt::skip]
+static SENSOR_FIELDS: [Entry; 2 * SENSOR_FIELDS_N] = [
+    e!(Holding, 0, "config_sample_period", U32, "ms", Rw, F::SensorStaged(Z::SamplePeriod),
+        "needs the unlock; staged: the sampling period: a sample is taken every this long (10 to 60000 ms); committed with command 1, in force at once"),
+    e!(Holding, 2, "config_load_zero", F32, "", Rw, F::SensorStaged(Z::LoadZero),
+        "needs the unlock; staged: the load cell's raw ADC code at zero load (counts; the tare); committed with command 1, in force at once"),
+    e!(Holding, 4, "config_load_scale", F32, "N", Rw, F::SensorStaged(Z::LoadScale),
+        "needs the unlock; staged: the load cell's scale, N per count (not 0; negative for a bridge wired the other way): P = (code - load_zero) * load_scale; committed with command 1, in force at once"),
+    e!(Holding, 6, "config_load_capacity", F32, "N", Rw, F::SensorStaged(Z::LoadCapacity),
+        "needs the unlock; staged: the load cell's rated capacity: loads beyond +- it are out of range; committed with command 1, in force at once"),
+    e!(Holding, 8, "config_probe1_zero", F32, "", Rw, F::SensorStaged(Z::Probe1Zero),
+        "needs the unlock; staged: probe 1's raw ADC code at displacement 0 (counts); committed with command 1, in force at once"),
+    e!(Holding, 10, "config_probe1_scale", F32, "m", Rw, F::SensorStaged(Z::Probe1Scale),
+        "needs the unlock; staged: probe 1's scale, m per count (not 0): d1 = (code - probe1_zero) * probe1_scale; committed with command 1, in force at once"),
+    e!(Holding, 12, "config_probe2_zero", F32, "", Rw, F::SensorStaged(Z::Probe2Zero),
+        "needs the unlock; staged: probe 2's raw ADC code at displacement 0 (counts); committed with command 1, in force at once"),
+    e!(Holding, 14, "config_probe2_scale", F32, "m", Rw, F::SensorStaged(Z::Probe2Scale),
+        "needs the unlock; staged: probe 2's scale, m per count (not 0); committed with command 1, in force at once"),
+    e!(Holding, 16, "config_probe_span", F32, "m", Rw, F::SensorStaged(Z::ProbeSpan),
+        "needs the unlock; staged: the probes' axial span: phi = atan2(d1 - d2 - probe_zero_offset, probe_span); committed with command 1, in force at once"),
+    e!(Holding, 18, "config_probe_zero_offset", F32, "m", Rw, F::SensorStaged(Z::ProbeZeroOffset),
+        "needs the unlock; staged: d1 - d2 in the known-aligned state; committed with command 1, in force at once"),
+    e!(Holding, 20, "config_tacho_pulses_per_rev", U32, "", Rw, F::SensorStaged(Z::PulsesPerRev),
+        "needs the unlock; staged: the tachometer's pulses per revolution of the roller it sees; committed with command 1, in force at once"),
+    e!(Holding, 22, "config_tacho_radius", F32, "m", Rw, F::SensorStaged(Z::Radius),
+        "needs the unlock; staged: that roller's surface radius: V = 2 pi r pulses / (tacho_pulses_per_rev dt); committed with command 1, in force at once"),
+    e!(Holding, 24, "config_tacho_max_speed", F32, "m/s", Rw, F::SensorStaged(Z::MaxSpeed),
+        "needs the unlock; staged: the highest plausible surface speed: above it the speed is out of range; committed with command 1, in force at once"),
+    e!(Holding, 26, "active_sample_period", U32, "ms", R, F::SensorActive(Z::SamplePeriod),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 28, "active_load_zero", F32, "", R, F::SensorActive(Z::LoadZero),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 30, "active_load_scale", F32, "N", R, F::SensorActive(Z::LoadScale),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 32, "active_load_capacity", F32, "N", R, F::SensorActive(Z::LoadCapacity),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 34, "active_probe1_zero", F32, "", R, F::SensorActive(Z::Probe1Zero),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 36, "active_probe1_scale", F32, "m", R, F::SensorActive(Z::Probe1Scale),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 38, "active_probe2_zero", F32, "", R, F::SensorActive(Z::Probe2Zero),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 40, "active_probe2_scale", F32, "m", R, F::SensorActive(Z::Probe2Scale),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 42, "active_probe_span", F32, "m", R, F::SensorActive(Z::ProbeSpan),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 44, "active_probe_zero_offset", F32, "m", R, F::SensorActive(Z::ProbeZeroOffset),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 46, "active_tacho_pulses_per_rev", U32, "", R, F::SensorActive(Z::PulsesPerRev),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 48, "active_tacho_radius", F32, "m", R, F::SensorActive(Z::Radius),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
+    e!(Holding, 50, "active_tacho_max_speed", F32, "m/s", R, F::SensorActive(Z::MaxSpeed),
+        "the sensor setting in force (read only); config_ with the same field name is its staged copy"),
 ];
 
 /// The four tables in the CSV's order.
@@ -1178,6 +1258,7 @@ static SAMPLE_FULL_SLOTS: [Slot; SAMPLE_FULL_FIELDS.len()] = slots(&SAMPLE_FULL_
 static EVENT_FIELD_SLOTS: [Slot; EVENT_FIELDS.len()] = slots(&EVENT_FIELDS);
 static SCENE_SLOTS: [Slot; SCENE_FIELDS.len()] = slots(&SCENE_FIELDS);
 static LINE_SLOTS: [Slot; LINE_FIELDS.len()] = slots(&LINE_FIELDS);
+static SENSOR_SLOTS: [Slot; SENSOR_FIELDS.len()] = slots(&SENSOR_FIELDS);
 static LINE_INPUT_SLOTS: [Slot; LINE_INPUT_FIELDS.len()] = slots(&LINE_INPUT_FIELDS);
 
 /// One table as the server holds it: `$map`'s entries as slots, its index, its blocks
@@ -1215,7 +1296,8 @@ static HOLDINGS_SERVED: Served = served!(
         SlotBlock::of(&HOLDINGS.blocks[0], &SAMPLE_SLOTS),
         SlotBlock::of(&HOLDINGS.blocks[1], &SAMPLE_FULL_SLOTS),
         SlotBlock::of(&HOLDINGS.blocks[2], &SCENE_SLOTS),
-        SlotBlock::of(&HOLDINGS.blocks[3], &LINE_SLOTS)
+        SlotBlock::of(&HOLDINGS.blocks[3], &LINE_SLOTS),
+        SlotBlock::of(&HOLDINGS.blocks[4], &SENSOR_SLOTS)
     ]
 );
 

@@ -106,6 +106,7 @@ mod line;
 pub mod map;
 mod pdu;
 pub mod rtu;
+mod sensing;
 mod state;
 mod values;
 
@@ -124,6 +125,7 @@ pub use line::{
 };
 pub use map::registers_csv;
 pub use rtu::{ADU_MAX, FramingCounters};
+pub use sensing::{SAMPLE_PERIOD_MS, SensorSettings};
 pub use state::Counters;
 pub use values::{DecodeError, NONE, event_from_registers, fault_code, fault_from_code};
 
@@ -134,6 +136,7 @@ use core::fmt;
 use events::EventWindow;
 use line::Line;
 use rtu::Framer;
+use sensing::Sensing;
 use state::{Core, Step};
 
 /// The default unit id.
@@ -152,7 +155,7 @@ pub const fn silence_us(baud: u32) -> u32 {
 }
 
 /// The server's configuration.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ServerConfig {
     /// The unit id (1 to 247; default 1).
@@ -177,6 +180,9 @@ pub struct ServerConfig {
     /// ([`LineSettings::DEFAULT`]'s: 19200 baud, even parity, no answer delay, no bus
     /// timeout); their `unit_id` is ignored: `unit_id` above is the node's.
     pub line: LineSettings,
+    /// The sampling period and the sensors' calibration, until a committed image's
+    /// replace them ([`SensorSettings::DEFAULT`]: the reference node's).
+    pub sensors: SensorSettings,
 }
 
 impl ServerConfig {
@@ -199,6 +205,7 @@ impl Default for ServerConfig {
             unlock_code: DEFAULT_UNLOCK_CODE,
             scene_required: false,
             line: LineSettings::DEFAULT,
+            sensors: SensorSettings::DEFAULT,
         }
     }
 }
@@ -211,6 +218,8 @@ pub enum ServerConfigError {
     UnitId,
     /// A line setting the node does not take.
     Line(LineError),
+    /// A sensor setting outside its register's domain.
+    Sensors,
 }
 
 impl fmt::Display for ServerConfigError {
@@ -218,6 +227,9 @@ impl fmt::Display for ServerConfigError {
         match self {
             ServerConfigError::UnitId => f.write_str("the unit id must be 1 to 247"),
             ServerConfigError::Line(e) => write!(f, "line settings: {e}"),
+            ServerConfigError::Sensors => {
+                f.write_str("a sensor setting is outside its register's domain")
+            }
         }
     }
 }
@@ -252,6 +264,9 @@ impl<E: Estimator> Server<E> {
         }
         let line = config.line_settings();
         line.validate().map_err(ServerConfigError::Line)?;
+        if !config.sensors.is_valid() {
+            return Err(ServerConfigError::Sensors);
+        }
         let pending = monitor.pending_events() as u32;
         let monitor_next = monitor.next_event_seq();
         let from = monitor_next.wrapping_sub(pending);
@@ -265,6 +280,7 @@ impl<E: Estimator> Server<E> {
             core: Core {
                 commissioning: Commissioning::new(config.unlock_code),
                 line: Line::new(line),
+                sensing: Sensing::new(config.sensors),
                 monitor,
                 step,
                 unit: config.unit_id,
@@ -355,6 +371,14 @@ impl<E: Estimator> Server<E> {
     pub fn sent(&mut self) {
         self.core.response_len = 0;
         self.core.line_sent();
+    }
+
+    /// The sampling period and sensor calibration in force (`active_sample_period`,
+    /// `active_load_zero`, ...): committed over the bus, restored from the committed
+    /// image, or the build's. Read it after each request and at boot, and recalibrate
+    /// the sensors' drivers when it changed.
+    pub fn sensors(&self) -> SensorSettings {
+        self.core.sensing.active()
     }
 
     /// The line settings in force (`active_*`): after each [`sent`](Self::sent) and
@@ -471,7 +495,7 @@ impl<E: Estimator> Server<E> {
             external: c.external,
         };
         c.commissioning
-            .take_committed(&c.monitor, switches, c.line.kept(), out)
+            .take_committed(&c.monitor, switches, c.line.kept(), c.sensing.active(), out)
     }
 
     /// At boot: applies the configuration the application restored from its storage,
@@ -481,14 +505,17 @@ impl<E: Estimator> Server<E> {
     /// reads after it.
     pub fn restore(&mut self, stored: Stored<'_>) -> BootSource {
         let c = &mut self.core;
-        let (source, switches, line) = c.commissioning.restore(stored, &mut c.monitor);
+        let (source, switches, kept) = c.commissioning.restore(stored, &mut c.monitor);
         if let Some(s) = switches {
             c.annunciator.set_latching(s.latching);
             c.external = s.external;
         }
-        if let Some(l) = line {
+        if let Some(l) = kept.line {
             c.line.restore(l);
             c.unit = l.unit_id;
+        }
+        if let Some(s) = kept.sensors {
+            c.sensing.restore(s);
         }
         source
     }

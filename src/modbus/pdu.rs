@@ -565,6 +565,10 @@ impl<E: Estimator> Core<E> {
                 self.commissioning.guard()?;
                 f.takes(v)
             }
+            Field::SensorStaged(f) => {
+                self.commissioning.guard()?;
+                f.takes(v)
+            }
             Field::Commission(Reg::Command | Reg::NewCode) | Field::Staged(_) => {
                 self.commissioning.guard()?;
                 !matches!(
@@ -616,10 +620,16 @@ impl<E: Estimator> Core<E> {
             Field::ExternalMode => self.switch(self.annunciator.latching(), v != 0),
             Field::Staged(f) => c.write_staged(f, v, self.monitor.config()),
             Field::LineStaged(f) => c.write_line(&mut self.line, f, v),
+            Field::SensorStaged(f) => c.write_sensor(&mut self.sensing, f, v),
             Field::Commission(Reg::NewCode) => c.write_new_code(v as u16),
             Field::Commission(Reg::Unlock) => c.unlock(v as u16)?,
             Field::Commission(Reg::Command) => {
-                c.command(v as u16, &mut self.monitor, &mut self.line)?;
+                c.command(
+                    v as u16,
+                    &mut self.monitor,
+                    &mut self.line,
+                    &mut self.sensing,
+                )?;
                 // The events lost count with the statistics (`events_dropped`): the
                 // window's share starts afresh with the monitor's.
                 if v == u32::from(super::config::command::RESET_STATISTICS) {

@@ -8,6 +8,7 @@ use super::events::{EventWindow, StorageStatus};
 use super::ident::Identification;
 use super::line::{Line, Raised};
 use super::rtu::{ADU_MAX, FramingCounters};
+use super::sensing::Sensing;
 use crate::Estimator;
 use crate::monitor::annunciation::{AlarmSet, Annunciator};
 use crate::monitor::{Monitor, RiskState, Sample};
@@ -64,6 +65,8 @@ pub(super) struct Core<E> {
     pub(super) commissioning: Commissioning<E>,
     /// The line settings: staged, in force, kept; the master's supervision.
     pub(super) line: Line,
+    /// The sampling period and the sensors' calibration: staged, in force.
+    pub(super) sensing: Sensing,
 }
 
 impl<E: Estimator> Core<E> {

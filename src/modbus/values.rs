@@ -429,6 +429,8 @@ impl<E: Estimator> Core<E> {
             Field::Commission(_) | Field::Staged(_) => 0,
             Field::Active(f) => super::config::active(f, self.monitor.config()),
             Field::LineStaged(f) => self.line.staged_value(f),
+            Field::SensorStaged(f) => self.sensing.staged_value(f),
+            Field::SensorActive(f) => self.sensing.active().get(f),
             Field::LineActive(f) => self.line.active().get(f),
             Field::LineConfirmWindow => u32::from(super::line::LINE_CONFIRM_WINDOW_S),
             Field::LineReverts => self.line.reverts(),

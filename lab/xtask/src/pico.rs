@@ -11,7 +11,8 @@
 //! - `--trace T.csv --scene S.csv --events OUT.csv [--samples SAMPLES.csv]`: commissions
 //!   the scene over the bus (tools/commission.py: the scene prepared for the node's
 //!   fixed-point core and the default configuration), drives the sensors from the
-//!   trace (through the inverse of the node's calibration, `nodes/pico/src/board.rs`),
+//!   trace (through the inverse of the calibration the node runs, read over the bus;
+//!   `--settings C.csv` commits one, and the sample period, before the scene),
 //!   reads the events over Modbus into OUT (the monitor example's `--events` format)
 //!   and writes to SAMPLES what the node's sensors delivered (the monitor example's
 //!   trace format): `cargo run --example monitor -- --model fixed --scene S.csv
@@ -58,6 +59,10 @@ pub struct Args {
     /// Where to write the samples the node's sensors delivered (a trace).
     #[arg(long, value_name = "SAMPLES.csv")]
     samples: Option<String>,
+    /// Settings committed before the scene (`name,value` lines as tools/commission.py
+    /// --config takes them: the sample period and the sensors' calibration, ...).
+    #[arg(long, value_name = "C.csv", requires = "trace")]
+    settings: Option<String>,
     /// Write the image as a UF2 file.
     #[arg(long, value_name = "OUT.uf2")]
     uf2: Option<String>,
@@ -79,6 +84,7 @@ pub fn run(args: &Args) -> std::process::ExitCode {
             Path::new(scene),
             Path::new(events),
             args.samples.as_deref().map(Path::new),
+            args.settings.as_deref().map(Path::new),
         )
     } else if let Some(out) = &args.uf2 {
         uf2(Path::new(out))
@@ -156,11 +162,19 @@ struct Row {
 /// 2 the probes, 4 and 8 the rails); an empty speed holds the last (the
 /// configuration's nominal speed before one).
 pub(crate) fn drive(samples: &[Sample]) -> Result<String, String> {
-    let cal = board::calibration().map_err(|e| format!("the node's calibration: {e}"))?;
+    drive_through(samples, &board::SensorSettings::DEFAULT)
+}
+
+/// [`drive`] through the inverse of `settings`' calibration (the node's in force).
+fn drive_through(samples: &[Sample], settings: &board::SensorSettings) -> Result<String, String> {
+    let cal = board::calibration(settings).map_err(|e| format!("the node's calibration: {e}"))?;
+    let speed_cal = cal
+        .speed
+        .ok_or("the node's calibration has no tachometer")?;
     let volts_per_code = board::ADS1115_FULL_SCALE_V / 32768.0;
     let pulse_hz = |v: f32| {
-        f64::from(v.max(0.0)) * f64::from(cal.speed.pulses_per_rev)
-            / (2.0 * std::f64::consts::PI * f64::from(cal.speed.radius_m))
+        f64::from(v.max(0.0)) * f64::from(speed_cal.pulses_per_rev)
+            / (2.0 * std::f64::consts::PI * f64::from(speed_cal.radius_m))
     };
     let config = misalign::monitor::Config::default();
     let mut speed = pulse_hz(config.nominal_speed);
@@ -193,7 +207,7 @@ pub(crate) fn drive(samples: &[Sample]) -> Result<String, String> {
             flags |= 4;
             0
         };
-        let pr = &cal.probes;
+        let pr = &cal.misalignment;
         let d1 = D2_M + pr.zero_offset_m + pr.span_m * libm::tanf(s.phi);
         let probe_v = if s.phi.is_finite() {
             [
@@ -396,6 +410,7 @@ fn run_trace(
     scene: &Path,
     events_out: &Path,
     samples_out: Option<&Path>,
+    settings: Option<&Path>,
 ) -> Result<(), String> {
     let open = |p: &Path| std::fs::File::open(p).map_err(|e| format!("{}: {e}", p.display()));
     let scene_v = misalign_cli::monitor_input::read_scene(open(scene)?)
@@ -405,6 +420,7 @@ fn run_trace(
     let elf = build()?;
     let dir = dir()?;
     let drive_path = dir.join("trace-drive.csv");
+    // Until the node's settings are read back: the build's.
     std::fs::write(&drive_path, drive(&samples)?).map_err(|e| e.to_string())?;
     // The scene's estimator for the trace's operating range, as the monitor example
     // builds it: its prepared bytes go to the node.
@@ -435,6 +451,26 @@ fn run_trace(
         },
     )?;
     let code = misalign::modbus::DEFAULT_UNLOCK_CODE.to_string();
+    // The node answers (its first answer may take seconds of the emulator's warm-up).
+    read_holding(h.port, 0)?;
+    if let Some(settings) = settings {
+        // Committed before the scene: the node samples nothing until the scene is.
+        let args = [
+            "--code".as_ref(),
+            code.as_ref(),
+            "--config".as_ref(),
+            settings.as_os_str(),
+        ];
+        crate::modbus::commission_py(&python, h.port, &registers, &args)
+            .map_err(|e| format!("committing {}: {e}", settings.display()))?;
+    }
+    // The sensors driven through the inverse of the calibration the node runs.
+    let in_force = read_sensor_settings(h.port)?;
+    std::fs::write(&drive_path, drive_through(&samples, &in_force)?).map_err(|e| e.to_string())?;
+    let answer = h.command(&format!("drive {}", drive_path.display()))?;
+    if !answer.contains("\"ok\":true") {
+        return Err(format!("the harness refused the drive: {answer}"));
+    }
     let args = [
         "--code".as_ref(),
         code.as_ref(),
@@ -736,32 +772,69 @@ fn holding_address(name: &str) -> Result<u16, String> {
         .ok_or_else(|| format!("no holding register {name}"))
 }
 
-/// One holding register of unit 1 on 127.0.0.1:`port` (function 3, an RTU frame on
-/// the bridge), asked up to five times.
+/// One holding register of unit 1 on 127.0.0.1:`port`.
 fn read_holding(port: u16, address: u16) -> Result<u16, String> {
+    Ok(read_holdings(port, address, 1)?[0])
+}
+
+/// `n` (at most 125) holding registers of unit 1 on 127.0.0.1:`port` from `address`
+/// (function 3, an RTU frame on the bridge), asked up to five times.
+fn read_holdings(port: u16, address: u16, n: u16) -> Result<Vec<u16>, String> {
     let mut frame = vec![1, 3];
     frame.extend_from_slice(&address.to_be_bytes());
-    frame.extend_from_slice(&1u16.to_be_bytes());
+    frame.extend_from_slice(&n.to_be_bytes());
     frame.extend_from_slice(&misalign::modbus::crc16(&frame).to_le_bytes());
+    let len = 5 + 2 * usize::from(n);
     let mut last = String::new();
     for _ in 0..5 {
         let mut s = TcpStream::connect(("127.0.0.1", port)).map_err(|e| e.to_string())?;
         s.set_read_timeout(Some(Duration::from_secs(5)))
             .map_err(|e| e.to_string())?;
         s.write_all(&frame).map_err(|e| e.to_string())?;
-        let mut answer = [0u8; 7];
+        let mut answer = vec![0u8; len];
         match s.read_exact(&mut answer) {
             Ok(())
-                if answer[..3] == [1, 3, 2]
-                    && misalign::modbus::crc16(&answer[..5]).to_le_bytes() == answer[5..] =>
+                if answer[..3] == [1, 3, (2 * n) as u8]
+                    && misalign::modbus::crc16(&answer[..len - 2]).to_le_bytes()
+                        == answer[len - 2..] =>
             {
-                return Ok(u16::from_be_bytes([answer[3], answer[4]]));
+                return Ok(answer[3..len - 2]
+                    .chunks_exact(2)
+                    .map(|c| u16::from_be_bytes([c[0], c[1]]))
+                    .collect());
             }
             Ok(()) => last = format!("the answer {answer:02x?}"),
             Err(e) => last = e.to_string(),
         }
     }
-    Err(format!("reading holding register {address}: {last}"))
+    Err(format!("reading holding registers from {address}: {last}"))
+}
+
+/// The sensor settings in force on the node (`active_sample_period` on, 13 values of
+/// two registers, high word first, in the image's order).
+fn read_sensor_settings(port: u16) -> Result<board::SensorSettings, String> {
+    let at = holding_address("active_sample_period")?;
+    let w = read_holdings(port, at, 26)?;
+    let v: Vec<u32> = w
+        .chunks_exact(2)
+        .map(|c| u32::from(c[0]) << 16 | u32::from(c[1]))
+        .collect();
+    let f = |i: usize| f32::from_bits(v[i]);
+    Ok(board::SensorSettings {
+        sample_period_ms: v[0],
+        load_zero_counts: f(1),
+        load_newtons_per_count: f(2),
+        load_capacity_n: f(3),
+        probe1_zero_counts: f(4),
+        probe1_metres_per_count: f(5),
+        probe2_zero_counts: f(6),
+        probe2_metres_per_count: f(7),
+        probe_span_m: f(8),
+        probe_zero_offset_m: f(9),
+        tacho_pulses_per_rev: v[10],
+        tacho_radius_m: f(11),
+        tacho_max_speed_m_s: f(12),
+    })
 }
 
 /// The stack's reservation (nodes/pico/memory.x) keeps at least this much (bytes) above
@@ -843,30 +916,48 @@ mod tests {
 
     #[test]
     fn the_drive_inverts_the_calibration_and_marks_what_a_sensor_cannot_read() {
-        let cal = board::calibration().unwrap();
+        let site = board::SensorSettings {
+            load_zero_counts: -3000.0,
+            load_newtons_per_count: -0.01,
+            probe1_zero_counts: 5000.0,
+            probe2_metres_per_count: 1.2e-7,
+            probe_span_m: 0.3,
+            probe_zero_offset_m: 2e-6,
+            tacho_pulses_per_rev: 360,
+            tacho_radius_m: 0.08,
+            ..board::SensorSettings::DEFAULT
+        };
+        for settings in [board::SensorSettings::DEFAULT, site] {
+            inverts(&settings);
+        }
+    }
+
+    fn inverts(settings: &board::SensorSettings) {
+        let cal = board::calibration(settings).unwrap();
+        let speed = cal.speed.unwrap();
         let mut samples = vec![
             Sample::new(1000, 2500.0, 2e-4).with_speed(2.0),
             Sample::new(1100, f32::NAN, 2e-4),
             Sample::new(1200, 2500.0, f32::NAN).with_speed(1.0),
         ];
-        let d = rows(&drive(&samples).unwrap());
+        let d = rows(&drive_through(&samples, settings).unwrap());
         assert_eq!(d.len(), 3);
         assert_eq!(d[0][0], "0");
         assert_eq!(d[2][0], "200");
         // The load's code reads back as the load, to a code.
         let code: i32 = d[0][1].parse().unwrap();
-        assert!((cal.load.newtons(code) - 2500.0).abs() <= cal.load.newtons_per_count);
+        assert!((cal.load.newtons(code) - 2500.0).abs() <= cal.load.newtons_per_count.abs());
         // Probe 1 sits span * tan(phi) beyond probe 2: the angle back from the volts.
         let v1: f32 = d[0][2].parse().unwrap();
         let v2: f32 = d[0][3].parse().unwrap();
         let counts = |v: f32| (v / (board::ADS1115_FULL_SCALE_V / 32768.0)).round() as i32;
-        let pr = cal.probes;
+        let pr = cal.misalignment;
         let phi = pr.phi(pr.probe1.metres(counts(v1)), pr.probe2.metres(counts(v2)));
         assert!((phi - 2e-4).abs() < 3e-7, "{phi}");
         // The pulse rate of 2 m/s, held where the trace has no speed, then 1 m/s.
         let hz = |r: &Vec<String>| r[4].parse::<f64>().unwrap();
-        let per_m = f64::from(cal.speed.pulses_per_rev)
-            / (2.0 * std::f64::consts::PI * f64::from(cal.speed.radius_m));
+        let per_m = f64::from(speed.pulses_per_rev)
+            / (2.0 * std::f64::consts::PI * f64::from(speed.radius_m));
         assert!((hz(&d[0]) - 2.0 * per_m).abs() < 1e-6);
         assert_eq!(hz(&d[1]), hz(&d[0]));
         assert!((hz(&d[2]) - per_m).abs() < 1e-6);
@@ -878,7 +969,7 @@ mod tests {
         samples = (0..=stuck / 1000 + 1)
             .map(|s| Sample::new(s * 1000, 2500.0, 2e-4 + s as f32 * 1e-6))
             .collect();
-        let d = rows(&drive(&samples).unwrap());
+        let d = rows(&drive_through(&samples, settings).unwrap());
         let frozen: Vec<bool> = d.iter().map(|r| r[5] == "1").collect();
         let first = frozen.iter().position(|&f| f).unwrap();
         assert_eq!(d[first][0].parse::<u32>().unwrap(), stuck);

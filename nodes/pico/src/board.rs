@@ -1,5 +1,5 @@
-//! The board in one place: the pins, the RS-485 line's settings, the sampling period,
-//! the sensors' calibration (docs/pico.md draws the same table for the technician).
+//! The board in one place: the pins, the RS-485 line's settings, what the build fixes
+//! of the sensors (docs/pico.md draws the same table for the technician).
 //!
 //! | signal | Pico pin | to |
 //! |---|---|---|
@@ -12,29 +12,30 @@
 //! | HX711 DOUT | GP10 | input with pull-up |
 //! | HX711 PD_SCK | GP11 | push-pull output |
 
-use misalign::sensors::{
-    CalibrationError, Hx711Channel, LoadCalibration, MisalignmentCalibration, ProbeCalibration,
-    ProbeSpec, SpeedCalibration, Timeout,
-};
+use misalign::sensors::{CalibrationError, Hx711Channel, ProbeSpec, SensorCalibration, Timeout};
 
-/// The RS-485 line: baud rate (8 data bits, no parity, 1 stop bit: embassy-rp's
-/// defaults) and the node's Modbus unit id. The one place a line setting is made.
+/// The UART's baud rate as built (8 data bits, no parity, 1 stop bit: embassy-rp's
+/// defaults); the unit id and the line settings the server reports are commissioned
+/// (docs/modbus.md, Line settings).
 pub struct Line {
     pub baud: u32,
-    pub unit_id: u8,
 }
 
-/// The line as built: 115200 baud 8N1, unit 1.
-pub const LINE: Line = Line {
-    baud: 115_200,
-    unit_id: 1,
-};
+/// The UART as built: 115200 baud 8N1.
+pub const LINE: Line = Line { baud: 115_200 };
 
-/// The sampling period (µs of the RP2040's 1 MHz timer): 10 samples a second. The
-/// HX711 converts at 80 samples a second (its RATE pin high) and the ADS1115 at 860,
-/// so that each sample takes a conversion at most 12.5 ms old and its reads hold the
-/// Modbus loop up for at most that long plus two of the ADS1115's 1.2 ms.
-pub const SAMPLE_PERIOD_US: u64 = 100_000;
+/// The sampling period and the sensors' calibration are commissioned over the bus
+/// (`config_sample_period`, `config_load_zero`, ... in docs/modbus.md) and kept on
+/// flash; until a site's are committed the node runs the library's
+/// `SensorSettings::DEFAULT`, the data sheets' values of the parts below: 10 samples a
+/// second; the load cell 2 mV/V, 20 kN, on the HX711's channel A at gain 128; each
+/// probe 4-20 mA over 0 to 2 mm through a 150 Ohm shunt (0.6 to 3.0 V), read at
+/// +-4.096 V (4800 codes at 0 mm, 24000 at 2 mm), the two 0.4 m apart; a 1024-line
+/// encoder on the measured roller's shaft (radius 50 mm), 10 m/s at most. The HX711
+/// converts at 80 samples a second (its RATE pin high) and the ADS1115 at 860, so that
+/// at the default period each sample takes a conversion at most 12.5 ms old and its
+/// reads hold the Modbus loop up for at most that long plus two of the ADS1115's 1.2 ms.
+pub use misalign::modbus::SensorSettings;
 
 /// The watchdog's timeout (ms): longer than any pass of the node's loop (a sample
 /// whose HX711 never becomes ready waits 50 ms; a sector erase 400 ms at most).
@@ -52,53 +53,18 @@ pub const ADS1115_TIMEOUT: Timeout = Timeout {
 /// The ADS1115's full-scale range (V): +-4.096 V, 8000 codes a volt.
 pub const ADS1115_FULL_SCALE_V: f32 = 4.096;
 
-/// The load cell: 2 mV/V, 20 kN, on the HX711's channel A at gain 128.
-pub const LOAD_RATED_MV_PER_V: f32 = 2.0;
-pub const LOAD_CAPACITY_N: f32 = 20e3;
+/// The HX711's channel and gain the load cell is wired to (the build's: not
+/// commissioned).
+pub const LOAD_CHANNEL: Hx711Channel = Hx711Channel::A128;
 
-/// Each probe: 4-20 mA over 0 to 2 mm through a 150 Ohm shunt (0.6 to 3.0 V), read
-/// at +-4.096 V: 4800 codes at 0 mm, 24000 at 2 mm; linear to 4 µm.
+/// Each probe's range and linearity (its data sheet: 0 to 2 mm, linear to 4 µm).
 pub const PROBE_SPEC: ProbeSpec = ProbeSpec {
     min_m: 0.0,
     max_m: 2e-3,
     linearity_m: 4e-6,
 };
-pub const PROBE_POINTS: [(f32, f32); 2] = [(4800.0, 0.0), (24000.0, 2e-3)];
-/// The probes' axial span (m) and the zero offset of the aligned state (m).
-pub const PROBE_SPAN_M: f32 = 0.4;
-pub const PROBE_ZERO_OFFSET_M: f32 = 0.0;
 
-/// The tachometer: a 1024-line encoder on the measured roller's shaft (radius 50 mm),
-/// 10 m/s at most.
-pub const SPEED: SpeedCalibration = SpeedCalibration {
-    pulses_per_rev: 1024,
-    radius_m: 0.05,
-    max_speed_m_s: 10.0,
-};
-
-/// The sensors' calibration as built (the data sheets' values; a site's own replaces
-/// them after the procedure of docs/SENSORS.md).
-pub struct Calibration {
-    pub load: LoadCalibration<Hx711Channel>,
-    pub probes: MisalignmentCalibration,
-    pub speed: SpeedCalibration,
-}
-
-/// The calibration, checked.
-pub fn calibration() -> Result<Calibration, CalibrationError> {
-    let probe = ProbeCalibration::two_point(PROBE_POINTS[0], PROBE_POINTS[1], PROBE_SPEC)?;
-    Ok(Calibration {
-        load: LoadCalibration::from_rated_output(
-            Hx711Channel::A128,
-            LOAD_RATED_MV_PER_V,
-            LOAD_CAPACITY_N,
-        )?,
-        probes: MisalignmentCalibration {
-            probe1: probe,
-            probe2: probe,
-            span_m: PROBE_SPAN_M,
-            zero_offset_m: PROBE_ZERO_OFFSET_M,
-        },
-        speed: SPEED,
-    })
+/// The sensors' calibration of the settings in force, checked.
+pub fn calibration(settings: &SensorSettings) -> Result<SensorCalibration, CalibrationError> {
+    settings.calibration(LOAD_CHANNEL, PROBE_SPEC)
 }

@@ -1,8 +1,9 @@
 //! The monitoring node on a Raspberry Pi Pico (RP2040, Cortex-M0+), the board a user
 //! flashes (docs/pico.md: pins, parts, power, putting the image on a board): the load
 //! cell on an HX711, two displacement probes on an ADS1115, a tachometer's pulses
-//! (`sensors.rs`), sampled on the RP2040's timer every 100 ms (the HX711 at 80 samples a second, the
-//! ADS1115 at 860) and sleeping between
+//! (`sensors.rs`), sampled on the RP2040's timer at the committed period (100 ms until
+//! one is; the HX711 at 80 samples a second, the ADS1115 at 860) through the committed
+//! calibration, and sleeping between
 //! samples and requests (`sleep.rs`); Modbus RTU over RS-485 on UART0 with the
 //! transceiver's driver enable (`board.rs`: the pins and the line in one place); its
 //! state, committed configuration and events on its own QSPI flash (`flash.rs`), in
@@ -131,6 +132,27 @@ impl serve::Board for Pico {
         self.watchdog
             .feed(Duration::from_millis(board::WATCHDOG_MS));
     }
+
+    fn sensors(&mut self, settings: &board::SensorSettings) {
+        defmt::println!(
+            "sensors: sample period {=u32} ms, load zero {=f32} scale {=f32} N/count, probes zero {=f32} {=f32} scale {=f32} {=f32} m/count span {=f32} m, tachometer {=u32} pulses/rev radius {=f32} m",
+            settings.sample_period_ms,
+            settings.load_zero_counts,
+            settings.load_newtons_per_count,
+            settings.probe1_zero_counts,
+            settings.probe2_zero_counts,
+            settings.probe1_metres_per_count,
+            settings.probe2_metres_per_count,
+            settings.probe_span_m,
+            settings.tacho_pulses_per_rev,
+            settings.tacho_radius_m
+        );
+        if let Some(s) = self.sensors.as_mut()
+            && let Err(e) = s.settings(settings)
+        {
+            defmt::error!("sensors: the drivers refused the calibration: {}", e);
+        }
+    }
 }
 
 #[cortex_m_rt::entry]
@@ -179,6 +201,7 @@ fn main() -> ! {
         i2c,
         pulses,
         Input::new(p.PIN_6, Pull::Down),
+        &board::SensorSettings::DEFAULT,
     );
     if let Err(e) = &sensors {
         defmt::error!("node: the sensors' calibration refused: {}", e);
@@ -187,9 +210,10 @@ fn main() -> ! {
         sensors: sensors.ok(),
         watchdog,
     };
+    // The unit id and line settings in force are the server's (committed, or the
+    // build's), logged once it has restored them; the UART runs the build's baud.
     defmt::println!(
-        "modbus: unit {=u8} at {=u32} baud 8N1 on UART0, driver enable GP2",
-        board::LINE.unit_id,
+        "modbus: RS-485 on UART0 at {=u32} baud 8N1, driver enable GP2",
         board::LINE.baud
     );
     let served = node::fixed_core().map(|core| {

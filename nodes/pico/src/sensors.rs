@@ -2,8 +2,9 @@
 //! on an HX711 (`Hx711` over two GPIOs), the two displacement probes on an ADS1115
 //! over I2C0 (`ads1x1x`, `Misalignment`), the tachometer's pulses counted by PWM slice
 //! 3 on its B input (`Tachometer`), and the pulse interface's line monitor. Sampled on
-//! the RP2040's timer at the board's period (`board::SAMPLE_PERIOD_US`), each sample
-//! stamped with its scheduled time; waits inside a read sleep (`Sleep`).
+//! the RP2040's timer at the committed period (`config_sample_period`), each sample
+//! stamped with its scheduled time, through the committed calibration
+//! ([`Sensors::settings`]); waits inside a read sleep (`Sleep`).
 
 use crate::board;
 use crate::sleep::{Sleep, sleep_until};
@@ -33,19 +34,22 @@ pub struct Sensors {
     last_counter: u16,
     /// When the next sample is due (µs of the timer).
     due_us: u64,
+    /// The sampling period (µs).
+    period_us: u64,
 }
 
 impl Sensors {
-    /// The sensors on their pins, calibrated (`board::calibration`); the first sample
-    /// a period from now.
+    /// The sensors on their pins, calibrated with `settings` (`board::calibration`);
+    /// the first sample a period from now.
     pub fn new(
         dout: Input<'static>,
         sck: Output<'static>,
         i2c: I2c<'static, I2C0, Blocking>,
         pulses: Pwm<'static>,
         line_ok: Input<'static>,
+        settings: &board::SensorSettings,
     ) -> Result<Self, CalibrationError> {
-        let cal = board::calibration()?;
+        let cal = board::calibration(settings)?;
         let hx = Hx711::new(dout, sck, Sleep, board::HX711_TIMEOUT)
             .map_err(|_| CalibrationError::Value)?;
         let cell = LoadCell::new(hx, cal.load, RawLimits::new(hx711_rails()))?;
@@ -58,23 +62,46 @@ impl Sensors {
         let probes = Misalignment::new(
             adc,
             (Ads1115Channel::A0, Ads1115Channel::A1),
-            cal.probes,
+            cal.misalignment,
             RawLimits::new(misalign::sensors::Rails {
                 min: i16::MIN.into(),
                 max: i16::MAX.into(),
             }),
         )?;
         let last_counter = pulses.counter();
+        let speed = cal.speed.ok_or(CalibrationError::Value)?;
+        let period_us = u64::from(settings.sample_period_ms) * 1000;
         Ok(Sensors {
             cell,
             probes,
-            tachometer: Tachometer::new(cal.speed)?,
+            tachometer: Tachometer::new(speed)?,
             pulses,
             line_ok,
             count: 0,
             last_counter,
-            due_us: Instant::now().as_micros() + board::SAMPLE_PERIOD_US,
+            due_us: Instant::now().as_micros() + period_us,
+            period_us,
         })
+    }
+
+    /// The settings in force changed (a commit, the committed image at boot): the
+    /// drivers recalibrated, the next sample at the old period's time and the new
+    /// period from then on. On an error (the drivers refuse it) nothing changes.
+    pub fn settings(&mut self, settings: &board::SensorSettings) -> Result<(), CalibrationError> {
+        let cal = board::calibration(settings)?;
+        let speed = cal.speed.ok_or(CalibrationError::Value)?;
+        let tachometer = if speed == self.tachometer.calibration() {
+            None
+        } else {
+            Some(Tachometer::new(speed)?)
+        };
+        self.cell.set_calibration(cal.load)?;
+        self.probes.set_calibration(cal.misalignment)?;
+        if let Some(t) = tachometer {
+            self.tachometer = t;
+        }
+        self.period_us = u64::from(settings.sample_period_ms) * 1000;
+        Ok(())
     }
 
     /// When the next sample is due (µs).
@@ -90,7 +117,7 @@ impl Sensors {
             return None;
         }
         let at = self.due_us;
-        let period = board::SAMPLE_PERIOD_US;
+        let period = self.period_us;
         self.due_us += period * ((now - at) / period + 1);
         let time_ms = (at / 1000) as u32;
         // The tachometer first: its count at the scheduled time.
