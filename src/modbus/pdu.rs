@@ -246,8 +246,8 @@ impl<E: Estimator> Core<E> {
         let end = 3 + bytes;
         // Each table's values from a function of its own (small enough to inline), one
         // `fill` each: a second `fill` with `value_holding` would take it out of line, a
-        // call per register. The line settings (a read from `LINE_ADDRESS` on stays in
-        // their block: `in_map`) are all `value_other`'s, which `value` falls to.
+        // call per register. From `LINE_ADDRESS` on (past the reserved run: `in_map`),
+        // the line and sensor settings, all `value_other`'s, which `value` falls to.
         if function == 3 && start < super::map::LINE_ADDRESS {
             self.fill::<true>(map, start, usize::from(end), Self::value_holding);
         } else {
