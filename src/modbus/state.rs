@@ -101,6 +101,7 @@ impl<E: Estimator> Core<E> {
         }
     }
 
+    #[cold]
     #[inline(never)]
     fn line_waiting(&mut self, addressed: bool) {
         let (confirmed, raised) = self.line.request(addressed);
