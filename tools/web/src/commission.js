@@ -5,7 +5,7 @@
 // unlock, write and read back, the scene and its CRC, commit; on any failure the
 // switches put back, revert and lock.
 import { registers, encode, decode, wordsOf } from './registers.js';
-import { Refused } from './modbus.js';
+import { Refused, Silent, crc16 } from './modbus.js';
 
 /** Switches the node applies as written (behind the unlock), kept with a commit. */
 export const SWITCHES = ['latching', 'external_mode'];
@@ -16,6 +16,11 @@ export const STATES = ['stopped', 'normal', 'microslip', 'gross slip', 'sensor f
 export const NE107 = ['good', 'maintenance required', 'out of specification', 'function check', 'failure'];
 /** The four alarms, in the bit order of `acknowledge_alarms` and `alarms`. */
 export const ALARMS = ['warning', 'alarm', 'sensor fault', 'approaching'];
+
+/** The line settings a master must follow to reach the node after their commit. */
+export const MOVES = ['unit_id', 'baud', 'parity'];
+/** `config_parity`'s values as the letters of a frame (8E1). */
+export const PARITY = ['N', 'O', 'E'];
 
 /** A step that failed, with the reason a technician reads. */
 export class Failed extends Error {}
@@ -112,6 +117,13 @@ export class Node {
     const input = await this.block('input', 0, window);
     const firstConfig = this.map.configRegisters()[0].address;
     const holding = await this.block('holding', 0, firstConfig);
+    // The line settings in force and their supervision, where the map has them.
+    const after = (table, first, last) => {
+      const [a, b] = [first, last].map((n) => this.map.has(n, table) && this.map.entry(n, table));
+      return a && b ? this.block(table, a.address, b.address + wordsOf(b.type)) : new Map();
+    };
+    for (const [k, v] of await after('holding', 'active_unit_id', 'line_confirm_window')) holding.set(k, v);
+    for (const [k, v] of await after('input', 'line_reverts', 'line_confirm_left')) input.set(k, v);
     const s = input.get('status').value;
     return {
       input,
@@ -212,14 +224,72 @@ export class Node {
     return this.write('command', [n]);
   }
 
-  /** Commit, refused with the node's reason (`commit_error`) spelled out. */
+  /** Where the node answers after a commit of what is staged: {unit, baud, parity}
+   * when the staged line settings move it (a new unit id, baud rate or parity), null
+   * when they do not. */
+  async lineMove() {
+    if (!((await this.read('staged'))[0] & 8)) return null;
+    const value = async (name) => {
+      const w = await this.read(name);
+      return w.length === 2 ? u32(w) : w[0];
+    };
+    const to = {}, from = {};
+    for (const f of MOVES) {
+      to[f] = await value(`config_${f}`);
+      from[f] = await value(`active_${f}`);
+    }
+    if (MOVES.every((f) => to[f] === from[f])) return null;
+    return { unit: to.unit_id, baud: to.baud, parity: PARITY[to.parity] ?? `code ${to.parity}` };
+  }
+
+  /** Asks the node at the line settings `to` from now on: the unit id, and a serial
+   * port reopened at the baud rate and parity (a WebSocket's bridge carries the bytes
+   * whatever the node's UART runs). */
+  async move(to) {
+    this.c.unit = to.unit;
+    await this.c.t.reconfigure?.(to.baud, to.parity);
+  }
+
+  /** After a commit that moved the node: a request at its new settings confirms them
+   * (`line_status` bit 1 clears); without one the node goes back to the old ones
+   * within `line_confirm_window`. The page asks there, up to three times. */
+  async confirmLine(to, from) {
+    await this.move(to);
+    for (let i = 0; i < 3; i++) {
+      try {
+        if (!((await this.read('line_status', 'input'))[0] & 2)) return;
+      } catch (e) {
+        if (!(e instanceof Silent)) throw e;
+      }
+    }
+    await this.move(from).catch(() => {});
+    throw new Failed(
+      `the node did not confirm its new line settings (unit ${to.unit}, ${to.baud} baud, parity ${to.parity}): ` +
+        'it goes back to the old ones within line_confirm_window',
+    );
+  }
+
+  /** Commit, refused with the node's reason (`commit_error`) spelled out. When the
+   * commit moves the node (its unit id, baud rate or parity), the page follows it
+   * and confirms the new settings; returns where it answers then, or null. */
   async commit() {
+    const { to, from } = await this.commitStaged();
+    if (to) await this.confirmLine(to, from);
+    return to;
+  }
+
+  /** The commit alone: where the node answers after it (`to`, null: where it did)
+   * and before it (`from`). */
+  async commitStaged() {
+    const to = await this.lineMove();
+    const from = { unit: this.c.unit, ...this.c.t.line?.() };
     const x = await this.command(1);
     if (x === 1) throw new Failed('commit refused: locked (unlock first)');
     if (x !== null) {
       const why = (await this.read('commit_error'))[0];
       throw new Failed(`commit refused: ${this.wasm.commitReason(why)} (commit_error 0x${why.toString(16)})`);
     }
+    return { to, from };
   }
 
   /** Every setting as its register's words, checked before anything is written. */
@@ -278,9 +348,26 @@ export class Node {
     }
   }
 
+  /** One line on the node (as tools/commission.py's --scan prints it): its unit id,
+   * map version, state, NAMUR NE 107 category and line settings in force. */
+  async describe(mapVersion) {
+    const s = (await this.read('status', 'input'))[0];
+    let line = '';
+    if (mapVersion >= 3 && this.map.has('active_baud')) {
+      const baud = u32(await this.read('active_baud'));
+      const parity = PARITY[(await this.read('active_parity'))[0]] ?? '?';
+      const delay = (await this.read('active_answer_delay'))[0];
+      const timeout = (await this.read('active_bus_timeout'))[0];
+      line = `, ${baud} baud 8${parity}${parity === 'N' ? 2 : 1}, answer delay ${delay} ms, bus timeout ${timeout} s`;
+    }
+    return `unit ${this.c.unit}: map_version ${mapVersion}, state ${STATES[s & 0xff] ?? s & 0xff}, NE 107 ${NE107[(s >> 8) & 0xf] ?? (s >> 8) & 0xf}${line}`;
+  }
+
   /** The whole commissioning, as tools/commission.py runs it: what the node runs
-   * afterwards is checked; on any failure after the unlock the switches are put
-   * back, the staged copy reverted and the node locked. Returns `config_source`. */
+   * afterwards is checked (at its new line settings, which the page follows and
+   * confirms, when the commit moved it); on any failure before the commit the switches
+   * are put back, the staged copy reverted and the node locked. Returns
+   * `config_source` and where the node answers when the commit moved it (else null). */
   async commission(code, settings, scene = null) {
     const checked = this.checked(settings);
     if (scene) {
@@ -292,10 +379,11 @@ export class Node {
     }
     await this.unlock(code);
     const switched = new Map();
+    let line = { to: null };
     try {
       for (const [name] of checked) if (SWITCHES.includes(name)) switched.set(name, await this.read(name));
       await this.stage(checked, scene);
-      if (checked.some(([n]) => !SWITCHES.includes(n)) || scene) await this.commit();
+      if (checked.some(([n]) => !SWITCHES.includes(n)) || scene) line = await this.commitStaged();
       else await this.command(3);
     } catch (e) {
       for (const [name, words] of switched) await this.write(name, words).catch(() => {});
@@ -303,6 +391,7 @@ export class Node {
       await this.command(3).catch(() => {});
       throw e;
     }
+    if (line.to) await this.confirmLine(line.to, line.from);
     for (const [name, words] of checked) {
       if (SWITCHES.includes(name) && !same(await this.read(name), words)) {
         throw new Failed(`${name} reads ${await this.read(name)} after the commit`);
@@ -316,6 +405,53 @@ export class Node {
       const crc = new DataView(scene.buffer, scene.byteOffset).getUint32(scene.length - 4, true);
       if (u32(await this.read('scene_active_crc')) !== crc) throw new Failed('the node does not run the scene after the commit');
     }
-    return (await this.read('config_source'))[0];
+    return { source: (await this.read('config_source'))[0], moved: line.to };
   }
+}
+
+/** `bytes` end in their CRC-16/MODBUS. */
+const crcOk = (bytes) => {
+  const crc = crc16(bytes.subarray(0, -2));
+  return bytes.at(-2) === (crc & 0xff) && bytes.at(-1) === crc >> 8;
+};
+const hex = (bytes) => [...bytes].map((b) => b.toString(16).padStart(2, '0')).join('');
+
+/** Each unit id of `units` asked once for `unit_id` and `map_version` (a read every
+ * node of this map answers), as tools/commission.py's --scan: the nodes found, each
+ * described in a line, and the clashes (bytes that are not one valid answer, as two
+ * nodes answering at once make, or an answer naming another unit id). `progress(unit)`
+ * is called before each. */
+export async function scan(client, wasm, units, timeoutMs, progress = () => {}, map = registers) {
+  const at = map.entry('unit_id').address;
+  const found = [], clashes = [];
+  const was = client.unit;
+  try {
+    for (const unit of units) {
+      progress(unit);
+      const got = await client.probe(unit, at, 2, timeoutMs);
+      if (!got.length) continue;
+      if (!(got.length === 9 && got[0] === unit && got[1] === 3 && got[2] === 4 && crcOk(got))) {
+        if (got.length === 5 && got[0] === unit && got[1] === 0x83 && crcOk(got)) {
+          clashes.push(`unit ${unit}: exception ${got[2]} to a read every node answers: not this map's node`);
+        } else {
+          clashes.push(`unit ${unit}: clash: ${got.length} bytes that are not one valid answer (two nodes at one unit id?): ${hex(got.subarray(0, 12))}`);
+        }
+        continue;
+      }
+      const id = (got[3] << 8) | got[4];
+      if (id !== unit) {
+        clashes.push(`unit ${unit}: answered with unit_id ${id} (a clash)`);
+        continue;
+      }
+      client.unit = unit;
+      try {
+        found.push({ unit, text: await new Node(client, wasm, map).describe((got[5] << 8) | got[6]) });
+      } catch (e) {
+        clashes.push(`unit ${unit}: clash while reading it: ${e.message}`);
+      }
+    }
+  } finally {
+    client.unit = was;
+  }
+  return { found, clashes };
 }

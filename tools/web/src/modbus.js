@@ -96,6 +96,42 @@ export class Client {
     }
   }
 
+  /** A read of `n` holding registers from `address` sent to `unit` as bytes, and
+   * every byte that comes back within `timeoutMs` (less once one whole valid answer
+   * is in), so that garbled bytes (two nodes answering at once) are seen rather than
+   * taken for silence. */
+  probe(unit, address, n, timeoutMs) {
+    const run = this.queue.then(async () => {
+      const frame = [unit, 3, address >> 8, address & 0xff, n >> 8, n & 0xff];
+      const crc = crc16(frame);
+      frame.push(crc & 0xff, crc >> 8);
+      if (this.t.silenceMs) await sleep(this.t.silenceMs);
+      this.buffer = [];
+      await this.t.write(Uint8Array.from(frame));
+      const deadline = performance.now() + timeoutMs;
+      const whole = () => {
+        const b = this.buffer;
+        if (b.length !== 5 + 2 * n || b[0] !== unit || b[1] !== 3 || b[2] !== 2 * n) return false;
+        const crc = crc16(b.slice(0, -2));
+        return b.at(-2) === (crc & 0xff) && b.at(-1) === crc >> 8;
+      };
+      while (!whole()) {
+        const left = deadline - performance.now();
+        if (left <= 0) break;
+        await new Promise((resolve) => {
+          const timer = setTimeout(resolve, left);
+          this.wake = () => { clearTimeout(timer); resolve(); };
+        });
+        this.wake = null;
+      }
+      const got = Uint8Array.from(this.buffer);
+      this.buffer = [];
+      return got;
+    });
+    this.queue = run.catch(() => {});
+    return run;
+  }
+
   /** The whole answer in the buffer, or null while bytes are missing. */
   complete(fn) {
     const b = this.buffer;

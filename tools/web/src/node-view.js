@@ -4,7 +4,7 @@
 // commit, revert, lock) by the same steps as tools/commission.py.
 import { Client, Silent } from './modbus.js';
 import { SerialTransport, WebSocketTransport, PageTransport } from './transport.js';
-import { Node, Failed, SWITCHES, registerName } from './commission.js';
+import { Node, Failed, SWITCHES, registerName, scan } from './commission.js';
 import { registers } from './registers.js';
 import { say, messageOf, fillTable, csvRows, STATE_COLOURS, STATE_NAMES } from './util.js';
 
@@ -12,6 +12,29 @@ import { say, messageOf, fillTable, csvRows, STATE_COLOURS, STATE_NAMES } from '
 const VALUES = ['slip_ratio', 'axial_force', 'critical_angle', 'margin', 'load', 'misalignment', 'time_to_critical', 'friction'];
 const COUNTERS = ['samples', 'events_dropped', 'event_seq_next', 'spikes', 'faults_non_finite', 'faults_out_of_range', 'faults_stuck', 'faults_gap', 'max_slip_ratio', 'min_margin'];
 const COMMISSIONING = ['config_source', 'scene_active_crc', 'unlock', 'lockout', 'unlock_failures', 'staged', 'map_version', 'unit_id'];
+/** The line settings in force and their supervision: [name, table]. */
+const LINE = [
+  ['active_unit_id', 'holding'], ['active_baud', 'holding'], ['active_parity', 'holding'],
+  ['active_answer_delay', 'holding'], ['active_bus_timeout', 'holding'], ['line_confirm_window', 'holding'],
+  ['line_status', 'input'], ['line_confirm_left', 'input'], ['line_reverts', 'input'],
+];
+/** A value's words in words a technician reads, where the number alone says little. */
+const SPELLED = {
+  active_parity: (v) => ['none (8N2)', 'odd (8O1)', 'even (8E1)'][v],
+  line_status: (v) => [v & 1 ? 'master lost' : '', v & 2 ? 'a change waits for its confirmation' : ''].filter(Boolean).join(', ') || 'in order',
+};
+
+/** Unit ids as a person writes them: `1-247`, `1,5,7`, `3`. */
+export function unitIds(text) {
+  const units = [];
+  for (const part of text.split(',')) {
+    const m = /^\s*(\d+)\s*(?:-\s*(\d+)\s*)?$/.exec(part);
+    const [a, b] = m ? [Number(m[1]), Number(m[2] ?? m[1])] : [NaN, NaN];
+    if (!(a >= 1 && b <= 247 && a <= b)) throw new Failed(`unit ids ${text.trim()}: a range (1-247) or a list (1,5,7) of ids from 1 to 247`);
+    for (let u = a; u <= b; u++) units.push(u);
+  }
+  return units;
+}
 
 export function setupNode(wasm, plan) {
   const $ = (id) => document.getElementById(id);
@@ -42,30 +65,111 @@ export function setupNode(wasm, plan) {
     }
   }
 
+  /** A client on a new transport as the connection form says (the old one closed). */
+  async function open(unit) {
+    await disconnect();
+    const t = kind.value === 'serial'
+      ? new SerialTransport(Number($('node-baud').value), $('node-parity').value)
+      : kind.value === 'websocket' ? new WebSocketTransport($('node-url').value.trim()) : new PageTransport(new wasm.PageNode(true));
+    const client = new Client(t, { unit, timeoutMs: 1000 });
+    await t.open();
+    transport = t;
+    $('node-disconnect').disabled = false;
+    return client;
+  }
+
+  /** The node at `client`'s unit id: its status, configuration and events shown. */
+  async function attach(client) {
+    steps = new Node(client, wasm);
+    try {
+      await readStatus();
+    } catch (err) {
+      await disconnect();
+      throw err;
+    }
+    live.hidden = false;
+    await readConfig();
+    await readEvents(null);
+    return `Connected through ${transport.name}, unit ${client.unit}.`;
+  }
+
+  const unitOf = (text) => {
+    const unit = Number(text);
+    if (!(Number.isInteger(unit) && unit >= 1 && unit <= 247)) throw new Failed(`unit id ${text}: a whole number from 1 to 247`);
+    return unit;
+  };
+
   $('node-connect').addEventListener('submit', (e) => {
     e.preventDefault();
-    step('Connecting', async () => {
-      await disconnect();
-      const unit = Number($('node-unit').value);
-      if (kind.value === 'serial') transport = new SerialTransport(Number($('node-baud').value), $('node-parity').value);
-      else if (kind.value === 'websocket') transport = new WebSocketTransport($('node-url').value.trim());
-      else transport = new PageTransport(new wasm.PageNode(true));
-      const client = new Client(transport, { unit, timeoutMs: 1000 });
-      await transport.open();
-      steps = new Node(client, wasm);
+    step('Connecting', async () => attach(await open(unitOf($('node-unit').value))));
+  });
+
+  /** The connection form shows where the node answers after a commit moved it. */
+  function moved(to) {
+    if (!to) return '';
+    $('node-unit').value = String(to.unit);
+    if (transport instanceof SerialTransport) {
+      $('node-baud').value = String(to.baud);
+      $('node-parity').value = to.parity;
+    }
+    return ` The node answers at unit ${to.unit}, ${to.baud} baud, parity ${to.parity} now, confirmed (the connection follows it).`;
+  }
+
+  let scanning = null;
+  $('node-scan-form').addEventListener('submit', (e) => {
+    e.preventDefault();
+    const list = $('node-scan-found');
+    step('Finding nodes', async () => {
+      const units = unitIds($('node-scan-units').value);
+      const wait = Number($('node-scan-timeout').value);
+      if (!(Number.isInteger(wait) && wait >= 10 && wait <= 5000)) throw new Failed(`wait ${$('node-scan-timeout').value}: whole ms from 10 to 5000`);
+      list.replaceChildren();
+      clearInterval(timer);
+      $('node-poll').checked = false;
+      const client = steps?.c ?? (await open(1));
+      const stop = { stopped: false };
+      scanning = stop;
+      $('node-scan').disabled = true;
+      $('node-scan-stop').disabled = false;
+      let result;
       try {
-        await readStatus();
-      } catch (err) {
-        await disconnect();
-        throw err;
+        result = await scan(client, wasm, units, wait, (u) => {
+          if (stop.stopped) throw new Failed(`stopped at unit ${u}`);
+          say(message, `Finding nodes: unit ${u} of ${units.at(-1)}…`);
+        });
+      } finally {
+        scanning = null;
+        $('node-scan').disabled = false;
+        $('node-scan-stop').disabled = true;
       }
-      live.hidden = false;
-      $('node-disconnect').disabled = false;
-      await readConfig();
-      await readEvents(null);
-      return `Connected through ${transport.name}, unit ${unit}.`;
+      for (const f of result.found) {
+        const li = document.createElement('li');
+        const text = document.createElement('span');
+        text.textContent = f.text;
+        const b = document.createElement('button');
+        b.type = 'button';
+        b.textContent = `Connect to unit ${f.unit}`;
+        b.addEventListener('click', () => step('Connecting', async () => {
+          $('node-unit').value = String(f.unit);
+          client.unit = f.unit;
+          return attach(client);
+        }));
+        li.append(text, b);
+        list.append(li);
+      }
+      for (const c of result.clashes) {
+        const li = document.createElement('li');
+        li.className = 'clash';
+        li.textContent = c;
+        list.append(li);
+      }
+      const n = result.found.length;
+      const text = `${n} node${n === 1 ? '' : 's'} found among ${units.length} unit ids${result.clashes.length ? `, ${result.clashes.length} clash${result.clashes.length === 1 ? '' : 'es'}` : ''}.`;
+      if (result.clashes.length) throw new Failed(`${text} ${result.clashes.join('; ')}`);
+      return text;
     });
   });
+  $('node-scan-stop').addEventListener('click', () => { if (scanning) scanning.stopped = true; });
 
   async function disconnect() {
     clearInterval(timer);
@@ -95,16 +199,18 @@ export function setupNode(wasm, plan) {
       const h = document.createElement('h3');
       h.textContent = title;
       const dl = document.createElement('dl');
-      for (const name of names) {
-        const e = registers.entry(name, table);
-        const d = (table === 'input' ? s.input : s.holding).get(name);
+      for (const item of names) {
+        const [name, t] = table ? [item, table] : item;
+        const e = registers.entry(name, t);
+        const d = (t === 'input' ? s.input : s.holding).get(name);
         const dt = document.createElement('dt');
         dt.textContent = name;
         dt.title = e.description;
         const dd = document.createElement('dd');
         dd.dataset.register = name;
         const hex = name.endsWith('_crc') ? `0x${d.value.toString(16).padStart(8, '0')}` : d.text;
-        dd.textContent = `${hex}${e.unit && d.text !== '-' ? ` ${e.unit}` : ''}`;
+        const spelled = SPELLED[name]?.(d.value);
+        dd.textContent = `${hex}${e.unit && d.text !== '-' ? ` ${e.unit}` : ''}${spelled ? ` (${spelled})` : ''}`;
         dl.append(dt, dd);
       }
       section.append(h, dl);
@@ -113,6 +219,7 @@ export function setupNode(wasm, plan) {
     list('Values', VALUES, 'input');
     list('Counters', COUNTERS, 'input');
     list('Commissioning', COMMISSIONING, 'holding');
+    list('Line', LINE.filter(([n, t]) => (t === 'input' ? s.input : s.holding).has(n)), null);
     return s;
   }
 
@@ -204,8 +311,8 @@ export function setupNode(wasm, plan) {
     const sc = await scene();
     if (!s.length && !sc) throw new Failed('nothing to write: stage a value or choose a scene');
     try {
-      const source = await steps.commission(code(), s, sc);
-      return `Commissioned: ${s.length} registers${sc ? ' and the scene' : ''} committed and read back; config_source ${source}.`;
+      const { source, moved: to } = await steps.commission(code(), s, sc);
+      return `Commissioned: ${s.length} registers${sc ? ' and the scene' : ''} committed and read back; config_source ${source}.${moved(to)}`;
     } finally {
       await after().catch(() => {});
     }
@@ -227,8 +334,8 @@ export function setupNode(wasm, plan) {
   }));
   $('node-commit').addEventListener('click', () => step('Committing', async () => {
     try {
-      await steps.commit();
-      return 'Committed: the node runs the staged copy.';
+      const to = await steps.commit();
+      return `Committed: the node runs the staged copy.${moved(to)}`;
     } finally {
       await after().catch(() => {});
     }

@@ -3,6 +3,7 @@
 //   await t.open();   t.write(bytes);   t.onbytes = (bytes) => ...;   await t.close();
 //   t.name            (what the page shows)
 //   t.silenceMs       (the line's silence the master keeps between frames)
+//   t.line(), await t.reconfigure(baud, parity)   (a serial port only: its settings)
 //
 // Web Serial (Chrome, Edge: a USB RS-485 adapter at the node's line settings), a
 // WebSocket to a TCP port (a gateway or the repository's bridge, tools/web/bridge.mjs,
@@ -22,11 +23,22 @@ export function lineSettings(baud, parity) {
 /** Web Serial: a port the person picks, opened at the node's line settings. */
 export class SerialTransport {
   constructor(baud = 19200, parity = 'E') {
+    this.set(baud, parity);
+    this.onbytes = () => {};
+  }
+
+  set(baud, parity) {
     this.settings = lineSettings(baud, parity);
+    this.baud = baud;
+    this.parity = parity;
     this.name = `serial ${baud} baud, 8${parity}${this.settings.stopBits}`;
     // 3.5 characters of 11 bits, at least 1.75 ms (the RTU rule above 19200 baud).
     this.silenceMs = Math.max(1.75, (3.5 * 11 * 1000) / baud);
-    this.onbytes = () => {};
+  }
+
+  /** The line settings the port runs: {baud, parity}. */
+  line() {
+    return { baud: this.baud, parity: this.parity };
   }
 
   async open() {
@@ -34,9 +46,23 @@ export class SerialTransport {
       throw new Error('this browser has no Web Serial: use Chrome or Edge, or a WebSocket to a gateway');
     }
     this.port = await navigator.serial.requestPort();
+    await this.start();
+  }
+
+  async start() {
+    this.closing = false;
     await this.port.open(this.settings);
     this.writer = this.port.writable.getWriter();
     this.reading = this.readLoop();
+  }
+
+  /** The same port at other line settings (the node moved to them): closed and
+   * opened again, without asking the person for the port. */
+  async reconfigure(baud, parity) {
+    if (baud === this.baud && parity === this.parity) return;
+    await this.close();
+    this.set(baud, parity);
+    await this.start();
   }
 
   async readLoop() {
@@ -67,6 +93,8 @@ export class SerialTransport {
     await this.reading?.catch(() => {});
     this.writer?.releaseLock();
     await this.port?.close().catch(() => {});
+    this.reader = null;
+    this.writer = null;
   }
 }
 

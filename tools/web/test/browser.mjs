@@ -189,6 +189,7 @@ await check('Node: connects through the bridge to the node in QEMU and reads its
   ok(m.ok, m.text);
   ok((await reg('samples')).trim() === '28620', `samples ${await reg('samples')}`);
   ok((await page.textContent('#node-status .state')).includes('NE 107'), 'the state');
+  ok(!(await page.isVisible('#node-baud')) && (await page.isVisible('#node-url')), 'a WebSocket shows its address, not the serial settings');
 });
 await check('Node: the event window is the example\'s events, decoded by the library', async () => {
   const rows = await page.$$eval('#node-events-table tbody tr', (r) => r.map((tr) => [...tr.cells].slice(0, 14).map((c) => c.textContent).join(',')));
@@ -241,6 +242,35 @@ await check('Node: acknowledges the alarms and an event', async () => {
   ok(a.ok && a.text.startsWith(`Events through #${first} acknowledged`), a.text);
   const now = await page.$$eval('#node-events-table tbody tr', (r) => r.map((tr) => Number(tr.cells[1].textContent)));
   ok(now.length > 0 && now.every((s) => s > first), `the window shows ${now}`);
+});
+const found = () => page.$$eval('#node-scan-found li', (li) => li.map((l) => `${l.className}|${l.querySelector('span')?.textContent ?? l.textContent}`));
+await check('Node: Find nodes lists the node at unit 1 with its line settings in force', async () => {
+  await page.fill('#node-scan-units', '1-3');
+  await page.click('#node-scan');
+  const m = await message('node-message');
+  ok(m.ok && m.text === '1 node found among 3 unit ids.', m.text);
+  const f = await found();
+  ok(f.length === 1 && /^\|unit 1: map_version \d+, state \S+/.test(f[0]) && f[0].includes(', 19200 baud 8E1, answer delay 0 ms'), f.join('\n'));
+  ok((await reg('active_baud')).trim() === '19200 bit/s' && (await reg('active_parity')).includes('even'), 'the line in the status');
+});
+await check('Node: a new unit id commissioned from the page: the page follows the node there and confirms it', async () => {
+  await page.fill('#node-code', '1234');
+  await page.fill('#node-config input[name=config_unit_id]', '7');
+  await page.click('#node-commission');
+  const m = await message('node-message');
+  ok(m.ok && m.text.includes('The node answers at unit 7, 19200 baud, parity E now, confirmed'), m.text);
+  ok((await page.inputValue('#node-unit')) === '7', 'the connection form shows unit 7');
+  ok((await reg('unit_id')).trim() === '7' && (await reg('active_unit_id')).trim() === '7', `unit_id ${await reg('unit_id')}`);
+  ok((await reg('line_status')).includes('in order') && (await reg('line_confirm_left')).trim() === '0 s', `line_status ${await reg('line_status')}, ${await reg('line_confirm_left')}`);
+  await page.fill('#node-scan-units', '1-8');
+  await page.click('#node-scan');
+  const s = await message('node-message');
+  ok(s.ok && s.text === '1 node found among 8 unit ids.', s.text);
+  const f = await found();
+  ok(f.length === 1 && f[0].startsWith('|unit 7: '), f.join('\n'));
+  await page.click('#node-scan-found button');
+  const c = await message('node-message');
+  ok(c.ok && c.text.endsWith('unit 7.'), c.text);
   await page.click('#node-read');
   await message('node-message');
   await page.screenshot({ path: path.join(SHOTS, 'node.png'), fullPage: true });
