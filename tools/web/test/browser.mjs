@@ -55,6 +55,19 @@ async function message(id, timeout = 30_000) {
   return page.evaluate((i) => ({ text: document.getElementById(i).textContent, ok: document.getElementById(i).classList.contains('ok') }), id);
 }
 
+// --- the page itself ------------------------------------------------------------------
+await check('every input, list and button has a name a screen reader says, and the tabs take the keyboard', async () => {
+  const unnamed = await page.$$eval('input, select, button, textarea', (els) =>
+    els.filter((el) => !(el.labels?.length || el.getAttribute('aria-label') || (el.tagName === 'BUTTON' && el.textContent.trim())))
+      .map((el) => el.id || el.name || el.outerHTML.slice(0, 60)));
+  ok(unnamed.length === 0, `without a label: ${unnamed.join(', ')}`);
+  await page.focus('#tab-plan');
+  await page.keyboard.press('ArrowRight');
+  ok(await page.$eval('#tab-review', (t) => t.getAttribute('aria-selected') === 'true' && document.activeElement === t), 'ArrowRight moves to Review');
+  await page.keyboard.press('ArrowLeft');
+  ok(await page.$eval('#tab-plan', (t) => t.getAttribute('aria-selected') === 'true'), 'ArrowLeft back to Plan');
+});
+
 // --- window.misalign: the example's files, byte for byte ---------------------------
 const bad = file('bad-rows.csv').toString('base64');
 const scene = text('scene.csv');
@@ -190,6 +203,16 @@ await check('Node: connects through the bridge to the node in QEMU and reads its
   ok((await reg('samples')).trim() === '28620', `samples ${await reg('samples')}`);
   ok((await page.textContent('#node-status .state')).includes('NE 107'), 'the state');
   ok(!(await page.isVisible('#node-baud')) && (await page.isVisible('#node-url')), 'a WebSocket shows its address, not the serial settings');
+});
+await check('Node: a unit id nobody answers is said so, with what to check', async () => {
+  await page.fill('#node-unit', '9');
+  await page.click('#node-connect-button');
+  const m = await message('node-message', 30_000);
+  ok(!m.ok && m.text.includes('the node did not answer within 1000 ms (its unit id 9, the line settings, the cable or the bridge?)'), m.text);
+  ok(!(await page.isVisible('#node-live')), 'the status is hidden');
+  await page.fill('#node-unit', '1');
+  await page.click('#node-connect-button');
+  ok((await message('node-message', 30_000)).ok, 'connected again at unit 1');
 });
 await check('Node: the event window is the example\'s events, decoded by the library', async () => {
   const rows = await page.$$eval('#node-events-table tbody tr', (r) => r.map((tr) => [...tr.cells].slice(0, 14).map((c) => c.textContent).join(',')));
