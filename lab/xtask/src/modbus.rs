@@ -201,7 +201,7 @@ pub fn run(args: &Args) -> ExitCode {
 }
 
 /// `--default-config C.csv`: the default configuration, for tools/commission.py.
-fn default_config(out: &str) -> Result<(), String> {
+pub(crate) fn default_config(out: &str) -> Result<(), String> {
     let registers = crate::root().join("target/modbus/registers.csv");
     std::fs::create_dir_all(registers.parent().unwrap()).map_err(|e| e.to_string())?;
     std::fs::write(&registers, registers_text()?).map_err(|e| e.to_string())?;

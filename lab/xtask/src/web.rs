@@ -557,6 +557,8 @@ fn reference_files(dir: &Path) -> Result<(), String> {
         "examples/prepare",
     )?;
     write(&dir.join("trace-short.csv"), long_trace(600_000))?;
+    // The Plan view's config.csv for the defaults is this file, byte for byte.
+    crate::modbus::default_config(&p("default-config.csv"))?;
     Ok(())
 }
 

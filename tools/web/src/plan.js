@@ -19,10 +19,13 @@ function pageNode(wasm) {
   return { node, steps: new Node(new Client(new PageTransport(node)), wasm) };
 }
 
-/** The configuration file: every `config_*` register the node runs, `name,value`, as
- * `cargo xtask modbus --default-config` writes it. */
+/** The configuration file: the monitor's configuration the node runs (no line or
+ * sensor settings, which are each node's own), `name,value`, as `cargo xtask modbus
+ * --default-config` writes it. */
 export function configFile(configuration) {
-  return `name,value\n${configuration.map((c) => `${c.entry.name},${c.active.text}`).join('\n')}\n`;
+  const monitor = new Set(registers.monitorRegisters().map((e) => e.name));
+  const rows = configuration.filter((c) => monitor.has(c.entry.name));
+  return `name,value\n${rows.map((c) => `${c.entry.name},${c.active.text}`).join('\n')}\n`;
 }
 
 export function setupPlan(wasm) {
@@ -35,7 +38,8 @@ export function setupPlan(wasm) {
   // The configuration's inputs, from the register map, with the node's defaults.
   (async () => {
     const { steps } = pageNode(wasm);
-    for (const c of await steps.configuration()) {
+    const monitor = new Set(registers.monitorRegisters().map((e) => e.name));
+    for (const c of (await steps.configuration()).filter((c) => monitor.has(c.entry.name))) {
       defaults.set(c.entry.name, c.staged.text);
       const label = document.createElement('label');
       label.title = c.entry.description;
@@ -88,7 +92,7 @@ export function setupPlan(wasm) {
       // The scene first: its own message if it is refused.
       wasm.prepareScene(scene, true);
       const changed = registers
-        .configRegisters()
+        .monitorRegisters()
         .map((e) => [e.name, form.elements.namedItem(e.name)?.value ?? defaults.get(e.name)])
         .filter(([n, v]) => v !== undefined && v.trim() !== defaults.get(n));
       const { node, steps } = pageNode(wasm);

@@ -61,6 +61,15 @@ export class RegisterMap {
   configRegisters() {
     return this.entries.filter((e) => e.table === 'holding' && e.name.startsWith('config_') && e.access === 'rw');
   }
+
+  /** The monitor's configuration alone: the staged registers before the line
+   * settings (the sensors' settings follow those). A file of line settings given to
+   * every node would put them all at one unit id, so a plan leaves them to each
+   * node's commissioning. */
+  monitorRegisters() {
+    const line = this.has('config_unit_id') ? this.entry('config_unit_id').address : Infinity;
+    return this.configRegisters().filter((e) => e.address < line);
+  }
 }
 
 /** Registers a value of `type` takes. */
