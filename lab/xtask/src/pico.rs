@@ -31,7 +31,8 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-#[allow(dead_code)]
+// The line settings and the divisor are the node's alone.
+#[allow(dead_code, unused_imports)]
 #[path = "../../../nodes/pico/src/board.rs"]
 mod board;
 
