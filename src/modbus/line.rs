@@ -338,6 +338,15 @@ impl Line {
         }
     }
 
+    /// A valid request reached the node: the master's supervision starts again.
+    /// Whether nothing more waits on it (no lost master to report back, no change to
+    /// confirm): a poll's case, which then needs no [`request`](Self::request).
+    #[inline(always)]
+    pub(crate) fn heard(&mut self) -> bool {
+        self.silent_ms = 0;
+        !self.master_lost && !matches!(self.change, Change::Confirming { .. })
+    }
+
     /// A valid request reached the node (`addressed`: to its unit id, not a
     /// broadcast). Whether this confirmed a change (the kept settings to persist), and
     /// what to raise.

@@ -43,7 +43,8 @@ fn head(pdu: &[u8]) -> Result<Head, Exception> {
 fn in_map(map: &Served, start: u16, quantity: u16) -> Result<(), Exception> {
     let end = u32::from(start) + u32::from(quantity);
     let (h0, h1) = map.hole;
-    if end <= u32::from(map.end) && (start >= h1 || end <= u32::from(h0)) {
+    // Before the hole (a table without one: `h0` its end) in one test, a poll's case.
+    if end <= u32::from(h0) || (start >= h1 && end <= u32::from(map.end)) {
         Ok(())
     } else {
         Err(Exception::IllegalDataAddress)
@@ -243,11 +244,12 @@ impl<E: Estimator> Core<E> {
         // At most 125 registers: 250 bytes, from response[3].
         let bytes = 2 * quantity.min(125) as u8;
         let end = 3 + bytes;
-        // Each table's values from a function of its own (small enough to inline).
+        // Each table's values from a function of its own (small enough to inline), one
+        // `fill` each: a second `fill` with `value_holding` would take it out of line, a
+        // call per register. From `LINE_ADDRESS` on (past the reserved run: `in_map`),
+        // the line and sensor settings, all `value_other`'s, which `value` falls to.
         if function == 3 && start < super::map::LINE_ADDRESS {
             self.fill::<true>(map, start, usize::from(end), Self::value_holding);
-        } else if function == 3 {
-            self.fill::<false>(map, start, usize::from(end), Self::value_holding);
         } else {
             self.fill::<false>(map, start, usize::from(end), Self::value);
         }

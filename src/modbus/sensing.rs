@@ -69,7 +69,8 @@ impl SensorSettings {
         tacho_max_speed_m_s: 10.0,
     };
 
-    /// Whether every value is in its register's domain ([`SensorField::takes`]).
+    /// Whether every value is in its register's domain (docs/modbus.md: each a finite
+    /// number, a scale not zero, the sampling period from 10 ms to 60 s).
     pub fn is_valid(&self) -> bool {
         SensorField::ALL.iter().all(|&f| f.takes(self.get(f)))
     }

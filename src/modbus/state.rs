@@ -92,8 +92,18 @@ impl<E: Estimator> Core<E> {
     }
 
     /// After a request for this node (`addressed`) or a broadcast was handled: the
-    /// master is back, a change is confirmed (and kept, as a commit is).
+    /// master is back, a change is confirmed (and kept, as a commit is). A poll's case
+    /// (nothing of it waits) costs a store and two tests; the rest is out of line.
+    #[inline(always)]
     pub(super) fn line_request(&mut self, addressed: bool) {
+        if !self.line.heard() {
+            self.line_waiting(addressed);
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn line_waiting(&mut self, addressed: bool) {
         let (confirmed, raised) = self.line.request(addressed);
         if confirmed {
             self.commissioning.switched();
