@@ -311,6 +311,86 @@ fn an_unconfirmed_change_goes_back() {
     }
 }
 
+/// A node started at the defaults for one power-on (the Pico's recovery pin): unit 1
+/// and the defaults answer although unit 23 at 57600 baud is committed; a commit of
+/// something else keeps the committed line settings in its image, so the next
+/// power-on without the pin starts at them; a change left unconfirmed returns to the
+/// defaults, not to the forgotten settings; one confirmed is kept.
+#[test]
+fn defaults_for_one_power_on_keep_the_committed_settings() {
+    let committed = LineSettings {
+        unit_id: 23,
+        baud: 57_600,
+        parity: Parity::Odd,
+        answer_delay_ms: 3,
+        bus_timeout_s: 10,
+    };
+    let mut site = server();
+    unlock(&mut site, 1);
+    put(&mut site, 1, "config_unit_id", 23).unwrap();
+    put(&mut site, 1, "config_baud", 57_600).unwrap();
+    put(&mut site, 1, "config_parity", Parity::Odd as u32).unwrap();
+    put(&mut site, 1, "config_answer_delay", 3).unwrap();
+    put(&mut site, 1, "config_bus_timeout", 10).unwrap();
+    commit(&mut site, 1).unwrap();
+    assert_eq!(get(&mut site, 23, "unit_id"), 23, "confirmed");
+    let mut image = [0; IMAGE_LEN];
+    assert!(site.take_committed(&mut image));
+    let window_ms = u32::from(LINE_CONFIRM_WINDOW_S) * 1000;
+
+    let mut s = server();
+    assert_eq!(s.restore(Stored::Image(&image)), BootSource::Committed);
+    assert_eq!(s.line(), committed);
+    s.line_defaults_for_now();
+    assert_eq!(s.line(), LineSettings::DEFAULT);
+    assert!(
+        request(&mut s, 23, 3, &words_be(&[5, 1])).is_none(),
+        "not unit 23 now"
+    );
+    assert_eq!(get(&mut s, 1, "unit_id"), 1);
+    assert_eq!(get(&mut s, 1, "active_baud"), 19_200);
+    // A commit of something else: the image keeps the committed line settings.
+    unlock(&mut s, 1);
+    put(&mut s, 1, "config_answer_delay", 0).unwrap();
+    commit(&mut s, 1).unwrap();
+    let mut again = [0; IMAGE_LEN];
+    assert!(s.take_committed(&mut again));
+    let mut next = server();
+    assert_eq!(next.restore(Stored::Image(&again)), BootSource::Committed);
+    assert_eq!(
+        next.line(),
+        committed,
+        "the pin released: the committed settings"
+    );
+    // A change left unconfirmed returns to the defaults in force.
+    unlock(&mut s, 1);
+    put(&mut s, 1, "config_unit_id", 40).unwrap();
+    commit(&mut s, 1).unwrap();
+    assert_eq!(s.unit_id(), 40);
+    s.tick(0);
+    s.tick(window_ms + 1);
+    assert_eq!(
+        s.line(),
+        LineSettings::DEFAULT,
+        "back to the defaults, not unit 23"
+    );
+    assert_eq!(s.line_reverts(), 1);
+    // One confirmed is kept.
+    unlock(&mut s, 1);
+    put(&mut s, 1, "config_unit_id", 41).unwrap();
+    commit(&mut s, 1).unwrap();
+    assert_eq!(get(&mut s, 41, "unit_id"), 41, "confirmed");
+    assert!(s.take_committed(&mut again));
+    let mut next = server();
+    assert_eq!(next.restore(Stored::Image(&again)), BootSource::Committed);
+    assert_eq!(next.unit_id(), 41);
+    assert_eq!(
+        next.line().baud,
+        19_200,
+        "the defaults' other settings, confirmed with it"
+    );
+}
+
 /// A commit of the configuration alone leaves the line as it is; a commit of both
 /// applies the configuration at once and the line after the answer.
 #[test]

@@ -2,7 +2,10 @@
 lab/pico's harness): commissioning over the bus surviving a reset; each sensor
 unplugged and stuck giving the sensor fault that names it; power cuts at sampled
 points of a checkpoint, a commit and an acknowledgement (what the node answered is on
-flash after the restart, nothing half-applied); the driver-enable pin right throughout.
+flash after the restart, nothing half-applied); the driver-enable pin right throughout;
+UART0's divisor and frame following the line settings in force (a confirmed change
+kept, an unconfirmed one undone after the window); the answer delay measured on the
+line; the recovery pin starting one power-on at the default line settings.
 
 The environment adds to conftest's: PICO_CONTROL (the harness's control port: one
 command a line, one JSON answer), MODBUS_SCENE (a prepared scene for the node's core)
@@ -311,3 +314,112 @@ def test_a_site_calibration_and_period_give_the_replays_events(tmp_path):
     times = [round(float(line.split(",")[0]) * 1000) for line in samples.read_text().splitlines()[1:]]
     steps = {b - a for a, b in zip(times, times[1:])}
     assert steps == {200}, steps
+
+
+# The line settings in force on the node's UART0 (docs/pico.md, The line settings).
+CLK_PERI_HZ = 125_000_000
+
+
+def divisor(baud):
+    """The PL011's divisor for `baud` (UARTIBRD, UARTFBRD): clk_peri / (16 baud) in
+    sixty-fourths, rounded."""
+    sixty_fourths = (8 * CLK_PERI_HZ // baud + 1) // 2
+    return sixty_fourths >> 6, sixty_fourths & 63
+
+
+def uart():
+    s = harness("status")
+    return (s["uart_ibrd"], s["uart_fbrd"]), s["uart_parity"], s["uart_stop_bits"]
+
+
+def at_unit(client, unit, name, value=None):
+    """Reads (`value` None) or writes the holding register `name` of `unit`."""
+    r = next(r for r in register_map() if r["table"] == "holding" and r["name"] == name)
+    two = r["type"] in ("u32", "f32")
+    if value is None:
+        a = client.read_holding_registers(int(r["address"]), count=2 if two else 1, device_id=unit)
+        assert not a.isError(), (unit, name, a)
+        return a.registers[0] << 16 | a.registers[1] if two else a.registers[0]
+    if two:
+        a = client.write_registers(int(r["address"]), [value >> 16, value & 0xFFFF], device_id=unit)
+    else:
+        a = client.write_register(int(r["address"]), value, device_id=unit)
+    assert not a.isError(), (unit, name, value, a)
+    return a
+
+
+def commit_line(client, unit, **settings):
+    """Unlocks `unit`, stages the line settings given (config_NAME=value) and commits:
+    answered at the old settings, in force after."""
+    at_unit(client, unit, "unlock", code())
+    for name, value in settings.items():
+        at_unit(client, unit, f"config_{name}", value)
+    at_unit(client, unit, "command", 1)
+
+
+def emulated_wait(seconds):
+    """Waits until `seconds` of the node's time have passed, asking the node nothing."""
+    at = harness("status")["ns"]
+    wait_until(lambda: harness("status")["ns"] > at + seconds * 1e9, timeout_s=600)
+
+
+def test_the_uart_runs_the_line_settings_in_force_and_a_change_unconfirmed_goes_back(client):
+    assert uart() == (divisor(get(client, "active_baud")), "even", 1), "the defaults"
+    window = get(client, "line_confirm_window")
+    reverts = get_input(client, "line_reverts")
+    commit_line(client, UNIT, baud=38_400, parity=0)
+    wait_until(lambda: uart() == (divisor(38_400), "none", 2))
+    assert get(client, "active_baud") == 38_400, "the request that confirms it"
+    emulated_wait(window + 2)
+    assert uart() == (divisor(38_400), "none", 2), "confirmed: kept"
+    assert get_input(client, "line_reverts") == reverts
+    # A change nobody confirms: the node's UART goes back after the window.
+    commit_line(client, UNIT, baud=57_600, parity=1)
+    wait_until(lambda: uart() == (divisor(57_600), "odd", 1))
+    emulated_wait(window + 2)
+    assert uart() == (divisor(38_400), "none", 2), "back to the settings before"
+    assert get_input(client, "line_reverts") == reverts + 1
+    commit_line(client, UNIT, baud=19_200, parity=2)
+    assert get(client, "active_baud") == 19_200
+    assert uart() == (divisor(19_200), "even", 1)
+
+
+def test_the_answer_delay_in_force_holds_each_answer(client):
+    """The emulated time from a request's last stop bit to its answer's first start
+    bit: without a delay, the 3.5 characters' silence that ends a frame (2.0 ms at
+    19200 baud) and the node's work; with one, the delay from the node's read of the
+    last byte."""
+    get(client, "unit_id")
+    no_delay = harness("status")["turnaround_ns"]
+    assert no_delay < 5e6, f"{no_delay} ns from the request to its answer without a delay"
+    commit_line(client, UNIT, answer_delay=40)
+    assert get(client, "active_answer_delay") == 40, "the request that confirms it"
+    for _ in range(3):
+        get(client, "unit_id")
+        t = harness("status")["turnaround_ns"]
+        assert 40e6 <= t < 45e6, f"{t} ns from the request to its answer, 40 ms asked"
+    commit_line(client, UNIT, answer_delay=0)
+    get(client, "unit_id")
+    assert harness("status")["turnaround_ns"] < 5e6
+
+
+def test_the_recovery_pin_starts_one_power_on_at_the_defaults(client):
+    commit_line(client, UNIT, unit_id=7, baud=38_400)
+    assert at_unit(client, 7, "unit_id") == 7, "the request that confirms it"
+    emulated_wait(2)  # the confirmed settings on flash
+    harness("recovery held")
+    before = boots()
+    harness("reset")
+    restarted(client, before)  # asks unit 1
+    assert get(client, "unit_id") == 1
+    assert get(client, "active_baud") == 19_200
+    assert uart() == (divisor(19_200), "even", 1)
+    harness("recovery released")
+    before = boots()
+    harness("reset")
+    wait_until(lambda: boots() > before)
+    assert wait_until(lambda: at_unit(client, 7, "unit_id") == 7), "the committed unit id again"
+    assert uart() == (divisor(38_400), "even", 1)
+    # Back to unit 1 at the defaults, confirmed there.
+    commit_line(client, 7, unit_id=1, baud=19_200)
+    assert get(client, "unit_id") == 1
