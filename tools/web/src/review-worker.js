@@ -1,5 +1,5 @@
 // The Review view's worker: the monitor's replay of a trace (two passes over the file,
-// read in 1 MiB pieces with FileReaderSync, never whole), off the page's thread so
+// read in 8 MiB pieces with FileReaderSync, never whole), off the page's thread so
 // that the page answers meanwhile. In: {file (a Blob, or null for the built-in
 // shift), scene (text or null), model, planner}. Out: progress, then the result.
 import init, { review_trace } from '@pkg/misalign_web.js';
