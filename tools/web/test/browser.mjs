@@ -296,6 +296,44 @@ await check('Node: a new unit id commissioned from the page: the page follows th
   await message('node-message');
   await page.screenshot({ path: path.join(SHOTS, 'node.png'), fullPage: true });
 });
+await check('Node: over Web Serial, a new baud rate and parity committed: the page reopens the port at them and the node confirms', async () => {
+  // A stand-in for the browser's Web Serial: the port the person would pick, its
+  // bytes carried to the node in QEMU through the bridge, each open's settings noted.
+  await page.evaluate((ws) => {
+    window.__opened = [];
+    class Port {
+      async open(settings) {
+        const socket = new WebSocket(ws);
+        socket.binaryType = 'arraybuffer';
+        await new Promise((resolve, reject) => { socket.onopen = resolve; socket.onerror = () => reject(new Error('bridge')); });
+        window.__opened.push(`${settings.baudRate} ${settings.dataBits}${settings.parity[0].toUpperCase()}${settings.stopBits}`);
+        this.socket = socket;
+        this.readable = new ReadableStream({ start(c) { socket.onmessage = (m) => c.enqueue(new Uint8Array(m.data)); } });
+        this.writable = new WritableStream({ write(chunk) { socket.send(chunk); } });
+      }
+      async close() { this.socket.close(); this.readable = null; this.writable = null; }
+    }
+    Object.defineProperty(navigator, 'serial', { configurable: true, value: { requestPort: async () => new Port() } });
+  }, WS);
+  await page.click('#node-disconnect');
+  await message('node-message');
+  await page.selectOption('#node-transport', 'serial');
+  await page.fill('#node-unit', '7');
+  await page.click('#node-connect-button');
+  const c = await message('node-message', 30_000);
+  ok(c.ok && c.text === 'Connected through serial 19200 baud, 8E1, unit 7.', c.text);
+  await page.fill('#node-code', '1234');
+  await page.fill('#node-config input[name=config_baud]', '38400');
+  await page.fill('#node-config input[name=config_parity]', '0');
+  await page.click('#node-commission');
+  const m = await message('node-message');
+  ok(m.ok && m.text.includes('The node answers at unit 7, 38400 baud, parity N now, confirmed'), m.text);
+  const opened = await page.evaluate(() => window.__opened);
+  ok(opened.join('|') === '19200 8E1|38400 8N2', `the port opened at ${opened.join(', then ')}`);
+  ok((await page.inputValue('#node-baud')) === '38400' && (await page.inputValue('#node-parity')) === 'N', 'the connection form shows 38400 8N2');
+  ok((await reg('active_baud')).trim() === '38400 bit/s' && (await reg('active_parity')).includes('none (8N2)'), `active_baud ${await reg('active_baud')}`);
+  ok((await reg('line_status')).includes('in order'), `line_status ${await reg('line_status')}`);
+});
 await check('the page raised no error', async () => {
   ok(errors.length === 0, errors.join('\n'));
 });
