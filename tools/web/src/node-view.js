@@ -20,7 +20,7 @@ const LINE = [
 ];
 /** A value's words in words a technician reads, where the number alone says little. */
 const SPELLED = {
-  active_parity: (v) => ['none (8N2)', 'odd (8O1)', 'even (8E1)'][v],
+  active_parity: (v) => ['none, 8N2', 'odd, 8O1', 'even, 8E1'][v],
   line_status: (v) => [v & 1 ? 'master lost' : '', v & 2 ? 'a change waits for its confirmation' : ''].filter(Boolean).join(', ') || 'in order',
 };
 
