@@ -12,11 +12,7 @@
 // node's defmt log (RTT, read from its RAM) is decoded by defmt-print onto stdout; its
 // `sample` lines go to --samples. A control port takes one command a line (answering
 // one JSON line): status, sensor NAME ok|unplugged|stuck, cut N POINTS, reset,
-// drive PATH (new rows before the trace starts), recovery held|released (the recovery
-// pin GP22 from the next boot on: held to GND, or released to its pull-up), quit.
-// Whenever the node sets UART0's divisor and frame the harness says `uart0: N baud,
-// parity P` (N from UARTIBRD and UARTFBRD); `status` reports them, and the last
-// time from a request's last byte to its answer's first (`turnaround_ns`).
+// drive PATH (new rows before the trace starts), quit.
 import fs from 'node:fs';
 import net from 'node:net';
 import { spawn } from 'node:child_process';
@@ -29,7 +25,7 @@ import { Hx711, Ads1115, Tachometer } from './src/sensors.mjs';
 
 const CYCLE_NS = 8; // 125 MHz, as embassy-rp sets the system clock
 const VTOR = 0x10000100; // the vector table, after the 256-byte second-stage loader
-const PINS = { de: 2, lineOk: 6, pulse: 7, dout: 10, sck: 11, recovery: 22 };
+const PINS = { de: 2, lineOk: 6, pulse: 7, dout: 10, sck: 11 };
 const HX711_PERIOD_NS = 12.5e6; // 80 samples a second (RATE high)
 const PAINT = 0xcccccccc;
 
@@ -183,7 +179,6 @@ class Harness {
     this.rxQueue = [];
     this.states = { load: 'ok', probe1: 'ok', probe2: 'ok', ads: 'ok', tach: 'ok' };
     this.cutPending = false;
-    this.recoveryHeld = false;
     this.flash.onCut = () => {
       this.cutPending = true;
     };
@@ -266,12 +261,6 @@ class Harness {
       this.resetPending = true;
     };
     this.uart = new Uart(mcu, mcu.uart[0], this.sched, (b) => this.toMaster(b), (on) => this.transmitting(on));
-    this.uart.onLine = () => {
-      const u = this.uart;
-      say(`uart0: ${Math.round(u.baud())} baud, parity ${u.parity()}, ${u.lcr & 8 ? 2 : 1} stop bits (IBRD ${u.ibrd}, FBRD ${u.fbrd})`);
-    };
-    // The recovery pin: its pull-up (rp2040js models no pulls) or a jumper to GND.
-    mcu.gpio[PINS.recovery].setInputValue(!this.recoveryHeld);
     mcu.gpio[PINS.de].addListener((v) => {
       this.de = v === 1;
     });
@@ -430,13 +419,6 @@ class Harness {
       flash_ops: this.flash.ops,
       de_errors: this.deErrors,
       overruns: this.uart.overruns,
-      uart_baud: this.uart.baud(),
-      uart_parity: this.uart.parity(),
-      uart_stop_bits: this.uart.lcr & 8 ? 2 : 1,
-      uart_ibrd: this.uart.ibrd,
-      uart_fbrd: this.uart.fbrd,
-      turnaround_ns: this.uart.turnaroundNs,
-      recovery_held: this.recoveryHeld,
       uart_read: this.uart.received,
       anchored: this.world.anchorNs !== null,
       done: this.world.done(),
@@ -466,10 +448,6 @@ class Harness {
         return { ok: true, ops: this.flash.ops };
       case 'reset':
         this.resetPending = true;
-        return { ok: true };
-      case 'recovery':
-        if (!['held', 'released'].includes(w[1])) return { error: `recovery ${w[1]}` };
-        this.recoveryHeld = w[1] === 'held';
         return { ok: true };
       case 'drive':
         // New rows for the sensors (the inverse of the calibration the node runs),

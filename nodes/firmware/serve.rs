@@ -51,18 +51,6 @@ pub trait Board {
     /// whenever they change (a commit after its answer, a revert): a board sets its
     /// UART's rate and frame to them here. The node has logged them.
     fn line(&mut self, _settings: &LineSettings) {}
-    /// The line's silence that ends a frame at `settings`, in the line clock's ticks,
-    /// if the board's clock follows the baud rate (`None`: the build's
-    /// [`LineClock::silence`] throughout).
-    fn silence(&self, _settings: &LineSettings) -> Option<u32> {
-        None
-    }
-    /// At boot, once the committed configuration is restored: whether the site asks
-    /// for the documented default line settings for this power-on (a recovery pin
-    /// held): [`Server::line_defaults_for_now`].
-    fn line_defaults(&mut self) -> bool {
-        false
-    }
     /// The sampling period and the sensors' calibration in force: at the start (the
     /// committed image's, or the build's) and after each commit that changed them. A
     /// board without sensors (the QEMU images: their built-in scenario keeps its own
@@ -111,12 +99,6 @@ pub fn node<
     // last checkpoint under it.
     #[cfg(feature = "modbus-flash")]
     start_storage(server, persist);
-    if board.line_defaults() {
-        server.line_defaults_for_now();
-        defmt::println!(
-            "modbus: recovery pin held at power-on: the default line settings for this power-on, the committed ones kept for the next"
-        );
-    }
     if !EXTERNAL_SAMPLES && !B::SENSORS {
         scenario(
             server,
@@ -229,7 +211,6 @@ fn serve<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32, B: Board>
     let mut line = server.line();
     log_line(&line);
     board.line(&line);
-    clock.silence = board.silence(&line).unwrap_or(clock.silence);
     let mut sensors = server.sensors();
     board.sensors(&sensors);
     let mut uart = Watched {
@@ -269,7 +250,6 @@ fn serve<E: Estimator, U: Read + ReadReady + Write, T: FnMut() -> u32, B: Board>
             line = server.line();
             log_line(&line);
             board.line(&line);
-            uart.clock.silence = board.silence(&line).unwrap_or(uart.clock.silence);
             uart.delay = u32::from(line.answer_delay_ms).saturating_mul(per_ms);
         }
         if server.sensors() != sensors {

@@ -239,9 +239,6 @@ pub(crate) struct Line {
     active: LineSettings,
     /// What a reset starts with: the confirmed settings (the committed image's).
     kept: LineSettings,
-    /// What a change waiting for its confirmation returns to: the settings in force
-    /// before it (and before any change over it still unconfirmed).
-    before: LineSettings,
     staged: Option<LineSettings>,
     change: Change,
     /// Time since the last request for this node (ms), saturated.
@@ -256,7 +253,6 @@ impl Line {
         Line {
             active: settings,
             kept: settings,
-            before: settings,
             staged: None,
             change: Change::None,
             silent_ms: 0,
@@ -279,17 +275,6 @@ impl Line {
     /// Settings restored from the committed image at boot: in force and kept.
     pub(crate) fn restore(&mut self, settings: LineSettings) {
         *self = Line::new(settings);
-    }
-
-    /// `settings` in force for this power-on only (a recovery pin held at boot): the
-    /// committed image keeps what it kept, which the next power-on brings back; a
-    /// change committed and confirmed from here is kept as any other, one left
-    /// unconfirmed returns to `settings`.
-    pub(crate) fn run_for_now(&mut self, settings: LineSettings) {
-        self.active = settings;
-        self.before = settings;
-        self.staged = None;
-        self.change = Change::None;
     }
 
     pub(crate) fn staged_value(&self, f: LineField) -> u32 {
@@ -317,9 +302,6 @@ impl Line {
         if let Some(s) = self.staged.take()
             && s != self.active
         {
-            if self.change == Change::None {
-                self.before = self.active;
-            }
             self.change = Change::Due(s);
         }
     }
@@ -376,7 +358,7 @@ impl Line {
         if let Change::Confirming { left_ms } = self.change {
             let left_ms = left_ms.saturating_sub(dt);
             if left_ms == 0 {
-                self.active = self.before;
+                self.active = self.kept;
                 self.change = Change::None;
                 self.reverts = self.reverts.wrapping_add(1);
                 // The settings before the change: the master had them in hand.

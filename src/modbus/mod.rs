@@ -520,18 +520,6 @@ impl<E: Estimator> Server<E> {
         source
     }
 
-    /// At boot, after [`restore`](Self::restore), when the site asks for it (a
-    /// recovery pin held at power-on): the documented default line settings
-    /// ([`LineSettings::DEFAULT`]) in force for this power-on only. The committed
-    /// image keeps its own, which the next power-on brings back; a change committed
-    /// and confirmed from the defaults is kept as any other, one left unconfirmed
-    /// returns to the defaults.
-    pub fn line_defaults_for_now(&mut self) {
-        let c = &mut self.core;
-        c.line.run_for_now(LineSettings::DEFAULT);
-        c.unit = LineSettings::DEFAULT.unit_id;
-    }
-
     /// At boot, after [`restore`](Self::restore): the monitor goes on from its
     /// checkpoint ([`Monitor::resume`]) under the configuration and scene it now runs.
     /// In the other order a committed configuration or scene, applied after, would

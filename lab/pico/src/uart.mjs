@@ -5,10 +5,7 @@
 // emulated time, both ways; BUSY while the transmitter holds a byte; the RX interrupt
 // at the UARTIFLS level, the RX timeout 32 bit times after the last byte, the TX
 // interrupt when the TX FIFO drains through its UARTIFLS level; an overrun when the RX
-// FIFO is full. `sched` is the harness's scheduler (emulated ns). Each write of
-// UARTLCR_H (which latches the divisor) is reported to `onLine` as the rate and frame
-// the node set; `turnaroundNs` is the last time from a received byte's stop bit to the
-// start of the next byte the node sent (an answer's first byte: the answer delay).
+// FIFO is full. `sched` is the harness's scheduler (emulated ns).
 
 const DR = 0x0, RSR = 0x4, FR = 0x18, IBRD = 0x24, FBRD = 0x28, LCR_H = 0x2c, CR = 0x30;
 const IFLS = 0x34, IMSC = 0x38, RIS = 0x3c, MIS = 0x40, ICR = 0x44, DMACR = 0x48;
@@ -44,30 +41,14 @@ export class Uart {
     this.overruns = 0;
     this.received = 0; // bytes the node read
     this.sent = 0;
-    this.lastRxNs = -Infinity; // the last received byte's stop bit (ns)
-    this.lastTxNs = -Infinity; // the last byte the node started sending (ns)
-    this.turnaroundNs = null;
-    this.onLine = () => {};
     peripheral.readUint32 = (offset) => this.read(offset);
     peripheral.writeUint32 = (offset, value) => this.write(offset, value);
   }
 
-  /** The baud rate UARTIBRD and UARTFBRD give (115200 before the node sets them). */
-  baud() {
-    const div = this.ibrd + this.fbrd / 64;
-    return div ? this.mcu.clkPeri / (16 * div) : 115200;
-  }
-
-  /** The parity UARTLCR_H sets: 'none', 'odd', 'even' (or 'stick'). */
-  parity() {
-    if (!(this.lcr & 2)) return 'none';
-    if (this.lcr & 0x80) return 'stick';
-    return this.lcr & 4 ? 'even' : 'odd';
-  }
-
   /** The line's character time (ns). */
   charNs() {
-    const baud = this.baud();
+    const div = this.ibrd + this.fbrd / 64;
+    const baud = div ? this.mcu.clkPeri / (16 * div) : 115200;
     const bits = 1 + 5 + ((this.lcr >> 5) & 3) + (this.lcr & 2 ? 1 : 0) + (this.lcr & 8 ? 2 : 1);
     return (bits * 1e9) / baud;
   }
@@ -101,7 +82,6 @@ export class Uart {
   }
 
   arrived(byte) {
-    this.lastRxNs = this.sched.now();
     if (this.rx.length >= this.depth()) {
       this.overruns += 1;
       this.ris |= OEI;
@@ -123,9 +103,6 @@ export class Uart {
   startShift() {
     if (this.shifting || !this.tx.length) return;
     this.shifting = true;
-    const now = this.sched.now();
-    if (this.lastRxNs > this.lastTxNs) this.turnaroundNs = now - this.lastRxNs;
-    this.lastTxNs = now;
     this.sending(true);
     this.sched.at(this.sched.now() + this.charNs(), () => {
       const before = this.tx.length;
@@ -201,7 +178,6 @@ export class Uart {
         return;
       case LCR_H:
         this.lcr = value & 0xff;
-        this.onLine();
         return;
       case CR:
         this.cr = value & 0xffff;

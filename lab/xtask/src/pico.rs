@@ -4,9 +4,7 @@
 //! - no option: the checks of `tests/modbus/test_pico.py` (pytest, pymodbus in the
 //!   venv of `cargo xtask modbus`): commissioning over the bus surviving a reset,
 //!   power cuts in a checkpoint, a commit and an acknowledgement, each sensor
-//!   unplugged and stuck, the driver-enable pin, UART0's divisor and frame after a
-//!   confirmed and an unconfirmed change of the line settings, the answer delay on the
-//!   line, the recovery pin; then the harness restarted on the
+//!   unplugged and stuck, the driver-enable pin; then the harness restarted on the
 //!   same flash image, the node still commissioned.
 //! - `--serve PORT`: the node on 127.0.0.1:PORT (its UART0 bridged) until killed, in
 //!   real time, its sensors on a steady process.
@@ -33,8 +31,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-// The line settings and the divisor are the node's alone.
-#[allow(dead_code, unused_imports)]
+#[allow(dead_code)]
 #[path = "../../../nodes/pico/src/board.rs"]
 mod board;
 

@@ -11,26 +11,18 @@
 //! | tachometer pulses | GP7 | PWM slice 3, channel B, counting rising edges |
 //! | HX711 DOUT | GP10 | input with pull-up |
 //! | HX711 PD_SCK | GP11 | push-pull output |
-//! | line recovery | GP22 | input with pull-up; a jumper to GND (pin 28) at power-on: the default line settings for that power-on |
 
 use misalign::sensors::{CalibrationError, Hx711Channel, ProbeSpec, SensorCalibration, Timeout};
 
-/// The UART runs the line settings in force (docs/modbus.md, Line settings: the
-/// committed ones, the documented defaults until some are), set by `line`; from reset
-/// until the node has restored them, the defaults.
-pub use misalign::modbus::{LineSettings, Parity};
-
-/// The PL011's baud rate divisor for `baud` from `clk_peri` (Hz): clk_peri / (16
-/// baud) in sixty-fourths, rounded, as its integer part (UARTIBRD, 1 to 65535) and its
-/// fraction (UARTFBRD); 19200 baud from 125 MHz: 406 + 58/64 (19199.8 baud).
-pub fn divisor(clk_peri: u32, baud: u32) -> (u32, u32) {
-    let sixty_fourths = (8 * u64::from(clk_peri) / u64::from(baud.max(1))).div_ceil(2);
-    match sixty_fourths >> 6 {
-        0 => (1, 0),
-        65_535.. => (65_535, 0),
-        ibrd => (ibrd as u32, (sixty_fourths & 63) as u32),
-    }
+/// The UART's baud rate as built (8 data bits, no parity, 1 stop bit: embassy-rp's
+/// defaults); the unit id and the line settings the server reports are commissioned
+/// (docs/modbus.md, Line settings).
+pub struct Line {
+    pub baud: u32,
 }
+
+/// The UART as built: 115200 baud 8N1.
+pub const LINE: Line = Line { baud: 115_200 };
 
 /// The sampling period and the sensors' calibration are commissioned over the bus
 /// (`config_sample_period`, `config_load_zero`, ... in docs/modbus.md) and kept on

@@ -106,12 +106,10 @@ impl<U: Write, D: OutputPin> Write for Rs485<U, D> {
     }
 }
 
-/// The Pico as the node's board: its sensors, its sleep, its watchdog, UART0's rate
-/// and frame, the recovery pin as read at power-on.
+/// The Pico as the node's board: its sensors, its sleep, its watchdog.
 struct Pico {
     sensors: Option<sensors::Sensors>,
     watchdog: Watchdog,
-    recovery_held: bool,
 }
 
 impl serve::Board for Pico {
@@ -133,45 +131,6 @@ impl serve::Board for Pico {
     fn alive(&mut self) {
         self.watchdog
             .feed(Duration::from_millis(board::WATCHDOG_MS));
-    }
-
-    fn line(&mut self, settings: &board::LineSettings) {
-        let (ibrd, fbrd) = board::divisor(embassy_rp::clocks::clk_peri_freq(), settings.baud);
-        let uart = embassy_rp::pac::UART0;
-        // The node calls this at the start and after an answer has left (`Rs485::flush`
-        // waits until the transmitter is idle): the PL011 disabled while its divisor
-        // and frame change, as it asks; UARTLCR_H's write latches the divisor. A byte
-        // coming in meanwhile is lost, as at any change of a line's rate.
-        let control = uart.uartcr().read();
-        uart.uartcr().modify(|w| w.set_uarten(false));
-        uart.uartibrd().write(|w| w.set_baud_divint(ibrd as u16));
-        uart.uartfbrd().write(|w| w.set_baud_divfrac(fbrd as u8));
-        uart.uartlcr_h().write(|w| {
-            // 8 data bits; with no parity, two stop bits.
-            w.set_wlen(0b11);
-            w.set_pen(settings.parity != board::Parity::None);
-            w.set_eps(settings.parity == board::Parity::Even);
-            w.set_stp2(settings.parity == board::Parity::None);
-            w.set_fen(true);
-        });
-        uart.uartcr().write_value(control);
-        defmt::println!(
-            "modbus: UART0 set to {=u32} baud (IBRD {=u32}, FBRD {=u32}), parity {=u8}, {=u8} stop bits",
-            settings.baud,
-            ibrd,
-            fbrd,
-            settings.parity as u8,
-            settings.parity.stop_bits()
-        );
-    }
-
-    fn silence(&self, settings: &board::LineSettings) -> Option<u32> {
-        // The line's clock counts microseconds.
-        Some(settings.silence_us())
-    }
-
-    fn line_defaults(&mut self) -> bool {
-        self.recovery_held
     }
 
     fn sensors(&mut self, settings: &board::SensorSettings) {
@@ -202,16 +161,8 @@ fn main() -> ! {
     let mut watchdog = Watchdog::new(p.WATCHDOG);
     watchdog.start(Duration::from_millis(board::WATCHDOG_MS));
     sleep::init();
-    // The recovery pin, read once its pull-up has raised it (a few µs; 100 here).
-    let recovery = Input::new(p.PIN_22, Pull::Up);
-    let settled = Instant::now().as_micros() + 100;
-    while Instant::now().as_micros() < settled {}
-    let recovery_held = recovery.is_low();
-    drop(recovery);
-    // The documented defaults until the node sets the line settings in force.
     let mut config = Config::default();
-    config.baudrate = board::LineSettings::DEFAULT.baud;
-    config.parity = embassy_rp::uart::Parity::ParityEven;
+    config.baudrate = board::LINE.baud;
     // The RX buffer holds 44 ms of the line: a sample's reads never overflow it.
     let (mut tx_buffer, mut rx_buffer) = ([0u8; 256], [0u8; 512]);
     let uart = BufferedUart::new(
@@ -258,22 +209,17 @@ fn main() -> ! {
     let mut pico = Pico {
         sensors: sensors.ok(),
         watchdog,
-        recovery_held,
     };
     // The unit id and line settings in force are the server's (committed, or the
-    // documented defaults), logged once it has restored them, the UART set to them.
+    // build's), logged once it has restored them; the UART runs the build's baud.
     defmt::println!(
-        "modbus: RS-485 on UART0, driver enable GP2; recovery pin GP22 {=str}",
-        if recovery_held {
-            "held low: the default line settings for this power-on"
-        } else {
-            "released"
-        }
+        "modbus: RS-485 on UART0 at {=u32} baud 8N1, driver enable GP2",
+        board::LINE.baud
     );
     let served = node::fixed_core().map(|core| {
         let clock = serve::LineClock {
             ticks: || Instant::now().as_micros() as u32,
-            silence: board::LineSettings::DEFAULT.silence_us(),
+            silence: misalign::modbus::silence_us(board::LINE.baud),
             // Microseconds.
             per_ms: 1000,
         };
