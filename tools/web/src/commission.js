@@ -5,7 +5,7 @@
 // unlock, write and read back, the scene and its CRC, commit; on any failure the
 // switches put back, revert and lock.
 import { registers, encode, decode, wordsOf } from './registers.js';
-import { Refused, Silent, crc16 } from './modbus.js';
+import { Refused, Silent, crcOk } from './modbus.js';
 
 /** Switches the node applies as written (behind the unlock), kept with a commit. */
 export const SWITCHES = ['latching', 'external_mode'];
@@ -409,11 +409,6 @@ export class Node {
   }
 }
 
-/** `bytes` end in their CRC-16/MODBUS. */
-const crcOk = (bytes) => {
-  const crc = crc16(bytes.subarray(0, -2));
-  return bytes.at(-2) === (crc & 0xff) && bytes.at(-1) === crc >> 8;
-};
 const hex = (bytes) => [...bytes].map((b) => b.toString(16).padStart(2, '0')).join('');
 
 /** Each unit id of `units` asked once for `unit_id` and `map_version` (a read every

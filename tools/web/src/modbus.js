@@ -19,6 +19,12 @@ export function crc16(bytes) {
   return crc;
 }
 
+/** `bytes` end in their CRC-16/MODBUS, low byte first. */
+export function crcOk(bytes) {
+  const crc = crc16(bytes.slice(0, -2));
+  return bytes.at(-2) === (crc & 0xff) && bytes.at(-1) === crc >> 8;
+}
+
 /** What each exception code means (the Modbus specification's names). */
 const EXCEPTIONS = {
   1: 'illegal function',
@@ -111,9 +117,7 @@ export class Client {
       const deadline = performance.now() + timeoutMs;
       const whole = () => {
         const b = this.buffer;
-        if (b.length !== 5 + 2 * n || b[0] !== unit || b[1] !== 3 || b[2] !== 2 * n) return false;
-        const crc = crc16(b.slice(0, -2));
-        return b.at(-2) === (crc & 0xff) && b.at(-1) === crc >> 8;
+        return b.length === 5 + 2 * n && b[0] === unit && b[1] === 3 && b[2] === 2 * n && crcOk(b);
       };
       while (!whole()) {
         const left = deadline - performance.now();
@@ -145,8 +149,7 @@ export class Client {
     else n = 8;
     if (b.length < n) return null;
     const answer = Uint8Array.from(b.slice(0, n));
-    const crc = crc16(answer.subarray(0, n - 2));
-    if (answer[n - 2] !== (crc & 0xff) || answer[n - 1] !== crc >> 8) {
+    if (!crcOk(answer)) {
       throw new Error('a damaged answer (its CRC does not match): noise on the line, or another master');
     }
     return answer;

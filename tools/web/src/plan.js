@@ -19,12 +19,14 @@ function pageNode(wasm) {
   return { node, steps: new Node(new Client(new PageTransport(node)), wasm) };
 }
 
+/** The monitor's configuration registers, by name (the Plan's form and file). */
+const MONITOR = new Set(registers.monitorRegisters().map((e) => e.name));
+
 /** The configuration file: the monitor's configuration the node runs (no line or
  * sensor settings, which are each node's own), `name,value`, as `cargo xtask modbus
  * --default-config` writes it. */
 export function configFile(configuration) {
-  const monitor = new Set(registers.monitorRegisters().map((e) => e.name));
-  const rows = configuration.filter((c) => monitor.has(c.entry.name));
+  const rows = configuration.filter((c) => MONITOR.has(c.entry.name));
   return `name,value\n${rows.map((c) => `${c.entry.name},${c.active.text}`).join('\n')}\n`;
 }
 
@@ -38,8 +40,7 @@ export function setupPlan(wasm) {
   // The configuration's inputs, from the register map, with the node's defaults.
   (async () => {
     const { steps } = pageNode(wasm);
-    const monitor = new Set(registers.monitorRegisters().map((e) => e.name));
-    for (const c of (await steps.configuration()).filter((c) => monitor.has(c.entry.name))) {
+    for (const c of (await steps.configuration()).filter((c) => MONITOR.has(c.entry.name))) {
       defaults.set(c.entry.name, c.staged.text);
       const label = document.createElement('label');
       label.title = c.entry.description;
